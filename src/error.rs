@@ -1,0 +1,66 @@
+//! Errors raised where input enters photonwave: files, scene descriptions, settings.
+//!
+//! Every variant names what the user can fix: the file, the line or the setting's field.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Everything that can go wrong before or while rendering, caused by input.
+#[derive(Debug)]
+pub enum Error {
+    /// A file could not be read at all.
+    Io { path: PathBuf, message: String },
+    /// A file was read but its content is wrong at a known line (1-based; 0 when unknown).
+    Parse { path: PathBuf, line: usize, message: String },
+    /// The scene as a whole cannot be rendered (no light, zero-area emitter, …).
+    Scene { message: String },
+    /// A setting has a value that makes no sense; `field` is its name as the user wrote it.
+    Setting { field: String, message: String },
+    /// Writing an output file failed.
+    Output { path: PathBuf, message: String },
+}
+
+impl Error {
+    /// An I/O error on `path`.
+    pub fn io(path: &Path, err: impl fmt::Display) -> Self {
+        Error::Io { path: path.to_path_buf(), message: err.to_string() }
+    }
+    /// A parse error at `line` (1-based) of `path`.
+    pub fn parse(path: &Path, line: usize, message: impl Into<String>) -> Self {
+        Error::Parse { path: path.to_path_buf(), line, message: message.into() }
+    }
+    /// A scene-level error.
+    pub fn scene(message: impl Into<String>) -> Self {
+        Error::Scene { message: message.into() }
+    }
+    /// A bad setting.
+    pub fn setting(field: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Setting { field: field.into(), message: message.into() }
+    }
+    /// A failure while writing `path`.
+    pub fn output(path: &Path, err: impl fmt::Display) -> Self {
+        Error::Output { path: path.to_path_buf(), message: err.to_string() }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Io { path, message } => write!(f, "{}: cannot read: {message}", path.display()),
+            Error::Parse { path, line: 0, message } => write!(f, "{}: {message}", path.display()),
+            Error::Parse { path, line, message } => {
+                write!(f, "{}:{line}: {message}", path.display())
+            }
+            Error::Scene { message } => write!(f, "scene error: {message}"),
+            Error::Setting { field, message } => write!(f, "setting `{field}`: {message}"),
+            Error::Output { path, message } => {
+                write!(f, "{}: cannot write: {message}", path.display())
+            }
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// Shorthand used across the crate.
+pub type Result<T> = std::result::Result<T, Error>;

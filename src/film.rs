@@ -1,0 +1,152 @@
+//! The film: per-pixel sums of each Jensen term, the beauty image as their sum, and output as a
+//! multi-layer EXR and a tone-mapped PNG preview.
+
+use crate::error::{Error as PwError, Result};
+use glam::Vec3;
+use std::path::Path;
+
+/// The terms radiance is split into; their sum is the beauty image.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Terms {
+    /// Emission seen directly by the camera.
+    pub emitted: Vec3,
+    /// Direct light at the first non-specular hit (light sampling).
+    pub direct: Vec3,
+    /// Everything seen through mirrors and glass, and the glossy lobe's reflection.
+    pub specular: Vec3,
+    /// Caustic-map estimate at the first non-specular hit.
+    pub caustic: Vec3,
+    /// Indirect diffuse light (final gather or the global map) at the first non-specular hit.
+    pub indirect: Vec3,
+}
+
+/// Layer names in EXR order (beauty is the unnamed default layer).
+pub const TERM_NAMES: [&str; 5] = ["emitted", "direct", "specular", "caustic", "indirect"];
+
+impl Terms {
+    /// Sum of all terms.
+    #[must_use]
+    pub fn beauty(&self) -> Vec3 {
+        self.emitted + self.direct + self.specular + self.caustic + self.indirect
+    }
+    /// The terms as an array, in [`TERM_NAMES`] order.
+    #[must_use]
+    pub fn as_array(&self) -> [Vec3; 5] {
+        [self.emitted, self.direct, self.specular, self.caustic, self.indirect]
+    }
+    /// True if every component is finite.
+    #[must_use]
+    pub fn is_finite(&self) -> bool {
+        self.as_array().iter().all(|v| v.is_finite())
+    }
+}
+
+impl std::ops::AddAssign for Terms {
+    fn add_assign(&mut self, o: Terms) {
+        self.emitted += o.emitted;
+        self.direct += o.direct;
+        self.specular += o.specular;
+        self.caustic += o.caustic;
+        self.indirect += o.indirect;
+    }
+}
+
+impl std::ops::Mul<f32> for Terms {
+    type Output = Terms;
+    fn mul(self, s: f32) -> Terms {
+        Terms {
+            emitted: self.emitted * s,
+            direct: self.direct * s,
+            specular: self.specular * s,
+            caustic: self.caustic * s,
+            indirect: self.indirect * s,
+        }
+    }
+}
+
+/// A finished image: per-pixel mean of each term, row-major, y down.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Per-pixel terms.
+    pub pixels: Vec<Terms>,
+}
+
+impl Film {
+    /// Beauty image as RGB triples.
+    #[must_use]
+    pub fn beauty(&self) -> Vec<Vec3> {
+        self.pixels.iter().map(Terms::beauty).collect()
+    }
+
+    /// Mean of the beauty image.
+    #[must_use]
+    pub fn mean(&self) -> Vec3 {
+        let sum: Vec3 = self.pixels.iter().map(Terms::beauty).sum();
+        sum / self.pixels.len().max(1) as f32
+    }
+
+    /// Writes the EXR: default layer R, G, B = beauty; one layer per term (`direct.R`, …).
+    pub fn write_exr(&self, path: &Path) -> Result<()> {
+        use exr::prelude::*;
+        let size = Vec2(self.width as usize, self.height as usize);
+        let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
+        let mut push = |name: String, get: &dyn Fn(&Terms) -> Vec3| {
+            for (c, suffix) in ["R", "G", "B"].iter().enumerate() {
+                let data: Vec<f32> = self.pixels.iter().map(|t| get(t)[c]).collect();
+                let full = if name.is_empty() { suffix.to_string() } else { format!("{name}.{suffix}") };
+                channels.push(AnyChannel::new(full.as_str(), FlatSamples::F32(data)));
+            }
+        };
+        push(String::new(), &|t| t.beauty());
+        for (i, name) in TERM_NAMES.iter().enumerate() {
+            push(name.to_string(), &move |t: &Terms| t.as_array()[i]);
+        }
+        let layer =
+            Layer::new(size, LayerAttributes::default(), Encoding::FAST_LOSSLESS, AnyChannels::sort(channels.into()));
+        Image::from_layer(layer).write().to_file(path).map_err(|e| PwError::output(path, e))
+    }
+
+    /// Writes a tone-mapped 8-bit sRGB PNG of the beauty image (exposure 1, clamped).
+    pub fn write_png(&self, path: &Path) -> Result<()> {
+        let file = std::fs::File::create(path).map_err(|e| PwError::output(path, e))?;
+        let mut enc = png::Encoder::new(std::io::BufWriter::new(file), self.width, self.height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header().map_err(|e| PwError::output(path, e))?;
+        let bytes: Vec<u8> = self.beauty().iter().flat_map(|c| c.to_array().map(srgb8)).collect();
+        w.write_image_data(&bytes).map_err(|e| PwError::output(path, e))?;
+        w.finish().map_err(|e| PwError::output(path, e))
+    }
+}
+
+/// Linear value → 8-bit sRGB.
+fn srgb8(v: f32) -> u8 {
+    let v = if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 };
+    let s = if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// Reads the named layer (`""` for beauty) of an EXR written by [`Film::write_exr`] as RGB.
+pub fn read_exr_layer(path: &Path, layer: &str) -> Result<(u32, u32, Vec<Vec3>)> {
+    use exr::prelude::*;
+    let image = read_all_flat_layers_from_file(path).map_err(|e| PwError::io(path, e))?;
+    let l = image.layer_data.first().ok_or_else(|| PwError::parse(path, 0, "EXR has no layer"))?;
+    let (w, h) = (l.size.0, l.size.1);
+    let find = |c: &str| {
+        let name = if layer.is_empty() { c.to_string() } else { format!("{layer}.{c}") };
+        l.channel_data
+            .list
+            .iter()
+            .find(|ch| ch.name.eq(name.as_str()))
+            .map(|ch| ch.sample_data.values_as_f32().collect::<Vec<f32>>())
+    };
+    let (r, g, b) = match (find("R"), find("G"), find("B")) {
+        (Some(r), Some(g), Some(b)) => (r, g, b),
+        _ => return Err(PwError::parse(path, 0, format!("EXR has no RGB channels for layer `{layer}`"))),
+    };
+    Ok((w as u32, h as u32, (0..w * h).map(|i| Vec3::new(r[i], g[i], b[i])).collect()))
+}

@@ -1,0 +1,116 @@
+//! The bounding volume hierarchy: obvhs builds a BVH2 over padded triangle boxes; traversal
+//! calls our watertight triangle test.
+//!
+//! obvhs 0.4.0 computes Morton codes over the union of the primitive boxes; a box centre lying
+//! exactly on that union's max face gets a code that wraps to 0 (DESIGN.md §8), so the +x/+y/+z
+//! walls of every closed room sort next to the opposite walls and traversal slows 5–13×. We pad
+//! every primitive box symmetrically by a small fraction of the scene diagonal: centres do not
+//! move, the union grows, and no centre lies on its max face. Padding also keeps the slab test
+//! conservative for flat boxes and rays that graze box faces.
+
+use super::triangle::{intersect_triangle, TriangleHit};
+use glam::{Vec3, Vec3A};
+use obvhs::{aabb::Aabb, bvh2::Bvh2, ray::Ray, BvhBuildParams};
+
+/// Relative padding of primitive boxes (fraction of the scene diagonal).
+pub const BOX_PAD: f32 = 1e-5;
+
+/// A closest hit: triangle index (in the scene's BVH order), distance and barycentrics.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Triangle index.
+    pub tri: u32,
+    /// Ray parameter.
+    pub t: f32,
+    /// Barycentrics of the three vertices.
+    pub b: [f32; 3],
+}
+
+/// A BVH over triangles stored as three vertex columns.
+pub struct Bvh {
+    bvh: Bvh2,
+}
+
+impl Bvh {
+    /// Builds over the triangles (p0[i], p1[i], p2[i]). Returns the BVH and the permutation:
+    /// `order[k]` is the input index of the triangle the BVH calls `k`; callers reorder their
+    /// per-triangle columns by it so that leaf indices address them directly.
+    #[must_use]
+    pub fn build(p0: &[Vec3], p1: &[Vec3], p2: &[Vec3]) -> (Bvh, Vec<u32>) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for p in p0.iter().chain(p1).chain(p2) {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        let diag = if p0.is_empty() { 1.0 } else { (hi - lo).length().max(f32::MIN_POSITIVE) };
+        let boxes: Vec<Aabb> = (0..p0.len())
+            .map(|i| {
+                let mn = p0[i].min(p1[i]).min(p2[i]);
+                let mx = p0[i].max(p1[i]).max(p2[i]);
+                // Padding relative to both the scene and the box's own magnitude.
+                let pad = Vec3::splat(diag * BOX_PAD) + mn.abs().max(mx.abs()) * 4.0 * f32::EPSILON;
+                Aabb::new(Vec3A::from(mn - pad), Vec3A::from(mx + pad))
+            })
+            .collect();
+        let mut build_time = std::time::Duration::ZERO;
+        let bvh = obvhs::bvh2::builder::build_bvh2(&boxes, BvhBuildParams::medium_build(), &mut build_time);
+        let order = bvh.primitive_indices.clone();
+        (Bvh { bvh }, order)
+    }
+
+    /// Closest hit with 0 < t < `t_max` among triangles given by the BVH-ordered columns.
+    #[must_use]
+    pub fn closest(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> Option<Hit> {
+        if self.bvh.nodes.is_empty() || !o.is_finite() || !d.is_finite() {
+            return None;
+        }
+        let ray = Ray::new(Vec3A::from(o), Vec3A::from(d), 0.0, t_max);
+        let mut best: Option<TriangleHit> = None;
+        let mut best_tri = 0u32;
+        let mut rh = obvhs::ray::RayHit::none();
+        self.bvh.ray_traverse(ray, &mut rh, |r, id| {
+            match intersect_triangle(o, d, r.tmax, tris.p0[id], tris.p1[id], tris.p2[id]) {
+                Some(h) => {
+                    best = Some(h);
+                    best_tri = id as u32;
+                    h.t
+                }
+                None => f32::INFINITY,
+            }
+        });
+        best.map(|h| Hit { tri: best_tri, t: h.t, b: h.b })
+    }
+
+    /// True if any triangle is hit with 0 < t < `t_max` (shadow rays).
+    #[must_use]
+    pub fn occluded(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> bool {
+        if self.bvh.nodes.is_empty() || !o.is_finite() || !d.is_finite() {
+            return false;
+        }
+        let ray = Ray::new(Vec3A::from(o), Vec3A::from(d), 0.0, t_max);
+        !self.bvh.ray_traverse_miss(ray, |_, id| {
+            match intersect_triangle(o, d, t_max, tris.p0[id], tris.p1[id], tris.p2[id]) {
+                Some(h) => h.t,
+                None => f32::INFINITY,
+            }
+        })
+    }
+
+    /// The underlying obvhs BVH2 (for benchmarks and packet traversal).
+    #[must_use]
+    pub fn bvh2(&self) -> &Bvh2 {
+        &self.bvh
+    }
+}
+
+/// Borrowed vertex columns in BVH order.
+#[derive(Clone, Copy)]
+pub struct TriangleColumns<'a> {
+    /// First vertices.
+    pub p0: &'a [Vec3],
+    /// Second vertices.
+    pub p1: &'a [Vec3],
+    /// Third vertices.
+    pub p2: &'a [Vec3],
+}

@@ -1,0 +1,9 @@
+//! Geometry: watertight ray/triangle intersection, robust ray origins, and the obvhs BVH.
+
+pub mod bvh;
+pub mod offset;
+pub mod triangle;
+
+pub use bvh::{Bvh, Hit};
+pub use offset::{gamma, offset_ray_origin};
+pub use triangle::intersect_triangle;

@@ -1,0 +1,243 @@
+//! The photonwave command line: `photonwave render SCENE [flags]`.
+
+use clap::{Parser, Subcommand};
+use glam::Vec3;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use photonwave::error::{Error, Result};
+use photonwave::reference::{self, MapPlan, Progress};
+use photonwave::scene::file::{fitted_camera, load_scene};
+use photonwave::settings::Kernel;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Mutex;
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(name = "photonwave", version, about = "A photon-mapping renderer (Jensen 1996)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene (.toml scene file or bare .obj) to a multi-layer EXR.
+    Render(RenderArgs),
+}
+
+fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 3 {
+        return Err(format!("expected X,Y,Z, got `{s}`"));
+    }
+    let mut v = [0.0f32; 3];
+    for (i, p) in parts.iter().enumerate() {
+        v[i] = p.trim().parse().map_err(|_| format!("`{p}` is not a number"))?;
+        if !v[i].is_finite() {
+            return Err(format!("`{p}` is not finite"));
+        }
+    }
+    Ok(Vec3::from_array(v))
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// Scene file (.toml) or mesh (.obj with its .mtl).
+    scene: PathBuf,
+    /// Output EXR (beauty as the default layer, one layer per term).
+    #[arg(short, long, default_value = "out.exr")]
+    output: PathBuf,
+    /// Image width in pixels [scene file, else 320].
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels [scene file, else 320].
+    #[arg(long)]
+    height: Option<u32>,
+    /// Camera position X,Y,Z [scene file, else fitted to the scene bounds].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    eye: Option<Vec3>,
+    /// Point the camera looks at X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    target: Option<Vec3>,
+    /// Camera up direction X,Y,Z [0,1,0].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    up: Option<Vec3>,
+    /// Vertical field of view in degrees [scene file, else 40].
+    #[arg(long)]
+    fov: Option<f32>,
+    /// Jittered samples per pixel [16].
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Photons to store in the global map [200000].
+    #[arg(long)]
+    photons: Option<u32>,
+    /// Photons to store in the caustic map [100000].
+    #[arg(long)]
+    caustic_photons: Option<u32>,
+    /// Nearest photons per estimate, both maps [global 64, caustic 48].
+    #[arg(long)]
+    k: Option<u32>,
+    /// Density-estimation kernel: box, cone, epanechnikov [cone].
+    #[arg(long)]
+    kernel: Option<Kernel>,
+    /// Final-gather rays per camera sample [4].
+    #[arg(long)]
+    gather_rays: Option<u32>,
+    /// Read the global map directly at the first diffuse hit instead of final gathering.
+    #[arg(long)]
+    no_final_gather: bool,
+    /// Longest photon path / specular chain [10].
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Seed of all random streams [1].
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Worker threads, 0 = all cores [0].
+    #[arg(long)]
+    threads: Option<u32>,
+    /// Write the summary as JSON to this file.
+    #[arg(long)]
+    stats: Option<PathBuf>,
+    /// Write a tone-mapped PNG preview to this file.
+    #[arg(long)]
+    png: Option<PathBuf>,
+    /// Engine: `reference` (scalar photon mapper) or `path` (unbiased path tracer, for validation).
+    #[arg(long, default_value = "reference")]
+    engine: Engine,
+    /// No progress bars.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Engine {
+    /// The scalar reference photon mapper.
+    Reference,
+    /// An unbiased path tracer with next-event estimation (slow; for checking energy).
+    Path,
+}
+
+/// indicatif progress bars on stderr, one per phase.
+struct Bars {
+    bar: Mutex<Option<ProgressBar>>,
+    quiet: bool,
+}
+
+impl Progress for Bars {
+    fn start(&self, phase: &str, total: u64) {
+        if self.quiet {
+            return;
+        }
+        let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template("{prefix:>16} [{bar:40}] {pos}/{len} ({elapsed}, eta {eta})")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+        );
+        bar.set_prefix(phase.to_string());
+        *self.bar.lock().unwrap_or_else(|e| e.into_inner()) = Some(bar);
+    }
+    fn advance(&self, n: u64) {
+        if let Some(b) = &*self.bar.lock().unwrap_or_else(|e| e.into_inner()) {
+            b.inc(n);
+        }
+    }
+    fn finish(&self) {
+        if let Some(b) = self.bar.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            b.finish();
+        }
+    }
+}
+
+fn render(args: RenderArgs) -> Result<()> {
+    let t0 = Instant::now();
+    let loaded = load_scene(&args.scene)?;
+    let scene = loaded.scene;
+    let mut settings = loaded.settings;
+    macro_rules! set {
+        ($($f:ident),*) => { $( if let Some(v) = args.$f { settings.$f = v; } )* };
+    }
+    set!(width, height, spp, photons, caustic_photons, gather_rays, max_depth, seed, threads, kernel);
+    if let Some(k) = args.k {
+        settings.k = k;
+        settings.caustic_k = k;
+    }
+    if args.no_final_gather {
+        settings.final_gather = false;
+    }
+    settings.validate()?;
+    let fov = args.fov.or(loaded.camera.map(|c| c.fov_deg)).unwrap_or(40.0);
+    let mut camera = loaded.camera.unwrap_or_else(|| fitted_camera(&scene, fov));
+    camera.fov_deg = fov;
+    if let Some(e) = args.eye {
+        camera.eye = e;
+    }
+    if let Some(t) = args.target {
+        camera.target = t;
+    }
+    if let Some(u) = args.up {
+        camera.up = u;
+    }
+    let rays = camera.prepare(settings.width, settings.height)?;
+    let load_s = t0.elapsed().as_secs_f64();
+
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let plan = MapPlan::for_scene(&scene);
+    eprintln!(
+        "scene: {} triangles, {} materials, {} lights ({} emissive triangles), total power {:.3} W",
+        scene.triangle_count(),
+        scene.materials.len(),
+        scene.lights.len(),
+        scene.area_lights.len(),
+        scene.total_power().element_sum() / 3.0
+    );
+    eprintln!("plan: global map {} — {}", if plan.global { "on" } else { "off" }, plan.global_reason);
+    eprintln!("plan: caustic map {} — {}", if plan.caustic { "on" } else { "off" }, plan.caustic_reason);
+    eprintln!(
+        "plan: indirect light by {}",
+        if settings.final_gather {
+            format!("final gather ({} rays per sample)", settings.gather_rays)
+        } else {
+            "reading the global map at the first hit".into()
+        }
+    );
+    let quiet = args.quiet || !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let bars = Bars { bar: Mutex::new(None), quiet };
+    let (film, mut stats) = match args.engine {
+        Engine::Reference => reference::render(&scene, &rays, &settings, &bars)?,
+        Engine::Path => reference::path::render_path_traced_with_stats(&scene, &rays, &settings, &bars)?,
+    };
+    stats.scene = args.scene.display().to_string();
+    stats.times.load_s = load_s;
+    stats.times.total_s += load_s;
+
+    film.write_exr(&args.output)?;
+    eprintln!("wrote {}", args.output.display());
+    if let Some(p) = &args.png {
+        film.write_png(p)?;
+        eprintln!("wrote {}", p.display());
+    }
+    eprint!("{}", stats.summary());
+    if let Some(p) = &args.stats {
+        let json = serde_json::to_string_pretty(&stats).map_err(|e| Error::output(p, e))?;
+        std::fs::write(p, json).map_err(|e| Error::output(p, e))?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(args) => render(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,374 @@
+//! The camera pass: jittered camera rays; mirrors and glass by ray tracing; at the first
+//! non-specular hit, Jensen's terms — direct light by light sampling, caustics from the caustic
+//! map, indirect diffuse by final gather over the global map (or the global map read directly),
+//! and the glossy lobe by one traced ray.
+//!
+//! Double counting is avoided by construction: final-gather and glossy rays never add emission
+//! (that is the direct term) and read full map estimates only at non-specular hits; a gather ray
+//! that ends on an emitter through mirrors is an `LS+D` caustic, already in the caustic map.
+
+use super::parallel::map_chunks;
+use super::{PhotonMaps, Progress};
+use crate::film::{Film, Terms};
+use crate::geometry::offset::offset_ray_origin;
+use crate::material::{Bsdf, Transport};
+use crate::photon_map::flags;
+use crate::rng::{Domain, Sampler};
+use crate::sampling::{cosine_hemisphere, Frame};
+use crate::scene::camera::CameraRays;
+use crate::scene::{Scene, SurfacePoint};
+use crate::settings::Settings;
+use crate::stats::RayCounts;
+use glam::Vec3;
+
+/// Shadow rays stop this fraction short of the light point (relative, so scale-free).
+const SHADOW_SHORTEN: f32 = 1e-4;
+/// Sub-stream tags.
+const TAG_GATHER: u64 = 1 << 32;
+const TAG_GLOSSY: u64 = 2 << 32;
+const TAG_LIGHT: u64 = 3 << 32;
+
+/// Everything a camera path needs.
+pub struct Context<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// The photon maps.
+    pub maps: &'a PhotonMaps,
+    /// The settings.
+    pub settings: &'a Settings,
+    /// Global-map radius in scene units.
+    pub global_radius: f32,
+    /// Caustic-map radius in scene units.
+    pub caustic_radius: f32,
+}
+
+impl<'a> Context<'a> {
+    /// Prepares radii from the scene size.
+    #[must_use]
+    pub fn new(scene: &'a Scene, maps: &'a PhotonMaps, settings: &'a Settings) -> Self {
+        let d = scene.diagonal();
+        Context {
+            scene,
+            maps,
+            settings,
+            global_radius: settings.global_radius * d,
+            caustic_radius: settings.caustic_radius * d,
+        }
+    }
+}
+
+/// Renders every pixel; returns the film, rays traced and dropped non-finite samples.
+pub fn render_image(
+    scene: &Scene,
+    maps: &PhotonMaps,
+    camera: &CameraRays,
+    settings: &Settings,
+    threads: usize,
+    progress: &dyn Progress,
+) -> (Film, RayCounts, u64) {
+    let ctx = Context::new(scene, maps, settings);
+    render_pixels(settings, camera, threads, progress, |o, d, s, rays, scratch| {
+        trace_camera_path(&ctx, o, d, s, rays, scratch)
+    })
+}
+
+/// The pixel loop shared by the photon mapper and the path tracer: rows in parallel, each pixel
+/// the mean of its jittered samples (stratified when spp is a square), non-finite samples
+/// dropped and counted. `radiance(o, d, sampler, rays, scratch)` traces one camera ray.
+pub fn render_pixels(
+    settings: &Settings,
+    camera: &CameraRays,
+    threads: usize,
+    progress: &dyn Progress,
+    radiance: impl Fn(Vec3, Vec3, &Sampler, &mut RayCounts, &mut Vec<(f32, u32)>) -> Terms + Sync,
+) -> (Film, RayCounts, u64) {
+    let (w, h) = (settings.width as usize, settings.height as usize);
+    let spp = settings.spp;
+    let strata = (spp as f32).sqrt() as u32;
+    let stratified = strata * strata == spp;
+    progress.start("camera", h as u64);
+    let rows = map_chunks(
+        h,
+        1,
+        threads,
+        |range| {
+            let mut rays = RayCounts::default();
+            let mut bad = 0u64;
+            let mut scratch = Vec::new();
+            let mut row = Vec::with_capacity(w * range.len());
+            for y in range {
+                for x in 0..w {
+                    let mut sum = Terms::default();
+                    for s in 0..spp {
+                        let index = ((y * w + x) as u64) * spp as u64 + s as u64;
+                        let sampler = Sampler::new(settings.seed, Domain::Camera, index);
+                        let (jx, jy) = (sampler.get(0, 0), sampler.get(0, 1));
+                        let (fx, fy) = if stratified {
+                            (((s % strata) as f32 + jx) / strata as f32, ((s / strata) as f32 + jy) / strata as f32)
+                        } else {
+                            (jx, jy)
+                        };
+                        let (o, d) = camera.ray(x as f32 + fx, y as f32 + fy);
+                        let t = radiance(o, d, &sampler, &mut rays, &mut scratch);
+                        if t.is_finite() {
+                            sum += t;
+                        } else {
+                            bad += 1;
+                        }
+                    }
+                    row.push(sum * (1.0 / spp as f32));
+                }
+            }
+            (row, rays, bad)
+        },
+        |n| progress.advance(n as u64),
+    );
+    progress.finish();
+    let mut pixels = Vec::with_capacity(w * h);
+    let mut rays = RayCounts::default();
+    let mut bad = 0;
+    for (row, r, b) in rows {
+        pixels.extend(row);
+        rays += r;
+        bad += b;
+    }
+    (Film { width: settings.width, height: settings.height, pixels }, rays, bad)
+}
+
+/// Radiance along one camera ray, split into terms.
+pub fn trace_camera_path(
+    ctx: &Context,
+    mut o: Vec3,
+    mut d: Vec3,
+    s: &Sampler,
+    rays: &mut RayCounts,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Terms {
+    let scene = ctx.scene;
+    let mut terms = Terms::default();
+    let mut beta = Vec3::ONE;
+    let mut through_specular = false;
+    for depth in 0..=ctx.settings.max_depth {
+        rays.camera += 1;
+        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else { break };
+        let sp = scene.surface(&hit);
+        let mat = &scene.materials[sp.material as usize];
+        let wo = -d;
+        if mat.emission != Vec3::ZERO && wo.dot(sp.frame.ng) > 0.0 {
+            let e = beta * mat.emission;
+            if through_specular {
+                terms.specular += e;
+            } else {
+                terms.emitted += e;
+            }
+        }
+        if mat.bsdf.is_delta() {
+            if depth == ctx.settings.max_depth {
+                break;
+            }
+            let u = [s.get(depth + 1, 0), s.get(depth + 1, 1), s.get(depth + 1, 2)];
+            let Some(bs) = mat.bsdf.sample(&sp.frame, wo, u, Transport::Radiance) else { break };
+            beta *= bs.weight;
+            through_specular = true;
+            o = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi);
+            d = bs.wi;
+            continue;
+        }
+        let ls = s.fork(TAG_LIGHT + depth as u64);
+        let direct = beta * direct_light(ctx, &sp, &mat.bsdf, wo, &ls, rays);
+        let caustic = beta * caustic_estimate(ctx, &sp, &mat.bsdf, wo, scratch);
+        let indirect = beta
+            * if ctx.settings.final_gather {
+                final_gather(ctx, &sp, &mat.bsdf, wo, &s.fork(TAG_GATHER + depth as u64), rays, scratch)
+            } else {
+                global_estimate(ctx, &sp, &mat.bsdf, wo, flags::DIRECT | flags::CAUSTIC, scratch)
+            };
+        let glossy =
+            beta * glossy_reflection(ctx, &sp, &mat.bsdf, wo, &s.fork(TAG_GLOSSY + depth as u64), rays, scratch);
+        if through_specular {
+            terms.specular += direct + caustic + indirect + glossy;
+        } else {
+            terms.direct += direct;
+            terms.caustic += caustic;
+            terms.indirect += indirect;
+            terms.specular += glossy;
+        }
+        break;
+    }
+    terms
+}
+
+/// Direct light at `sp` toward `wo`: every delta light once, area lights by `light_samples`
+/// samples chosen by power; each with a shadow ray.
+pub fn direct_light(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    s: &Sampler,
+    rays: &mut RayCounts,
+) -> Vec3 {
+    let scene = ctx.scene;
+    let (_, ns) = sp.frame.oriented(wo);
+    let mut sum = Vec3::ZERO;
+    let mut add = |light_index: u32, u: [f32; 2], weight: f32, rays: &mut RayCounts| {
+        let light = &scene.lights[light_index as usize];
+        let tri = scene.light_triangle(light);
+        let Some(inc) = light.sample_incident(tri.as_ref(), sp.p, u) else { return };
+        let f = bsdf.eval(&sp.frame, wo, inc.wi);
+        let cos = inc.wi.dot(ns).abs();
+        if f == Vec3::ZERO || cos == 0.0 {
+            return;
+        }
+        rays.shadow += 1;
+        let origin = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, inc.wi);
+        let blocked = match inc.point {
+            Some((q, _)) => scene.occluded(origin, q - origin, 1.0 - SHADOW_SHORTEN),
+            None => scene.occluded(origin, inc.wi, f32::INFINITY),
+        };
+        if !blocked {
+            sum += f * inc.value * (cos * weight);
+        }
+    };
+    for &li in &scene.delta_lights {
+        add(li, [0.5, 0.5], 1.0, rays);
+    }
+    if let Some(dist) = &scene.area_power {
+        let n = ctx.settings.light_samples;
+        for j in 0..n {
+            let pick = dist.sample(s.get(j, 0));
+            let pmf = dist.pmf(pick) as f32;
+            add(scene.area_lights[pick], [s.get(j, 1), s.get(j, 2)], 1.0 / (pmf * n as f32), rays);
+        }
+    }
+    sum
+}
+
+/// Caustic-map radiance estimate at `sp` toward `wo`.
+pub fn caustic_estimate(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Vec3 {
+    let (ng, _) = sp.frame.oriented(wo);
+    let k = ctx.settings.caustic_k as usize;
+    ctx.maps
+        .caustic
+        .estimate(sp.p, ng, k, ctx.caustic_radius, ctx.settings.kernel, 0, |wi| bsdf.eval(&sp.frame, wo, wi), scratch)
+        .radiance
+}
+
+/// Global-map radiance estimate at `sp` toward `wo`, ignoring photons with any `mask` flag.
+pub fn global_estimate(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    mask: u8,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Vec3 {
+    let (ng, _) = sp.frame.oriented(wo);
+    let k = ctx.settings.k as usize;
+    ctx.maps
+        .global
+        .estimate(sp.p, ng, k, ctx.global_radius, ctx.settings.kernel, mask, |wi| bsdf.eval(&sp.frame, wo, wi), scratch)
+        .radiance
+}
+
+/// Final gather: `kd/N · Σ L(x, ωi)` over N cosine-weighted rays, L read from the global map at
+/// the first non-specular hit (following mirrors and glass, adding no emission).
+pub fn final_gather(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    s: &Sampler,
+    rays: &mut RayCounts,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Vec3 {
+    let kd = bsdf.diffuse();
+    if kd == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let (ng, ns) = sp.frame.oriented(wo);
+    let frame = Frame::new(ns);
+    let n = ctx.settings.gather_rays;
+    let mut sum = Vec3::ZERO;
+    for g in 0..n {
+        let wi = frame.to_world(cosine_hemisphere([s.get(g, 0), s.get(g, 1)]));
+        if wi.dot(ng) <= 0.0 {
+            continue;
+        }
+        let o = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, wi);
+        sum += incoming_from_map(ctx, o, wi, &s.fork(g as u64), rays, scratch);
+    }
+    kd * sum / n as f32
+}
+
+/// Radiance arriving at `o` from direction `-d`, as the global map sees it at the first
+/// non-specular hit (through at most `max_depth` mirror/glass bounces; no emission).
+fn incoming_from_map(
+    ctx: &Context,
+    mut o: Vec3,
+    mut d: Vec3,
+    s: &Sampler,
+    rays: &mut RayCounts,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Vec3 {
+    let scene = ctx.scene;
+    let mut beta = Vec3::ONE;
+    for depth in 0..=ctx.settings.max_depth {
+        rays.gather += 1;
+        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else { return Vec3::ZERO };
+        let sp = scene.surface(&hit);
+        let bsdf = &scene.materials[sp.material as usize].bsdf;
+        if !bsdf.is_delta() {
+            return beta * global_estimate(ctx, &sp, bsdf, -d, 0, scratch);
+        }
+        let u = [s.get(depth, 0), s.get(depth, 1), s.get(depth, 2)];
+        let Some(bs) = bsdf.sample(&sp.frame, -d, u, Transport::Radiance) else { return Vec3::ZERO };
+        beta *= bs.weight;
+        o = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi);
+        d = bs.wi;
+    }
+    Vec3::ZERO
+}
+
+/// The glossy lobe's reflection: one ray sampled from the lobe; at its first non-specular hit,
+/// direct light, caustics and the global map without direct and caustic photons (so each path
+/// is counted once: emission reached by this ray is already in the direct term).
+pub fn glossy_reflection(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    s: &Sampler,
+    rays: &mut RayCounts,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Vec3 {
+    let Some(bs) = bsdf.sample_glossy(&sp.frame, wo, [s.get(0, 0), s.get(0, 1)]) else { return Vec3::ZERO };
+    let mut o = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi);
+    let mut d = bs.wi;
+    let mut beta = bs.weight;
+    let scene = ctx.scene;
+    for depth in 0..=ctx.settings.max_depth {
+        rays.gather += 1;
+        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else { return Vec3::ZERO };
+        let y = scene.surface(&hit);
+        let b = &scene.materials[y.material as usize].bsdf;
+        if !b.is_delta() {
+            let direct = direct_light(ctx, &y, b, -d, &s.fork(7), rays);
+            let caustic = caustic_estimate(ctx, &y, b, -d, scratch);
+            let rest = global_estimate(ctx, &y, b, -d, flags::DIRECT | flags::CAUSTIC, scratch);
+            return beta * (direct + caustic + rest);
+        }
+        let u = [s.get(depth + 1, 0), s.get(depth + 1, 1), s.get(depth + 1, 2)];
+        let Some(bs) = b.sample(&y.frame, -d, u, Transport::Radiance) else { return Vec3::ZERO };
+        beta *= bs.weight;
+        o = offset_ray_origin(y.p, y.p_error, y.frame.ng, bs.wi);
+        d = bs.wi;
+    }
+    Vec3::ZERO
+}

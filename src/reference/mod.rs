@@ -1,0 +1,202 @@
+//! The scalar reference renderer (Jensen 1996), one ray at a time, no ECS, no SIMD: the oracle
+//! every faster engine is compared against. Written for obviousness.
+//!
+//! A render is: plan which maps the scene needs → photon passes (global, caustic) → kd-trees →
+//! camera pass (direct + specular + caustic + indirect per pixel sample).
+
+pub mod camera;
+pub mod parallel;
+pub mod path;
+pub mod photons;
+
+use crate::error::{Error, Result};
+use crate::film::Film;
+use crate::photon_map::PhotonMap;
+use crate::rng::Domain;
+use crate::scene::camera::CameraRays;
+use crate::scene::Scene;
+use crate::settings::Settings;
+use crate::stats::{MapStats, RenderStats};
+use std::time::Instant;
+
+/// Which photon maps a scene needs, and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapPlan {
+    /// Build the global map.
+    pub global: bool,
+    /// Why (or why not).
+    pub global_reason: String,
+    /// Build the caustic map.
+    pub caustic: bool,
+    /// Why (or why not).
+    pub caustic_reason: String,
+}
+
+impl MapPlan {
+    /// Decides from the scene's materials.
+    #[must_use]
+    pub fn for_scene(scene: &Scene) -> Self {
+        let delta = scene.has_delta_surfaces();
+        let diffuse = scene.has_diffuse_surfaces();
+        let (caustic, caustic_reason) = match (delta, diffuse) {
+            (true, true) => (true, "mirror or glass surfaces can focus light onto diffuse surfaces".to_string()),
+            (false, _) => (false, "no mirror or glass in the scene".to_string()),
+            (true, false) => (false, "no diffuse surface to receive caustics".to_string()),
+        };
+        let (global, global_reason) = if diffuse {
+            (true, "diffuse surfaces reflect indirect light".to_string())
+        } else {
+            (false, "no diffuse or glossy surface in the scene".to_string())
+        };
+        MapPlan { global, global_reason, caustic, caustic_reason }
+    }
+
+    /// Refuses settings that leave a needed map empty.
+    pub fn check(&self, settings: &Settings) -> Result<()> {
+        if self.global && settings.photons == 0 {
+            return Err(Error::setting(
+                "photons",
+                format!("must be > 0: the scene needs a global map ({})", self.global_reason),
+            ));
+        }
+        if self.caustic && settings.caustic_photons == 0 {
+            return Err(Error::setting(
+                "caustic_photons",
+                format!("must be > 0: the scene needs a caustic map ({})", self.caustic_reason),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Both photon maps (empty where the plan skipped one).
+pub struct PhotonMaps {
+    /// Global map (all non-specular hits).
+    pub global: PhotonMap,
+    /// Caustic map (`LS+D` paths).
+    pub caustic: PhotonMap,
+}
+
+/// Progress reporting hooks (the CLI wires these to progress bars; tests pass [`NoProgress`]).
+pub trait Progress: Sync {
+    /// A phase starts with `total` units of work.
+    fn start(&self, phase: &str, total: u64);
+    /// `n` more units are done.
+    fn advance(&self, n: u64);
+    /// The phase is over.
+    fn finish(&self);
+}
+
+/// Reports nothing.
+pub struct NoProgress;
+impl Progress for NoProgress {
+    fn start(&self, _: &str, _: u64) {}
+    fn advance(&self, _: u64) {}
+    fn finish(&self) {}
+}
+
+/// Renders `scene` as seen by `camera` with `settings`.
+pub fn render(
+    scene: &Scene,
+    camera: &CameraRays,
+    settings: &Settings,
+    progress: &dyn Progress,
+) -> Result<(Film, RenderStats)> {
+    settings.validate()?;
+    let plan = MapPlan::for_scene(scene);
+    plan.check(settings)?;
+    let threads = settings.thread_count();
+    let start = Instant::now();
+    let mut stats = RenderStats {
+        engine: "reference".into(),
+        triangles: scene.triangle_count(),
+        lights: scene.lights.len(),
+        width: settings.width,
+        height: settings.height,
+        spp: settings.spp,
+        threads,
+        seed: settings.seed,
+        ..Default::default()
+    };
+
+    let mut global_photons = Vec::new();
+    if plan.global {
+        let t = Instant::now();
+        let pass = photons::trace_photons(scene, settings, Domain::GlobalPhoton, settings.photons, threads, progress);
+        stats.times.global_photons_s = t.elapsed().as_secs_f64();
+        stats.rays.photon += pass.rays;
+        stats.non_finite_photons += pass.non_finite;
+        stats.global_map.emitted = pass.emitted;
+        global_photons = pass.photons;
+        stats.passes.push("global photon pass".into());
+    }
+    stats.global_map.built = plan.global;
+    stats.global_map.reason = plan.global_reason.clone();
+    let mut caustic_photons = Vec::new();
+    if plan.caustic {
+        let t = Instant::now();
+        let pass =
+            photons::trace_photons(scene, settings, Domain::CausticPhoton, settings.caustic_photons, threads, progress);
+        stats.times.caustic_photons_s = t.elapsed().as_secs_f64();
+        stats.rays.photon += pass.rays;
+        stats.non_finite_photons += pass.non_finite;
+        stats.caustic_map.emitted = pass.emitted;
+        caustic_photons = pass.photons;
+        stats.passes.push("caustic photon pass".into());
+    }
+    stats.caustic_map.built = plan.caustic;
+    stats.caustic_map.reason = plan.caustic_reason.clone();
+
+    let t = Instant::now();
+    stats.global_map.stored = global_photons.len() as u64;
+    stats.caustic_map.stored = caustic_photons.len() as u64;
+    let maps = PhotonMaps { global: PhotonMap::build(global_photons), caustic: PhotonMap::build(caustic_photons) };
+    stats.times.map_build_s = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let (film, rays, non_finite) = camera::render_image(scene, &maps, camera, settings, threads, progress);
+    stats.times.camera_s = t.elapsed().as_secs_f64();
+    stats.rays += rays;
+    stats.non_finite_samples = non_finite;
+    stats.passes.push(if settings.final_gather {
+        "final gather".into()
+    } else {
+        "global map read at first hit".into()
+    });
+    stats.times.total_s = start.elapsed().as_secs_f64();
+    stats.mean_rgb = film.mean().to_array();
+    Ok((film, stats))
+}
+
+/// Builds just the photon maps (for tests and tools), with the plan's decisions.
+#[must_use]
+pub fn build_maps(scene: &Scene, settings: &Settings) -> (PhotonMaps, MapStats, MapStats) {
+    let plan = MapPlan::for_scene(scene);
+    let threads = settings.thread_count();
+    let mut g = MapStats { built: plan.global, reason: plan.global_reason, ..Default::default() };
+    let mut c = MapStats { built: plan.caustic, reason: plan.caustic_reason, ..Default::default() };
+    let gp = if plan.global {
+        let p = photons::trace_photons(scene, settings, Domain::GlobalPhoton, settings.photons, threads, &NoProgress);
+        g.emitted = p.emitted;
+        p.photons
+    } else {
+        vec![]
+    };
+    let cp = if plan.caustic {
+        let p = photons::trace_photons(
+            scene,
+            settings,
+            Domain::CausticPhoton,
+            settings.caustic_photons,
+            threads,
+            &NoProgress,
+        );
+        c.emitted = p.emitted;
+        p.photons
+    } else {
+        vec![]
+    };
+    g.stored = gp.len() as u64;
+    c.stored = cp.len() as u64;
+    (PhotonMaps { global: PhotonMap::build(gp), caustic: PhotonMap::build(cp) }, g, c)
+}

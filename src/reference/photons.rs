@@ -1,0 +1,175 @@
+//! The photon pass: emit photons from lights in proportion to power, trace them with Russian
+//! roulette at constant power, and store them at non-specular hits.
+//!
+//! Global map: every non-specular hit (paths L{S|D}*D). Caustic map: photons whose every bounce
+//! so far was specular (LS+D); their paths are discarded at the first hit when it is not
+//! specular (a Jensen projection map reduced to rejection: unbiased, as the discarded paths still
+//! count in the emitted total). Paths are emitted in fixed batches until the map holds its target,
+//! so the photon set is the same at any thread count. Stored power = Φ-weighted path power divided
+//! by the number of paths emitted.
+
+use super::parallel::map_chunks;
+use super::Progress;
+use crate::geometry::offset::{barycentric_error, offset_ray_origin};
+use crate::material::Transport;
+use crate::photon_map::{flags, Photon};
+use crate::rng::{Domain, Sampler};
+use crate::scene::Scene;
+use crate::settings::Settings;
+use glam::Vec3;
+
+/// Paths per batch; a map stops growing at the first batch boundary past its target.
+pub const BATCH: usize = 16_384;
+/// Paths per work chunk inside a batch.
+const CHUNK: usize = 1024;
+/// At most this many paths per stored photon requested (caps scenes where few photons qualify).
+const MAX_PATHS_PER_PHOTON: u64 = 256;
+
+/// What a photon pass produced.
+pub struct PhotonPass {
+    /// Stored photons, power already divided by `emitted`.
+    pub photons: Vec<Photon>,
+    /// Paths emitted.
+    pub emitted: u64,
+    /// Ray segments traced.
+    pub rays: u64,
+    /// Paths dropped for non-finite power.
+    pub non_finite: u64,
+}
+
+/// Emits batches of paths until `target` photons are stored (or the path cap is reached).
+pub fn trace_photons(
+    scene: &Scene,
+    settings: &Settings,
+    domain: Domain,
+    target: u32,
+    threads: usize,
+    progress: &dyn Progress,
+) -> PhotonPass {
+    let name = if domain == Domain::CausticPhoton { "caustic photons" } else { "global photons" };
+    progress.start(name, target as u64);
+    let mut photons = Vec::new();
+    let (mut emitted, mut rays, mut non_finite) = (0u64, 0u64, 0u64);
+    let cap = (target as u64 * MAX_PATHS_PER_PHOTON).max(BATCH as u64);
+    let mut reported = 0u64;
+    while (photons.len() as u64) < target as u64 && emitted < cap {
+        let first = emitted;
+        let chunks = map_chunks(
+            BATCH,
+            CHUNK,
+            threads,
+            |range| {
+                let mut out = Vec::new();
+                let (mut r, mut nf) = (0u64, 0u64);
+                for i in range {
+                    trace_path(scene, settings, domain, first + i as u64, &mut out, &mut r, &mut nf);
+                }
+                (out, r, nf)
+            },
+            |_| {},
+        );
+        for (out, r, nf) in chunks {
+            photons.extend(out);
+            rays += r;
+            non_finite += nf;
+        }
+        emitted += BATCH as u64;
+        let now = (photons.len() as u64).min(target as u64);
+        progress.advance(now - reported);
+        reported = now;
+    }
+    progress.finish();
+    let scale = 1.0 / emitted as f32;
+    for p in &mut photons {
+        p.power *= scale;
+    }
+    PhotonPass { photons, emitted, rays, non_finite }
+}
+
+/// Traces photon path `index` of `domain`, appending stored photons (un-normalised power) to `out`.
+pub fn trace_path(
+    scene: &Scene,
+    settings: &Settings,
+    domain: Domain,
+    index: u64,
+    out: &mut Vec<Photon>,
+    rays: &mut u64,
+    non_finite: &mut u64,
+) {
+    let s = Sampler::new(settings.seed, domain, index);
+    let li = scene.light_power.sample(s.get(0, 0));
+    let pmf = scene.light_power.pmf(li) as f32;
+    let light = &scene.lights[li];
+    let tri = scene.light_triangle(light);
+    let em = light.sample_emission(
+        tri.as_ref(),
+        (scene.centre(), scene.radius()),
+        [s.get(0, 1), s.get(0, 2), s.get(0, 3), s.get(0, 4)],
+    );
+    let mut power = em.power / pmf;
+    if !power.is_finite() || !em.direction.is_finite() {
+        *non_finite += 1;
+        return;
+    }
+    let mut dir = em.direction;
+    let mut origin = match (em.normal, tri) {
+        (Some(n), Some(t)) => {
+            // The emission point's rounding error is bounded like any barycentric point.
+            let err = barycentric_error([1.0, 1.0, 1.0], t.p[0], t.p[1], t.p[2]);
+            offset_ray_origin(em.origin, err, n, dir)
+        }
+        _ => em.origin,
+    };
+    let caustic = domain == Domain::CausticPhoton;
+    let mut specular_only = true;
+    for bounce in 0..settings.max_depth {
+        *rays += 1;
+        let Some(hit) = scene.intersect(origin, dir, f32::INFINITY) else { break };
+        let sp = scene.surface(&hit);
+        let bsdf = scene.materials[sp.material as usize].bsdf;
+        let wo = -dir;
+        if !bsdf.is_delta() {
+            if caustic && bounce == 0 {
+                break;
+            }
+            let (ng, _) = sp.frame.oriented(wo);
+            let mut f = 0;
+            if bounce == 0 {
+                f |= flags::DIRECT;
+            }
+            if specular_only && bounce > 0 {
+                f |= flags::CAUSTIC;
+            }
+            if !caustic || f & flags::CAUSTIC != 0 {
+                out.push(Photon { position: sp.p, power, wi: wo, normal: ng, flags: f });
+            }
+            if caustic {
+                break;
+            }
+        }
+        let u = [s.get(bounce + 1, 0), s.get(bounce + 1, 1), s.get(bounce + 1, 2)];
+        let Some(bs) = bsdf.sample(&sp.frame, wo, u, Transport::Power) else { break };
+        if !bs.delta {
+            specular_only = false;
+        }
+        // Russian roulette keeps the largest channel's power constant: never gains energy.
+        let p_survive = bs.weight.max_element().min(1.0);
+        if !(p_survive > 0.0) || s.get(bounce + 1, 3) >= p_survive {
+            break;
+        }
+        power *= bs.weight / p_survive;
+        if !power.is_finite() {
+            *non_finite += 1;
+            break;
+        }
+        origin = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi);
+        dir = bs.wi;
+    }
+}
+
+/// Powers of the first-hit photons of a global pass, for flux checks: their sum should be the
+/// lights' power (every emitted photon lands somewhere in a closed scene).
+#[must_use]
+pub fn first_hit_power(photons: &[Photon]) -> Vec3 {
+    photons.iter().filter(|p| p.flags & flags::DIRECT != 0).map(|p| p.power).sum()
+}

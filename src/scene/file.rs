@@ -1,0 +1,300 @@
+//! The TOML scene file: meshes, camera, extra lights, material overrides and render settings.
+//!
+//! ```toml
+//! [[mesh]]
+//! file = "cornell-box.obj"      # relative to this file
+//! scale = 1.0                   # optional, then
+//! translate = [0, 0, 0]         # optional
+//!
+//! [camera]
+//! eye = [0, 1, 3.4]
+//! target = [0, 1, 0]
+//! up = [0, 1, 0]                # optional
+//! fov = 40                      # vertical, degrees
+//!
+//! [[light]]
+//! type = "point"                # point | spot | directional
+//! position = [0, 1.5, 0]
+//! intensity = [5, 5, 5]         # W/sr
+//!
+//! [materials.sphere]            # replaces the MTL material `sphere`
+//! type = "glass"                # lambert | glossy | mirror | glass
+//! ior = 1.5
+//!
+//! [render]                      # any field of Settings
+//! spp = 16
+//! ```
+
+use super::camera::Camera;
+use super::light::Light;
+use super::obj::{load_obj, MaterialTable};
+use super::{MeshInput, Scene};
+use crate::error::{Error, Result};
+use crate::material::{Bsdf, Material};
+use crate::settings::Settings;
+use glam::Vec3;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    #[serde(default)]
+    mesh: Vec<MeshEntry>,
+    camera: Option<CameraEntry>,
+    #[serde(default)]
+    light: Vec<LightEntry>,
+    #[serde(default)]
+    materials: BTreeMap<String, MaterialEntry>,
+    #[serde(default)]
+    render: Option<Settings>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct MeshEntry {
+    file: PathBuf,
+    #[serde(default = "one")]
+    scale: f32,
+    #[serde(default)]
+    translate: [f32; 3],
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct CameraEntry {
+    eye: [f32; 3],
+    target: [f32; 3],
+    #[serde(default = "y_up")]
+    up: [f32; 3],
+    fov: f32,
+}
+
+fn y_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+enum LightEntry {
+    Point {
+        position: [f32; 3],
+        intensity: [f32; 3],
+    },
+    Spot {
+        position: [f32; 3],
+        target: [f32; 3],
+        intensity: [f32; 3],
+        angle: f32,
+        #[serde(default)]
+        inner_angle: Option<f32>,
+    },
+    Directional {
+        direction: [f32; 3],
+        irradiance: [f32; 3],
+    },
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+enum MaterialEntry {
+    Lambert {
+        kd: [f32; 3],
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+    Glossy {
+        kd: [f32; 3],
+        ks: [f32; 3],
+        exponent: f32,
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+    Mirror {
+        #[serde(default = "ones")]
+        ks: [f32; 3],
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+    Glass {
+        #[serde(default = "ior_default")]
+        ior: f32,
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+}
+
+fn ones() -> [f32; 3] {
+    [1.0; 3]
+}
+fn ior_default() -> f32 {
+    1.5
+}
+
+/// A loaded scene with what its file said about the camera and settings.
+pub struct LoadedScene {
+    /// The assembled scene.
+    pub scene: Scene,
+    /// Camera from the file, if it had one.
+    pub camera: Option<Camera>,
+    /// Settings from the file's `[render]` table (defaults otherwise).
+    pub settings: Settings,
+}
+
+fn finite3(field: &str, v: [f32; 3]) -> Result<Vec3> {
+    let v = Vec3::from_array(v);
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(Error::setting(field, "must be finite"))
+    }
+}
+
+fn colour(field: &str, v: [f32; 3]) -> Result<Vec3> {
+    let v = finite3(field, v)?;
+    if v.min_element() < 0.0 {
+        Err(Error::setting(field, "must not be negative"))
+    } else {
+        Ok(v)
+    }
+}
+
+fn albedo(field: &str, v: [f32; 3]) -> Result<Vec3> {
+    let v = colour(field, v)?;
+    if v.max_element() > 1.0 {
+        Err(Error::setting(field, "must not exceed 1 (it would create energy)"))
+    } else {
+        Ok(v)
+    }
+}
+
+impl LightEntry {
+    fn to_light(&self, i: usize) -> Result<Light> {
+        let f = |name: &str| format!("light[{i}].{name}");
+        Ok(match *self {
+            LightEntry::Point { position, intensity } => Light::Point {
+                position: finite3(&f("position"), position)?,
+                intensity: colour(&f("intensity"), intensity)?,
+            },
+            LightEntry::Spot { position, target, intensity, angle, inner_angle } => {
+                let position = finite3(&f("position"), position)?;
+                let direction = (finite3(&f("target"), target)? - position)
+                    .try_normalize()
+                    .ok_or_else(|| Error::setting(f("target"), "must differ from position"))?;
+                if !(angle > 0.0 && angle < 180.0) {
+                    return Err(Error::setting(f("angle"), "half-angle of the cone must be in (0, 180) degrees"));
+                }
+                let inner = inner_angle.unwrap_or(angle);
+                if !(inner > 0.0 && inner <= angle) {
+                    return Err(Error::setting(f("inner_angle"), "must be in (0, angle]"));
+                }
+                Light::Spot {
+                    position,
+                    direction,
+                    intensity: colour(&f("intensity"), intensity)?,
+                    cos_inner: inner.to_radians().cos(),
+                    cos_outer: angle.to_radians().cos(),
+                }
+            }
+            LightEntry::Directional { direction, irradiance } => Light::Directional {
+                direction: finite3(&f("direction"), direction)?
+                    .try_normalize()
+                    .ok_or_else(|| Error::setting(f("direction"), "must not be zero"))?,
+                irradiance: colour(&f("irradiance"), irradiance)?,
+            },
+        })
+    }
+}
+
+impl MaterialEntry {
+    fn to_material(&self, name: &str) -> Result<Material> {
+        let f = |field: &str| format!("materials.{name}.{field}");
+        let (bsdf, emission) = match *self {
+            MaterialEntry::Lambert { kd, emission } => (Bsdf::Lambert { kd: albedo(&f("kd"), kd)? }, emission),
+            MaterialEntry::Glossy { kd, ks, exponent, emission } => {
+                let (kd, ks) = (albedo(&f("kd"), kd)?, albedo(&f("ks"), ks)?);
+                if (kd + ks).max_element() > 1.0 {
+                    return Err(Error::setting(f("ks"), "kd + ks must not exceed 1 in any channel"));
+                }
+                if !(exponent >= 0.0 && exponent.is_finite()) {
+                    return Err(Error::setting(f("exponent"), "must be a finite number ≥ 0"));
+                }
+                (Bsdf::Glossy { kd, ks, exponent }, emission)
+            }
+            MaterialEntry::Mirror { ks, emission } => (Bsdf::Mirror { ks: albedo(&f("ks"), ks)? }, emission),
+            MaterialEntry::Glass { ior, emission } => {
+                if !(ior > 0.0 && ior.is_finite()) {
+                    return Err(Error::setting(f("ior"), "must be a positive number"));
+                }
+                (Bsdf::Glass { ior }, emission)
+            }
+        };
+        let emission = match emission {
+            Some(e) => colour(&f("emission"), e)?,
+            None => Vec3::ZERO,
+        };
+        Ok(Material { name: name.to_string(), bsdf, emission })
+    }
+}
+
+/// Loads a scene: a `.toml` scene file, or a bare `.obj` (with its MTL files).
+pub fn load_scene(path: &Path) -> Result<LoadedScene> {
+    let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if is_obj {
+        let mut table = MaterialTable::default();
+        let mut warnings = Vec::new();
+        let mesh = load_obj(path, (1.0, Vec3::ZERO), &mut table, &mut warnings)?;
+        let scene = Scene::build(vec![mesh], table.materials, vec![], warnings)?;
+        return Ok(LoadedScene { scene, camera: None, settings: Settings::default() });
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let file: SceneFile = toml::from_str(&text).map_err(|e| {
+        let line = e.span().map_or(0, |s| text[..s.start.min(text.len())].lines().count().max(1));
+        Error::parse(path, line, e.message().to_string())
+    })?;
+    if file.mesh.is_empty() && file.light.is_empty() {
+        return Err(Error::parse(path, 0, "the scene file names no [[mesh]] and no [[light]]"));
+    }
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut table = MaterialTable::default();
+    let mut warnings = Vec::new();
+    let mut meshes: Vec<MeshInput> = Vec::new();
+    for (i, m) in file.mesh.iter().enumerate() {
+        if !(m.scale.is_finite() && m.scale > 0.0) {
+            return Err(Error::setting(format!("mesh[{i}].scale"), "must be a positive number"));
+        }
+        let translate = finite3(&format!("mesh[{i}].translate"), m.translate)?;
+        meshes.push(load_obj(&dir.join(&m.file), (m.scale, translate), &mut table, &mut warnings)?);
+    }
+    for (name, entry) in &file.materials {
+        if !table.by_name.contains_key(name) {
+            return Err(Error::setting(format!("materials.{name}"), "no mesh uses a material of that name"));
+        }
+        table.insert(entry.to_material(name)?);
+    }
+    let lights = file.light.iter().enumerate().map(|(i, l)| l.to_light(i)).collect::<Result<Vec<_>>>()?;
+    let camera = file.camera.map(|c| Camera {
+        eye: Vec3::from_array(c.eye),
+        target: Vec3::from_array(c.target),
+        up: Vec3::from_array(c.up),
+        fov_deg: c.fov,
+    });
+    let settings = file.render.unwrap_or_default();
+    settings.validate()?;
+    let scene = Scene::build(meshes, table.materials, lights, warnings)?;
+    Ok(LoadedScene { scene, camera, settings })
+}
+
+/// A camera that frames the scene's bounding sphere from +z, looking down −z.
+#[must_use]
+pub fn fitted_camera(scene: &Scene, fov_deg: f32) -> Camera {
+    let c = scene.centre();
+    let r = scene.radius();
+    let dist = r / (fov_deg.to_radians() * 0.5).sin() * 1.05;
+    Camera { eye: c + Vec3::Z * dist, target: c, up: Vec3::Y, fov_deg }
+}

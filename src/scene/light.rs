@@ -1,0 +1,187 @@
+//! Light sources: emissive triangles (area lights from MTL `Ke`) and the point, spot and
+//! directional lights of the scene file; their power, emission sampling (photons) and
+//! illumination sampling (direct light).
+
+use crate::sampling::{concentric_disk, uniform_cone, uniform_sphere, uniform_triangle, Frame};
+use glam::Vec3;
+use std::f32::consts::PI;
+
+/// A light source.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// Emissive triangle `tri` (scene BVH order) with radiance `radiance` from its front face.
+    Area { tri: u32, radiance: Vec3 },
+    /// Isotropic point light with radiant intensity `intensity` (W/sr).
+    Point { position: Vec3, intensity: Vec3 },
+    /// Spot light: intensity `intensity` inside `cos_inner`, falling linearly in cos θ to zero at
+    /// `cos_outer`.
+    Spot { position: Vec3, direction: Vec3, intensity: Vec3, cos_inner: f32, cos_outer: f32 },
+    /// Distant light travelling along `direction` with irradiance `irradiance` on a perpendicular plane.
+    Directional { direction: Vec3, irradiance: Vec3 },
+}
+
+/// A photon leaving a light: origin, direction and power before division by the photon count.
+#[derive(Clone, Copy, Debug)]
+pub struct Emission {
+    /// Where it starts.
+    pub origin: Vec3,
+    /// Unit direction.
+    pub direction: Vec3,
+    /// Power carried, already divided by the pdfs of the sample (sums to Φ in expectation).
+    pub power: Vec3,
+    /// Surface normal at the origin (area lights), used to offset the first ray.
+    pub normal: Option<Vec3>,
+}
+
+/// A sample of incident light at a shading point (direct lighting).
+#[derive(Clone, Copy, Debug)]
+pub struct Incident {
+    /// Unit direction from the shading point toward the light.
+    pub wi: Vec3,
+    /// Radiance or irradiance-like contribution divided by the sample pdf (f·cos not applied).
+    pub value: Vec3,
+    /// Distance to the light sample (infinite for directional lights).
+    pub distance: f32,
+    /// The light-side point and its geometric normal, for shadow rays (None for distant lights).
+    pub point: Option<(Vec3, Vec3)>,
+}
+
+/// Triangle geometry an area light needs.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleGeom {
+    /// Vertices.
+    pub p: [Vec3; 3],
+    /// Unit geometric normal (front face).
+    pub n: Vec3,
+    /// Area.
+    pub area: f32,
+}
+
+/// Falloff of a spot light at `cos_theta`.
+#[must_use]
+pub fn spot_falloff(cos_theta: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    if cos_theta >= cos_inner {
+        1.0
+    } else if cos_theta <= cos_outer {
+        0.0
+    } else {
+        (cos_theta - cos_outer) / (cos_inner - cos_outer)
+    }
+}
+
+impl Light {
+    /// True for lights that cannot be hit by rays (point, spot, directional).
+    #[must_use]
+    pub fn is_delta(&self) -> bool {
+        !matches!(self, Light::Area { .. })
+    }
+
+    /// Emitted power (W) per channel. `scene_radius` bounds the scene (directional lights).
+    #[must_use]
+    pub fn power(&self, tri: Option<&TriangleGeom>, scene_radius: f32) -> Vec3 {
+        match *self {
+            Light::Area { radiance, .. } => radiance * PI * tri.map_or(0.0, |t| t.area),
+            Light::Point { intensity, .. } => intensity * 4.0 * PI,
+            Light::Spot { intensity, cos_inner, cos_outer, .. } => {
+                intensity * 2.0 * PI * ((1.0 - cos_inner) + 0.5 * (cos_inner - cos_outer))
+            }
+            Light::Directional { irradiance, .. } => irradiance * PI * scene_radius * scene_radius,
+        }
+    }
+
+    /// Samples a photon leaving the light with four uniform numbers; `scene` = (centre, radius).
+    #[must_use]
+    pub fn sample_emission(&self, tri: Option<&TriangleGeom>, scene: (Vec3, f32), u: [f32; 4]) -> Emission {
+        match *self {
+            Light::Area { radiance, .. } => {
+                let t = tri.expect("area light without its triangle");
+                let (b1, b2) = uniform_triangle([u[0], u[1]]);
+                let origin = t.p[0] * (1.0 - b1 - b2) + t.p[1] * b1 + t.p[2] * b2;
+                let local = crate::sampling::cosine_hemisphere([u[2], u[3]]);
+                // pdf = (1/A)·(cos/π); Le·cos/pdf = π·A·Le.
+                Emission {
+                    origin,
+                    direction: Frame::new(t.n).to_world(local),
+                    power: radiance * PI * t.area,
+                    normal: Some(t.n),
+                }
+            }
+            Light::Point { position, intensity } => Emission {
+                origin: position,
+                direction: uniform_sphere([u[0], u[1]]),
+                power: intensity * 4.0 * PI,
+                normal: None,
+            },
+            Light::Spot { position, direction, intensity, cos_inner, cos_outer } => {
+                let local = uniform_cone([u[0], u[1]], cos_outer);
+                let pdf = 1.0 / (2.0 * PI * (1.0 - cos_outer));
+                Emission {
+                    origin: position,
+                    direction: Frame::new(direction).to_world(local),
+                    power: intensity * spot_falloff(local.z, cos_inner, cos_outer) / pdf,
+                    normal: None,
+                }
+            }
+            Light::Directional { direction, irradiance } => {
+                let (centre, radius) = scene;
+                let (dx, dy) = concentric_disk([u[0], u[1]]);
+                let f = Frame::new(direction);
+                let origin = centre + (f.s * dx + f.t * dy) * radius - direction * (2.0 * radius);
+                Emission { origin, direction, power: irradiance * PI * radius * radius, normal: None }
+            }
+        }
+    }
+
+    /// Samples light arriving at `p` with two uniform numbers. `None` when no light arrives
+    /// (back face of an area light, outside a spot cone, degenerate geometry).
+    #[must_use]
+    pub fn sample_incident(&self, tri: Option<&TriangleGeom>, p: Vec3, u: [f32; 2]) -> Option<Incident> {
+        match *self {
+            Light::Area { radiance, .. } => {
+                let t = tri?;
+                let (b1, b2) = uniform_triangle(u);
+                let q = t.p[0] * (1.0 - b1 - b2) + t.p[1] * b1 + t.p[2] * b2;
+                let d = q - p;
+                let dist2 = d.length_squared();
+                let dist = dist2.sqrt();
+                let wi = d / dist;
+                let cos_l = -wi.dot(t.n);
+                if !(cos_l > 0.0) || !(dist2 > 0.0) || !wi.is_finite() {
+                    return None;
+                }
+                // Area measure → solid angle: Le·cos_l·A/d².
+                Some(Incident { wi, value: radiance * (cos_l * t.area / dist2), distance: dist, point: Some((q, t.n)) })
+            }
+            Light::Point { position, intensity } => {
+                let d = position - p;
+                let dist2 = d.length_squared();
+                let dist = dist2.sqrt();
+                (dist2 > 0.0).then(|| Incident {
+                    wi: d / dist,
+                    value: intensity / dist2,
+                    distance: dist,
+                    point: Some((position, Vec3::ZERO)),
+                })
+            }
+            Light::Spot { position, direction, intensity, cos_inner, cos_outer } => {
+                let d = position - p;
+                let dist2 = d.length_squared();
+                let dist = dist2.sqrt();
+                if !(dist2 > 0.0) {
+                    return None;
+                }
+                let wi = d / dist;
+                let fall = spot_falloff((-wi).dot(direction), cos_inner, cos_outer);
+                (fall > 0.0).then(|| Incident {
+                    wi,
+                    value: intensity * fall / dist2,
+                    distance: dist,
+                    point: Some((position, Vec3::ZERO)),
+                })
+            }
+            Light::Directional { direction, irradiance } => {
+                Some(Incident { wi: -direction, value: irradiance, distance: f32::INFINITY, point: None })
+            }
+        }
+    }
+}

@@ -1,0 +1,318 @@
+//! The scene: triangles as columns in BVH order, materials, lights and their power
+//! distributions, and the BVH. Built from OBJ/MTL (through tobj) and the TOML scene file.
+
+pub mod camera;
+pub mod file;
+pub mod light;
+pub mod obj;
+pub mod validate;
+
+use crate::error::{Error, Result};
+use crate::geometry::bvh::TriangleColumns;
+use crate::geometry::offset::barycentric_error;
+use crate::geometry::{Bvh, Hit};
+use crate::material::{Bsdf, Material, SurfaceFrame};
+use crate::sampling::Distribution1D;
+pub use camera::Camera;
+use glam::Vec3;
+pub use light::{Light, TriangleGeom};
+
+/// Triangles of one mesh before the scene is assembled.
+#[derive(Clone, Debug, Default)]
+pub struct MeshInput {
+    /// Where the mesh came from (for messages).
+    pub source: String,
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Vertex normals (empty, or one per position).
+    pub normals: Vec<Vec3>,
+    /// Triangles as vertex indices.
+    pub triangles: Vec<[u32; 3]>,
+    /// Material of each triangle (index into the scene's material table).
+    pub material: Vec<u32>,
+}
+
+/// A point on a surface, everything shading needs.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfacePoint {
+    /// Position.
+    pub p: Vec3,
+    /// Bound on the rounding error of `p`, per axis.
+    pub p_error: Vec3,
+    /// Geometric and shading normals (unflipped).
+    pub frame: SurfaceFrame,
+    /// Material index.
+    pub material: u32,
+    /// Triangle index.
+    pub tri: u32,
+}
+
+/// An assembled, validated scene.
+pub struct Scene {
+    /// First vertices (BVH order).
+    pub p0: Vec<Vec3>,
+    /// Second vertices.
+    pub p1: Vec<Vec3>,
+    /// Third vertices.
+    pub p2: Vec<Vec3>,
+    /// Vertex normals per triangle (the geometric normal where the mesh has none).
+    pub vn: Vec<[Vec3; 3]>,
+    /// Unit geometric normals.
+    pub ng: Vec<Vec3>,
+    /// Triangle areas.
+    pub area: Vec<f32>,
+    /// Material per triangle.
+    pub material: Vec<u32>,
+    /// Material table.
+    pub materials: Vec<Material>,
+    /// Lights (area lights first, one per emissive triangle).
+    pub lights: Vec<Light>,
+    /// Lights by power (photon emission).
+    pub light_power: Distribution1D,
+    /// Indices of area lights in `lights`, and their distribution by power (direct lighting).
+    pub area_lights: Vec<u32>,
+    /// Distribution over `area_lights` by power.
+    pub area_power: Option<Distribution1D>,
+    /// Indices of delta lights in `lights`.
+    pub delta_lights: Vec<u32>,
+    /// Bounding box of all triangles and lights.
+    pub bounds: (Vec3, Vec3),
+    /// Degenerate (zero-area) triangles dropped at load.
+    pub dropped_degenerate: usize,
+    /// Non-fatal observations made while loading.
+    pub warnings: Vec<String>,
+    bvh: Bvh,
+}
+
+impl Scene {
+    /// Assembles meshes, materials and extra lights; validates and builds the BVH.
+    pub fn build(
+        meshes: Vec<MeshInput>,
+        materials: Vec<Material>,
+        extra_lights: Vec<Light>,
+        mut warnings: Vec<String>,
+    ) -> Result<Scene> {
+        let (mut p0, mut p1, mut p2, mut vn, mut mat) = (vec![], vec![], vec![], vec![], vec![]);
+        let mut dropped = 0usize;
+        // Emissive area per material, to refuse lights whose every triangle is degenerate.
+        let mut emitter_area = vec![0.0f64; materials.len()];
+        let mut emitter_seen = vec![false; materials.len()];
+        for m in &meshes {
+            for (t, tri) in m.triangles.iter().enumerate() {
+                let v = tri.map(|i| m.positions[i as usize]);
+                let material = m.material[t];
+                let emissive = materials[material as usize].emission != Vec3::ZERO;
+                let area2 = (v[1] - v[0]).cross(v[2] - v[0]).length();
+                if emissive {
+                    emitter_seen[material as usize] = true;
+                }
+                if !(area2 > 0.0) || !area2.is_finite() {
+                    dropped += 1;
+                    continue;
+                }
+                if emissive {
+                    emitter_area[material as usize] += 0.5 * area2 as f64;
+                }
+                p0.push(v[0]);
+                p1.push(v[1]);
+                p2.push(v[2]);
+                let gn = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+                vn.push(if m.normals.is_empty() {
+                    [gn; 3]
+                } else {
+                    tri.map(|i| m.normals[i as usize].try_normalize().unwrap_or(gn))
+                });
+                mat.push(material);
+            }
+        }
+        for (i, seen) in emitter_seen.iter().enumerate() {
+            if *seen && emitter_area[i] <= 0.0 {
+                return Err(Error::scene(format!(
+                    "emitter material `{}` has zero area: every triangle using it is degenerate",
+                    materials[i].name
+                )));
+            }
+        }
+        if dropped > 0 {
+            warnings.push(format!("{dropped} degenerate (zero-area) triangles were skipped"));
+        }
+        if p0.is_empty() && extra_lights.is_empty() {
+            return Err(Error::scene("the scene has no triangles"));
+        }
+
+        let (bvh, order) = Bvh::build(&p0, &p1, &p2);
+        let pick = |v: &Vec<Vec3>| order.iter().map(|&i| v[i as usize]).collect::<Vec<_>>();
+        let (p0, p1, p2) = (pick(&p0), pick(&p1), pick(&p2));
+        let vn: Vec<[Vec3; 3]> = order.iter().map(|&i| vn[i as usize]).collect();
+        let material: Vec<u32> = order.iter().map(|&i| mat[i as usize]).collect();
+        let ng: Vec<Vec3> = (0..p0.len()).map(|i| (p1[i] - p0[i]).cross(p2[i] - p0[i]).normalize()).collect();
+        let area: Vec<f32> = (0..p0.len()).map(|i| 0.5 * (p1[i] - p0[i]).cross(p2[i] - p0[i]).length()).collect();
+
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for p in p0.iter().chain(&p1).chain(&p2) {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        let mut lights: Vec<Light> = (0..p0.len())
+            .filter(|&i| materials[material[i] as usize].emission != Vec3::ZERO)
+            .map(|i| Light::Area { tri: i as u32, radiance: materials[material[i] as usize].emission })
+            .collect();
+        for l in &extra_lights {
+            if let Light::Point { position, .. } | Light::Spot { position, .. } = *l {
+                lo = lo.min(position);
+                hi = hi.max(position);
+            }
+        }
+        lights.extend(extra_lights);
+        if lights.is_empty() {
+            return Err(Error::scene(
+                "the scene has no light: give a material a non-zero `Ke` in the MTL file, or add a [[light]] to the scene file",
+            ));
+        }
+        let mut scene = Scene {
+            p0,
+            p1,
+            p2,
+            vn,
+            ng,
+            area,
+            material,
+            materials,
+            lights,
+            light_power: Distribution1D::default(),
+            area_lights: vec![],
+            area_power: None,
+            delta_lights: vec![],
+            bounds: (lo, hi),
+            dropped_degenerate: dropped,
+            warnings,
+            bvh,
+        };
+        let radius = scene.radius();
+        let powers: Vec<f64> = scene
+            .lights
+            .iter()
+            .map(|l| {
+                let tri = match l {
+                    Light::Area { tri, .. } => Some(scene.triangle(*tri)),
+                    _ => None,
+                };
+                l.power(tri.as_ref(), radius).element_sum() as f64 / 3.0
+            })
+            .collect();
+        scene.light_power = Distribution1D::try_new(&powers)
+            .ok_or_else(|| Error::scene("every light has zero power: check `Ke` and light intensities"))?;
+        scene.area_lights = (0..scene.lights.len() as u32).filter(|&i| !scene.lights[i as usize].is_delta()).collect();
+        scene.delta_lights = (0..scene.lights.len() as u32).filter(|&i| scene.lights[i as usize].is_delta()).collect();
+        let area_w: Vec<f64> = scene.area_lights.iter().map(|&i| powers[i as usize]).collect();
+        scene.area_power = Distribution1D::try_new(&area_w);
+        Ok(scene)
+    }
+
+    /// Vertex columns for intersection.
+    #[must_use]
+    pub fn columns(&self) -> TriangleColumns<'_> {
+        TriangleColumns { p0: &self.p0, p1: &self.p1, p2: &self.p2 }
+    }
+
+    /// Closest hit along `o + t·d`, 0 < t < `t_max`.
+    #[must_use]
+    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<Hit> {
+        self.bvh.closest(self.columns(), o, d, t_max)
+    }
+
+    /// True if anything blocks `o + t·d`, 0 < t < `t_max`.
+    #[must_use]
+    pub fn occluded(&self, o: Vec3, d: Vec3, t_max: f32) -> bool {
+        self.bvh.occluded(self.columns(), o, d, t_max)
+    }
+
+    /// The BVH.
+    #[must_use]
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
+
+    /// The surface point of a hit.
+    #[must_use]
+    pub fn surface(&self, hit: &Hit) -> SurfacePoint {
+        let i = hit.tri as usize;
+        let b = hit.b;
+        let (a, bb, c) = (self.p0[i], self.p1[i], self.p2[i]);
+        let p = a * b[0] + bb * b[1] + c * b[2];
+        let n = self.vn[i];
+        let ns = (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).try_normalize().unwrap_or(self.ng[i]);
+        SurfacePoint {
+            p,
+            p_error: barycentric_error(b, a, bb, c),
+            frame: SurfaceFrame { ng: self.ng[i], ns },
+            material: self.material[i],
+            tri: hit.tri,
+        }
+    }
+
+    /// Geometry of triangle `i` for area lights.
+    #[must_use]
+    pub fn triangle(&self, i: u32) -> TriangleGeom {
+        let i = i as usize;
+        TriangleGeom { p: [self.p0[i], self.p1[i], self.p2[i]], n: self.ng[i], area: self.area[i] }
+    }
+
+    /// The triangle geometry a light needs (area lights only).
+    #[must_use]
+    pub fn light_triangle(&self, light: &Light) -> Option<TriangleGeom> {
+        match light {
+            Light::Area { tri, .. } => Some(self.triangle(*tri)),
+            _ => None,
+        }
+    }
+
+    /// Length of the bounding-box diagonal.
+    #[must_use]
+    pub fn diagonal(&self) -> f32 {
+        (self.bounds.1 - self.bounds.0).length().max(f32::MIN_POSITIVE)
+    }
+
+    /// Centre of the bounding box.
+    #[must_use]
+    pub fn centre(&self) -> Vec3 {
+        0.5 * (self.bounds.0 + self.bounds.1)
+    }
+
+    /// Radius of the bounding sphere around the box centre.
+    #[must_use]
+    pub fn radius(&self) -> f32 {
+        0.5 * self.diagonal()
+    }
+
+    /// Total emitted power per channel.
+    #[must_use]
+    pub fn total_power(&self) -> Vec3 {
+        self.lights.iter().map(|l| l.power(self.light_triangle(l).as_ref(), self.radius())).sum()
+    }
+
+    /// Number of triangles.
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.p0.len()
+    }
+
+    /// True if any triangle has a delta (mirror or glass) material.
+    #[must_use]
+    pub fn has_delta_surfaces(&self) -> bool {
+        self.material.iter().any(|&m| self.materials[m as usize].bsdf.is_delta())
+    }
+
+    /// True if any triangle is glass.
+    #[must_use]
+    pub fn has_glass(&self) -> bool {
+        self.material.iter().any(|&m| matches!(self.materials[m as usize].bsdf, Bsdf::Glass { .. }))
+    }
+
+    /// True if any triangle has a non-delta (diffuse or glossy) material.
+    #[must_use]
+    pub fn has_diffuse_surfaces(&self) -> bool {
+        self.material.iter().any(|&m| !self.materials[m as usize].bsdf.is_delta())
+    }
+}

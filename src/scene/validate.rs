@@ -1,0 +1,177 @@
+//! Line-by-line checks of OBJ and MTL text before tobj parses it, so that every malformed
+//! statement is reported with its file and line (tobj reports only a kind of error), and so that
+//! non-finite numbers, which Rust's float parser accepts as "nan" or "inf", are refused.
+
+use crate::error::{Error, Result};
+use std::path::{Path, PathBuf};
+
+fn floats(path: &Path, line_no: usize, what: &str, words: &[&str], min: usize, max: usize) -> Result<Vec<f32>> {
+    if words.len() < min || words.len() > max {
+        let count = if min == max { format!("{min}") } else { format!("{min} to {max}") };
+        return Err(Error::parse(path, line_no, format!("`{what}` needs {count} numbers, found {}", words.len())));
+    }
+    words
+        .iter()
+        .map(|w| {
+            let v: f32 =
+                w.parse().map_err(|_| Error::parse(path, line_no, format!("`{what}`: `{w}` is not a number")))?;
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(Error::parse(path, line_no, format!("`{what}`: `{w}` is not finite")))
+            }
+        })
+        .collect()
+}
+
+/// Checks an OBJ file's text; returns the `mtllib` files it names (relative to the OBJ's folder).
+pub fn check_obj(path: &Path, text: &str) -> Result<Vec<PathBuf>> {
+    let mut n_v = 0i64;
+    let mut n_vt = 0i64;
+    let mut n_vn = 0i64;
+    let mut n_f = 0usize;
+    let mut mtllibs = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line_no = i + 1;
+        let line = raw.split('#').next().unwrap_or("").trim();
+        let mut it = line.split_whitespace();
+        let Some(kw) = it.next() else { continue };
+        let words: Vec<&str> = it.collect();
+        match kw {
+            "v" => {
+                // x y z [w], optionally followed by r g b vertex colours.
+                floats(path, line_no, "v", &words, 3, 7)?;
+                n_v += 1;
+            }
+            "vn" => {
+                floats(path, line_no, "vn", &words, 3, 3)?;
+                n_vn += 1;
+            }
+            "vt" => {
+                floats(path, line_no, "vt", &words, 1, 3)?;
+                n_vt += 1;
+            }
+            "f" => {
+                if words.len() < 3 {
+                    return Err(Error::parse(
+                        path,
+                        line_no,
+                        format!("a face needs at least 3 vertices, found {}", words.len()),
+                    ));
+                }
+                for w in &words {
+                    for (k, part) in w.split('/').enumerate() {
+                        if part.is_empty() && k > 0 {
+                            continue;
+                        }
+                        let (count, what) = match k {
+                            0 => (n_v, "vertex"),
+                            1 => (n_vt, "texture coordinate"),
+                            2 => (n_vn, "normal"),
+                            _ => {
+                                return Err(Error::parse(
+                                    path,
+                                    line_no,
+                                    format!("face vertex `{w}` has too many `/` parts"),
+                                ))
+                            }
+                        };
+                        let idx: i64 = part.parse().map_err(|_| {
+                            Error::parse(path, line_no, format!("face vertex `{w}`: `{part}` is not an index"))
+                        })?;
+                        let resolved = if idx < 0 { count + idx + 1 } else { idx };
+                        if idx == 0 || resolved < 1 || resolved > count {
+                            return Err(Error::parse(
+                                path,
+                                line_no,
+                                format!("face refers to {what} {idx}, but only {count} are defined before this line"),
+                            ));
+                        }
+                    }
+                }
+                n_f += 1;
+            }
+            "mtllib" => {
+                let name = line.split_once(char::is_whitespace).map(|x| x.1.trim()).unwrap_or("");
+                if name.is_empty() {
+                    return Err(Error::parse(path, line_no, "`mtllib` names no file"));
+                }
+                mtllibs.push(PathBuf::from(name));
+            }
+            "usemtl" | "o" | "g" | "s" | "l" | "p" | "vp" | "cstype" | "deg" | "curv" | "surf" | "parm" | "end"
+            | "usemap" | "maplib" | "mg" | "lod" | "bevel" | "c_interp" | "d_interp" | "shadow_obj" | "trace_obj"
+            | "call" | "csh" => {}
+            other => {
+                return Err(Error::parse(path, line_no, format!("unknown OBJ statement `{other}`")));
+            }
+        }
+    }
+    if n_f == 0 {
+        return Err(Error::parse(path, 0, "the file has no faces"));
+    }
+    Ok(mtllibs)
+}
+
+/// Checks an MTL file's text: numbers where numbers belong, finite and non-negative colours.
+pub fn check_mtl(path: &Path, text: &str) -> Result<()> {
+    let mut current: Option<String> = None;
+    for (i, raw) in text.lines().enumerate() {
+        let line_no = i + 1;
+        let line = raw.split('#').next().unwrap_or("").trim();
+        let mut it = line.split_whitespace();
+        let Some(kw) = it.next() else { continue };
+        let words: Vec<&str> = it.collect();
+        if kw == "newmtl" {
+            if words.is_empty() {
+                return Err(Error::parse(path, line_no, "`newmtl` needs a name"));
+            }
+            current = Some(words.join(" "));
+            continue;
+        }
+        if kw.starts_with("map_") || matches!(kw, "bump" | "disp" | "decal" | "refl" | "norm") {
+            continue;
+        }
+        if current.is_none() {
+            return Err(Error::parse(path, line_no, format!("`{kw}` before any `newmtl`")));
+        }
+        match kw {
+            "Ka" | "Kd" | "Ks" | "Ke" | "Tf" => {
+                let v = floats(path, line_no, kw, &words, 3, 3)?;
+                if v.iter().any(|&c| c < 0.0) {
+                    return Err(Error::parse(path, line_no, format!("`{kw}` must not be negative")));
+                }
+            }
+            "Ns" | "d" | "Tr" | "Pr" | "Pm" | "Ps" | "Pc" | "Pcr" | "aniso" | "anisor" => {
+                floats(path, line_no, kw, &words, 1, 1)?;
+            }
+            "Ni" => {
+                let v = floats(path, line_no, kw, &words, 1, 1)?;
+                if v[0] <= 0.0 {
+                    return Err(Error::parse(path, line_no, "`Ni` (index of refraction) must be positive"));
+                }
+            }
+            "illum" => {
+                if words.len() != 1 || words[0].parse::<u8>().is_err() {
+                    return Err(Error::parse(path, line_no, "`illum` needs one integer 0–10"));
+                }
+            }
+            other => return Err(Error::parse(path, line_no, format!("unknown MTL statement `{other}`"))),
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reports_line_of_bad_vertex() {
+        let e = check_obj(Path::new("a.obj"), "v 0 0 0\nv 1 nan 0\nf 1 2 1\n").unwrap_err();
+        assert!(e.to_string().starts_with("a.obj:2:"), "{e}");
+        let e = check_obj(Path::new("a.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 3\n").unwrap_err();
+        assert!(e.to_string().contains("a.obj:3:") && e.to_string().contains("vertex 3"), "{e}");
+        let e = check_mtl(Path::new("m.mtl"), "newmtl a\nKd 1 x 0\n").unwrap_err();
+        assert!(e.to_string().starts_with("m.mtl:2:"), "{e}");
+    }
+}

@@ -1,0 +1,148 @@
+//! Every knob of a render in one struct, with documented defaults. The scene file's `[render]`
+//! table and the CLI flags both map onto it.
+
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// Density-estimation kernel, each normalised so that a uniform photon density is returned exactly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Kernel {
+    /// Constant weight: ∑Φ / (πr²).
+    Box,
+    /// Jensen's cone filter, weight 1 − d/r, normalised by 3/(πr²).
+    Cone,
+    /// Epanechnikov, weight 1 − d²/r², normalised by 2/(πr²).
+    Epanechnikov,
+}
+
+impl std::str::FromStr for Kernel {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "box" => Ok(Kernel::Box),
+            "cone" => Ok(Kernel::Cone),
+            "epanechnikov" => Ok(Kernel::Epanechnikov),
+            _ => Err(format!("unknown kernel `{s}` (box, cone, epanechnikov)")),
+        }
+    }
+}
+
+/// Render settings. Radii are fractions of the scene's bounding-box diagonal, so that a scene
+/// renders the same at any unit scale.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Settings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Jittered samples per pixel.
+    pub spp: u32,
+    /// Photons to store in the global map (emission stops at the first batch that reaches it).
+    pub photons: u32,
+    /// Photons to store in the caustic map.
+    pub caustic_photons: u32,
+    /// Nearest photons per global-map estimate.
+    pub k: u32,
+    /// Nearest photons per caustic-map estimate.
+    pub caustic_k: u32,
+    /// Maximum search radius of the global map, as a fraction of the scene diagonal.
+    pub global_radius: f32,
+    /// Maximum search radius of the caustic map, as a fraction of the scene diagonal.
+    pub caustic_radius: f32,
+    /// Density-estimation kernel for both maps.
+    pub kernel: Kernel,
+    /// Final-gather rays per camera sample.
+    pub gather_rays: u32,
+    /// Final gather (true) or read the global map directly at the first diffuse hit (false).
+    pub final_gather: bool,
+    /// Longest photon path and longest specular chain of a camera path (bounces).
+    pub max_depth: u32,
+    /// Area-light samples per shading point.
+    pub light_samples: u32,
+    /// Seed of every random stream.
+    pub seed: u64,
+    /// Worker threads (0 = all cores).
+    pub threads: u32,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            width: 320,
+            height: 320,
+            spp: 16,
+            photons: 200_000,
+            caustic_photons: 100_000,
+            k: 64,
+            caustic_k: 48,
+            global_radius: 0.05,
+            caustic_radius: 0.015,
+            kernel: Kernel::Cone,
+            gather_rays: 4,
+            final_gather: true,
+            max_depth: 10,
+            light_samples: 1,
+            seed: 1,
+            threads: 0,
+        }
+    }
+}
+
+impl Settings {
+    /// Rejects values that make no sense, naming the field.
+    pub fn validate(&self) -> Result<()> {
+        let err = |f: &str, m: &str| Err(Error::setting(f, m));
+        if !(1..=16384).contains(&self.width) {
+            return err("width", "must be between 1 and 16384");
+        }
+        if !(1..=16384).contains(&self.height) {
+            return err("height", "must be between 1 and 16384");
+        }
+        if !(1..=65536).contains(&self.spp) {
+            return err("spp", "must be between 1 and 65536");
+        }
+        if self.photons > 100_000_000 {
+            return err("photons", "at most 100 000 000");
+        }
+        if self.caustic_photons > 100_000_000 {
+            return err("caustic_photons", "at most 100 000 000");
+        }
+        if !(2..=10_000).contains(&self.k) {
+            return err("k", "must be between 2 and 10000 (the estimator uses k − 1 photons)");
+        }
+        if !(2..=10_000).contains(&self.caustic_k) {
+            return err("caustic_k", "must be between 2 and 10000");
+        }
+        if !(self.global_radius > 0.0 && self.global_radius <= 1.0) {
+            return err("global_radius", "must be in (0, 1] (fraction of the scene diagonal)");
+        }
+        if !(self.caustic_radius > 0.0 && self.caustic_radius <= 1.0) {
+            return err("caustic_radius", "must be in (0, 1] (fraction of the scene diagonal)");
+        }
+        if self.final_gather && !(1..=4096).contains(&self.gather_rays) {
+            return err("gather_rays", "must be between 1 and 4096 with final gather on");
+        }
+        if !(1..=1000).contains(&self.max_depth) {
+            return err("max_depth", "must be between 1 and 1000");
+        }
+        if !(1..=1024).contains(&self.light_samples) {
+            return err("light_samples", "must be between 1 and 1024");
+        }
+        if self.threads > 1024 {
+            return err("threads", "at most 1024");
+        }
+        Ok(())
+    }
+
+    /// Worker threads to use.
+    #[must_use]
+    pub fn thread_count(&self) -> usize {
+        if self.threads == 0 {
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        } else {
+            self.threads as usize
+        }
+    }
+}

@@ -1,0 +1,139 @@
+//! The render summary printed at the end and written by `--stats FILE.json`.
+
+use serde::Serialize;
+
+/// Rays traced, by purpose.
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq, Eq)]
+pub struct RayCounts {
+    /// Primary rays and rays continuing camera paths through mirrors and glass.
+    pub camera: u64,
+    /// Shadow rays toward lights.
+    pub shadow: u64,
+    /// Final-gather and glossy rays.
+    pub gather: u64,
+    /// Photon path segments.
+    pub photon: u64,
+}
+
+impl RayCounts {
+    /// All rays.
+    #[must_use]
+    pub fn total(&self) -> u64 {
+        self.camera + self.shadow + self.gather + self.photon
+    }
+}
+
+impl std::ops::AddAssign for RayCounts {
+    fn add_assign(&mut self, o: Self) {
+        self.camera += o.camera;
+        self.shadow += o.shadow;
+        self.gather += o.gather;
+        self.photon += o.photon;
+    }
+}
+
+/// One photon map: whether it was built, why, and what it holds.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct MapStats {
+    /// Whether the map was built.
+    pub built: bool,
+    /// Why it was (or was not) built.
+    pub reason: String,
+    /// Photon paths emitted for it.
+    pub emitted: u64,
+    /// Photons stored.
+    pub stored: u64,
+}
+
+/// Wall time per phase, seconds.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct PhaseTimes {
+    /// Loading and BVH build.
+    pub load_s: f64,
+    /// Global photon pass.
+    pub global_photons_s: f64,
+    /// Caustic photon pass.
+    pub caustic_photons_s: f64,
+    /// Building the kd-trees.
+    pub map_build_s: f64,
+    /// Camera pass.
+    pub camera_s: f64,
+    /// Everything.
+    pub total_s: f64,
+}
+
+/// Everything the summary reports.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct RenderStats {
+    /// Engine that rendered.
+    pub engine: String,
+    /// Scene file.
+    pub scene: String,
+    /// Triangles after dropping degenerate ones.
+    pub triangles: usize,
+    /// Light sources (each emissive triangle counts).
+    pub lights: usize,
+    /// Image size and sampling.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Worker threads.
+    pub threads: usize,
+    /// Seed.
+    pub seed: u64,
+    /// Global photon map.
+    pub global_map: MapStats,
+    /// Caustic photon map.
+    pub caustic_map: MapStats,
+    /// Passes that ran: photon passes, final gather or direct global-map reading.
+    pub passes: Vec<String>,
+    /// Rays traced.
+    pub rays: RayCounts,
+    /// Camera samples dropped because a term was NaN or infinite.
+    pub non_finite_samples: u64,
+    /// Photons dropped because their power was NaN or infinite.
+    pub non_finite_photons: u64,
+    /// Phase times.
+    pub times: PhaseTimes,
+    /// Mean of the beauty image (RGB).
+    pub mean_rgb: [f32; 3],
+}
+
+impl RenderStats {
+    /// A human-readable summary.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let t = &self.times;
+        let map = |name: &str, m: &MapStats| {
+            if m.built {
+                format!("  {name:<8} map: {} photons stored from {} emitted paths\n", m.stored, m.emitted)
+            } else {
+                format!("  {name:<8} map: not built — {}\n", m.reason)
+            }
+        };
+        format!(
+            "summary ({} engine, {} threads)\n{}{}  rays: {} total ({} camera, {} shadow, {} gather, {} photon)\n  \
+             time: load {:.2} s, global photons {:.2} s, caustic photons {:.2} s, maps {:.2} s, camera {:.2} s, total {:.2} s\n  \
+             non-finite samples dropped: {} camera, {} photon\n",
+            self.engine,
+            self.threads,
+            map("global", &self.global_map),
+            map("caustic", &self.caustic_map),
+            self.rays.total(),
+            self.rays.camera,
+            self.rays.shadow,
+            self.rays.gather,
+            self.rays.photon,
+            t.load_s,
+            t.global_photons_s,
+            t.caustic_photons_s,
+            t.map_build_s,
+            t.camera_s,
+            t.total_s,
+            self.non_finite_samples,
+            self.non_finite_photons,
+        )
+    }
+}
