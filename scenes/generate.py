@@ -1,0 +1,132 @@
+#!/usr/bin/env python3
+"""Writes photonwave's bundled scenes (OBJ + MTL). Run from this folder: python3 generate.py
+
+Geometry of the Cornell box is the measured data published by the Cornell Program of Computer
+Graphics (dimensions in mm: a 556 x 548.8 x 559.2 room, a 130 x 105 light, two blocks),
+converted to metres and turned 180 degrees about y so that the camera looks down -z:
+x' = (278 - x)/1000, y' = y/1000, z' = (279.6 - z)/1000. Colours are rounded RGB reflectances.
+Every face is wound counter-clockwise as seen from the side it faces (walls into the room,
+blocks outward, the light downward), because emission leaves the front face only.
+"""
+import math
+
+def conv(p):
+    x, y, z = p
+    return ((278.0 - x) / 1000.0, y / 1000.0, (279.6 - z) / 1000.0)
+
+def sub(a, b): return tuple(a[i] - b[i] for i in range(3))
+def cross(a, b): return (a[1]*b[2]-a[2]*b[1], a[2]*b[0]-a[0]*b[2], a[0]*b[1]-a[1]*b[0])
+def dot(a, b): return sum(a[i]*b[i] for i in range(3))
+
+class Obj:
+    def __init__(self, mtl):
+        self.lines = [f"# photonwave bundled scene, written by scenes/generate.py", f"mtllib {mtl}"]
+        self.nv = 0
+        self.nn = 0
+
+    def quad(self, name, material, pts, facing):
+        """A planar polygon whose normal is turned toward `facing` (a direction)."""
+        pts = [conv(p) for p in pts]
+        n = cross(sub(pts[1], pts[0]), sub(pts[2], pts[0]))
+        if dot(n, facing) < 0:
+            pts = pts[::-1]
+        self.lines.append(f"o {name}")
+        self.lines.append(f"usemtl {material}")
+        for p in pts:
+            self.lines.append("v %.6f %.6f %.6f" % p)
+        k = len(pts)
+        self.lines.append("f " + " ".join(str(self.nv + 1 + i) for i in range(k)))
+        self.nv += k
+
+    def sphere(self, name, material, centre, radius, inward=False, seg=48, rings=24):
+        """A UV sphere with vertex normals; front faces outward (or inward)."""
+        self.lines.append(f"o {name}")
+        self.lines.append(f"usemtl {material}")
+        self.lines.append("s 1")
+        base_v, base_n = self.nv, self.nn
+        verts = []
+        for r in range(rings + 1):
+            th = math.pi * r / rings
+            for s in range(seg + 1):
+                ph = 2 * math.pi * s / seg
+                n = (math.sin(th) * math.cos(ph), math.cos(th), math.sin(th) * math.sin(ph))
+                verts.append(n)
+        for n in verts:
+            self.lines.append("v %.6f %.6f %.6f" % tuple(centre[i] + radius * n[i] for i in range(3)))
+        for n in verts:
+            m = tuple(-c for c in n) if inward else n
+            self.lines.append("vn %.6f %.6f %.6f" % m)
+        self.nv += len(verts)
+        self.nn += len(verts)
+        idx = lambda r, s: r * (seg + 1) + s + 1
+        for r in range(rings):
+            for s in range(seg):
+                a, b, c, d = idx(r, s), idx(r, s + 1), idx(r + 1, s + 1), idx(r + 1, s)
+                tris = [(a, b, c), (a, c, d)]
+                if r == 0:
+                    tris = [(a, c, d)]          # pole: (a, b) coincide
+                elif r == rings - 1:
+                    tris = [(a, b, c)]          # pole: (c, d) coincide
+                for t in tris:
+                    if inward:
+                        t = t[::-1]
+                    self.lines.append("f " + " ".join(f"{base_v + i}//{base_n + i}" for i in t))
+
+    def write(self, path):
+        with open(path, "w") as f:
+            f.write("\n".join(self.lines) + "\n")
+
+def mtl(path, materials):
+    with open(path, "w") as f:
+        f.write("# photonwave bundled materials, written by scenes/generate.py\n")
+        for name, body in materials:
+            f.write(f"\nnewmtl {name}\n{body.strip()}\n")
+
+INTO_ROOM = None  # sentinel: walls face the room centre
+
+def cornell(obj, blocks=True):
+    centre = (278.0, 274.4, 279.6)
+    def wall(name, mat, pts):
+        c = tuple(sum(p[i] for p in pts) / len(pts) for i in range(3))
+        obj.quad(name, mat, pts, sub(conv(centre), conv(c)))
+    wall("floor", "white", [(552.8, 0, 0), (0, 0, 0), (0, 0, 559.2), (549.6, 0, 559.2)])
+    wall("ceiling", "white", [(556, 548.8, 0), (556, 548.8, 559.2), (0, 548.8, 559.2), (0, 548.8, 0)])
+    wall("back", "white", [(549.6, 0, 559.2), (0, 0, 559.2), (0, 548.8, 559.2), (556, 548.8, 559.2)])
+    wall("right", "green", [(0, 0, 559.2), (0, 0, 0), (0, 548.8, 0), (0, 548.8, 559.2)])
+    wall("left", "red", [(552.8, 0, 0), (549.6, 0, 559.2), (556, 548.8, 559.2), (556, 548.8, 0)])
+    obj.quad("light", "light", [(343, 548.7, 227), (343, 548.7, 332), (213, 548.7, 332), (213, 548.7, 227)], (0, -1, 0))
+    if not blocks:
+        return
+    for name, top, h in [("short_block", [(130, 65), (82, 225), (240, 272), (290, 114)], 165.0),
+                         ("tall_block", [(423, 247), (265, 296), (314, 456), (472, 406)], 330.0)]:
+        cx = sum(p[0] for p in top) / 4; cz = sum(p[1] for p in top) / 4
+        obj.quad(name + "_top", "white", [(x, h, z) for x, z in top], (0, 1, 0))
+        for i in range(4):
+            (x0, z0), (x1, z1) = top[i], top[(i + 1) % 4]
+            mid = conv(((x0 + x1) / 2, h / 2, (z0 + z1) / 2))
+            out = sub(mid, conv((cx, h / 2, cz)))
+            obj.quad(f"{name}_side{i}", "white", [(x0, 0, z0), (x1, 0, z1), (x1, h, z1), (x0, h, z0)], out)
+
+BOX_MATERIALS = [
+    ("white", "illum 1\nKd 0.73 0.73 0.73"),
+    ("red", "illum 1\nKd 0.63 0.06 0.05"),
+    ("green", "illum 1\nKd 0.15 0.45 0.09"),
+    ("light", "illum 1\nKd 0.78 0.78 0.78\nKe 15 11 6"),
+]
+
+o = Obj("cornell-box.mtl"); cornell(o); o.write("cornell-box.obj")
+mtl("cornell-box.mtl", BOX_MATERIALS)
+
+o = Obj("cornell-spheres.mtl"); cornell(o, blocks=False)
+o.sphere("mirror_sphere", "mirror", (-0.12, 0.1, -0.1), 0.1)
+o.sphere("glass_sphere", "glass", (0.13, 0.1, 0.08), 0.1)
+o.write("cornell-spheres.obj")
+mtl("cornell-spheres.mtl", BOX_MATERIALS + [
+    ("mirror", "illum 5\nKs 0.95 0.95 0.95"),
+    ("glass", "illum 7\nNi 1.5"),
+])
+
+# White furnace: a closed sphere of radius 1 whose inside emits Le = 1 and reflects albedo 0.5.
+o = Obj("furnace.mtl"); o.sphere("enclosure", "furnace", (0, 0, 0), 1.0, inward=True, seg=32, rings=16)
+o.write("furnace.obj")
+mtl("furnace.mtl", [("furnace", "illum 1\nKd 0.5 0.5 0.5\nKe 1 1 1")])

@@ -1,0 +1,242 @@
+//! Known answers: the white furnace, flux conservation, kernel normalisation, k-NN bias, and
+//! irradiance from an area light against Lambert's polygon formula.
+
+mod common;
+
+use common::*;
+use glam::Vec3;
+use photonwave::material::{Bsdf, Material, SurfaceFrame};
+use photonwave::photon_map::{Photon, PhotonMap};
+use photonwave::reference::camera::{direct_light, Context};
+use photonwave::reference::photons::{first_hit_power, trace_photons};
+use photonwave::reference::{NoProgress, PhotonMaps};
+use photonwave::rng::{Domain, Sampler};
+use photonwave::scene::{Light, MeshInput, Scene, SurfacePoint};
+use photonwave::settings::{Kernel, Settings};
+
+/// Furnace: Le = 1, albedo a = 0.5 (scenes/furnace.toml).
+const LE: f64 = 1.0;
+const A: f64 = 0.5;
+
+fn furnace_expected(bounces: u32) -> f64 {
+    // Emission plus `bounces` orders of reflection: Le·(1 − a^(n+1))/(1 − a).
+    LE * (1.0 - A.powi(bounces as i32 + 1)) / (1.0 - A)
+}
+
+#[test]
+fn white_furnace_through_light_sampling() {
+    let loaded = load("furnace.toml");
+    for depth in [1u32, 3] {
+        let s = Settings { width: 16, height: 16, spp: 16, max_depth: depth, ..Default::default() };
+        let film = render_path(&loaded, &s);
+        let (mean, se) = mean_and_se(&grey(&film));
+        // Pixels are independent path-traced estimates: 4 standard errors, plus 1e-4 for f32 sums.
+        let tol = 4.0 * se + 1e-4;
+        let want = furnace_expected(depth);
+        assert!((mean - want).abs() < tol, "depth {depth}: {mean} vs {want} ± {tol}");
+    }
+}
+
+#[test]
+fn white_furnace_through_the_photon_map() {
+    let loaded = load("furnace.toml");
+    let depth = 3;
+    let base = Settings { width: 16, height: 16, spp: 4, photons: 60_000, max_depth: depth, ..Default::default() };
+    // Read at the first hit: emission + direct (light sampling) + global photons that bounced at
+    // least once, which carry orders 2..=depth.
+    let direct_read = render(&loaded, &Settings { final_gather: false, ..base.clone() });
+    // Final gather: emission + direct + a × (global map at the gather hit: orders 1..=depth),
+    // i.e. orders up to depth + 1.
+    let gathered = render(&loaded, &base);
+    // The photon-map part (≈ 0.44) is a k-NN estimate with relative σ ≈ 1/√(k−2) ≈ 0.13 per
+    // lookup; ~60 000·3 photons / 64 per lookup ≈ 2 800 independent neighbourhoods → σ ≈ 0.0025·0.44.
+    // Tolerance 1 %: more than 4σ of that, plus the tessellation's tiny non-uniformity.
+    for (film, want) in [(direct_read, furnace_expected(depth)), (gathered, furnace_expected(depth + 1))] {
+        let (mean, _) = mean_and_se(&grey(&film));
+        assert!((mean - want).abs() < 0.01 * want, "{mean} vs {want}");
+    }
+}
+
+#[test]
+fn first_hit_photon_power_sums_to_light_power() {
+    // In a closed sphere every emitted photon lands; each carries Φ/N, so the first hits sum to Φ.
+    let loaded = load("furnace.toml");
+    let s = Settings::default();
+    let pass = trace_photons(&loaded.scene, &s, Domain::GlobalPhoton, 20_000, 1, &NoProgress);
+    let got = first_hit_power(&pass.photons);
+    let want = loaded.scene.total_power();
+    assert!(((got - want) / want).abs().max_element() < 1e-4, "{got} vs {want}");
+}
+
+fn closed_cube(half: f32, kd: f32) -> MeshInput {
+    // Six inward-facing faces of a cube, two triangles each.
+    let mut m = MeshInput { source: "cube".into(), ..Default::default() };
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let n = Vec3::from_array(std::array::from_fn(|i| if i == axis { sign } else { 0.0 }));
+            let u = Vec3::from_array(std::array::from_fn(|i| if i == (axis + 1) % 3 { half } else { 0.0 }));
+            let v = n.cross(u).normalize() * half;
+            let c = n * half;
+            let base = m.positions.len() as u32;
+            m.positions.extend([c - u - v, c + u - v, c + u + v, c - u + v]);
+            // Wind so the front face looks inward (−n).
+            let tri = |a: u32, b: u32, cc: u32| [base + a, base + cc, base + b];
+            m.triangles.push(tri(0, 1, 2));
+            m.triangles.push(tri(0, 2, 3));
+            m.material.extend([0, 0]);
+        }
+    }
+    let _ = kd;
+    m
+}
+
+#[test]
+fn spot_light_flux_is_conserved_in_a_closed_box() {
+    // A spot light's photons carry unequal power (falloff / pdf); their sum estimates Φ.
+    let mat = Material { name: "grey".into(), bsdf: Bsdf::Lambert { kd: Vec3::splat(0.5) }, emission: Vec3::ZERO };
+    let spot = Light::Spot {
+        position: Vec3::ZERO,
+        direction: Vec3::new(0.3, -1.0, 0.2).normalize(),
+        intensity: Vec3::new(2.0, 1.0, 0.5),
+        cos_inner: 20f32.to_radians().cos(),
+        cos_outer: 40f32.to_radians().cos(),
+    };
+    let scene = Scene::build(vec![closed_cube(1.0, 0.5)], vec![mat], vec![spot], vec![]).unwrap();
+    let pass = trace_photons(&scene, &Settings::default(), Domain::GlobalPhoton, 16_384, 1, &NoProgress);
+    let got = first_hit_power(&pass.photons);
+    let want = scene.total_power();
+    // Per-photon weight w = falloff/E[falloff]: w ∈ [0, 1/E], E[falloff] = 0.51 here, so the
+    // relative σ of the mean over N = 16 384 paths is ≤ √(1/0.51 − 1)/√N ≈ 0.8 %; 4σ = 3.1 %.
+    assert!(((got - want) / want).abs().max_element() < 0.031, "{got} vs {want}");
+}
+
+#[test]
+fn every_kernel_returns_a_uniform_density() {
+    // A square lattice of spacing h with unit power: density 1/h². Lattice points in a disk of
+    // radius r = 50h deviate from πr²/h² by O((r/h)^(2/3)) ≈ 14 of 7 854: tolerance 0.5 %.
+    let h = 0.001f32;
+    let mut photons = Vec::new();
+    for i in -80..=80 {
+        for j in -80..=80 {
+            let position = Vec3::new(i as f32 * h + 0.000_31, 0.0, j as f32 * h + 0.000_17);
+            photons.push(Photon { position, power: Vec3::ONE, wi: Vec3::Y, normal: Vec3::Y, flags: 0 });
+        }
+    }
+    let map = PhotonMap::build(photons);
+    let mut scratch = Vec::new();
+    for kernel in [Kernel::Box, Kernel::Cone, Kernel::Epanechnikov] {
+        let e = map.estimate(Vec3::ZERO, Vec3::Y, 100_000, 50.0 * h, kernel, 0, |_| Vec3::ONE, &mut scratch);
+        let rel = e.radiance.x * h * h;
+        assert!((rel - 1.0).abs() < 0.005, "{kernel:?}: {rel}");
+    }
+}
+
+#[test]
+fn knn_estimate_is_unbiased_on_a_uniform_plane() {
+    // N uniform photons in the unit square; k = 16; estimates at a grid of queries 0.01 apart
+    // (neighbourhoods of radius ≈ 0.0023 do not overlap). (k−1)/(πr²) has mean ρ and relative
+    // variance 1/(k−2); over Q ≈ 6 400 queries σ ≈ 0.0033, tolerance 4σ = 1.3 %. The biased
+    // k/(πr²) would read 16/15 = +6.7 %.
+    let n = 1_000_000u32;
+    let s = Sampler::new(99, Domain::GlobalPhoton, 0);
+    let photons: Vec<Photon> = (0..n)
+        .map(|i| Photon {
+            position: Vec3::new(s.get(i, 0), 0.0, s.get(i, 1)),
+            power: Vec3::ONE,
+            wi: Vec3::Y,
+            normal: Vec3::Y,
+            flags: 0,
+        })
+        .collect();
+    let map = PhotonMap::build(photons);
+    let mut scratch = Vec::new();
+    let (mut sum, mut q) = (0.0f64, 0);
+    for i in 0..80 {
+        for j in 0..80 {
+            let p = Vec3::new(0.1 + i as f32 * 0.01, 0.0, 0.1 + j as f32 * 0.01);
+            let e = map.estimate(p, Vec3::Y, 16, 0.1, Kernel::Box, 0, |_| Vec3::ONE, &mut scratch);
+            sum += e.radiance.x as f64 / n as f64;
+            q += 1;
+        }
+    }
+    let mean = sum / q as f64;
+    assert!((mean - 1.0).abs() < 0.013, "mean density ratio {mean}");
+}
+
+/// Irradiance at `p` (normal `n`) from a uniform Lambertian polygon of radiance `le`:
+/// E = le/2 · Σ θ_i (n · unit(v_i × v_{i+1})) (Lambert's formula).
+fn polygon_irradiance(p: Vec3, n: Vec3, corners: &[Vec3], le: f32) -> f32 {
+    let v: Vec<Vec3> = corners.iter().map(|c| (*c - p).normalize()).collect();
+    let mut sum = 0.0;
+    for i in 0..v.len() {
+        let (a, b) = (v[i], v[(i + 1) % v.len()]);
+        sum += a.dot(b).clamp(-1.0, 1.0).acos() * n.dot(a.cross(b).normalize());
+    }
+    0.5 * le * sum.abs()
+}
+
+#[test]
+fn quad_light_irradiance_matches_lamberts_formula() {
+    let le = 3.0f32;
+    let corners =
+        [Vec3::new(-0.5, 1.0, -0.5), Vec3::new(0.5, 1.0, -0.5), Vec3::new(0.5, 1.0, 0.5), Vec3::new(-0.5, 1.0, 0.5)];
+    // Wound to face down (−y): (c0, c1, c2) and (c0, c2, c3).
+    let mesh = MeshInput {
+        source: "quad".into(),
+        positions: corners.to_vec(),
+        normals: vec![],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        material: vec![0, 0],
+    };
+    let light = Material { name: "light".into(), bsdf: Bsdf::Lambert { kd: Vec3::ZERO }, emission: Vec3::splat(le) };
+    let scene = Scene::build(vec![mesh], vec![light], vec![], vec![]).unwrap();
+    let settings = Settings { light_samples: 256, ..Default::default() };
+    let maps = PhotonMaps { global: Default::default(), caustic: Default::default() };
+    let ctx = Context::new(&scene, &maps, &settings);
+    let white = Bsdf::Lambert { kd: Vec3::ONE };
+    for p in [Vec3::ZERO, Vec3::new(0.7, 0.0, 0.3), Vec3::new(2.0, 0.3, -1.0)] {
+        let sp = SurfacePoint {
+            p,
+            p_error: Vec3::ZERO,
+            frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y },
+            material: 0,
+            tri: 0,
+        };
+        let mut rays = Default::default();
+        // E = π·L_reflected for a white Lambertian; each call averages 256 light samples.
+        let values: Vec<f32> = (0..256)
+            .map(|i| {
+                let s = Sampler::new(5, Domain::Camera, i);
+                std::f32::consts::PI * direct_light(&ctx, &sp, &white, Vec3::Y, &s, &mut rays).x
+            })
+            .collect();
+        let (mean, se) = mean_and_se(&values);
+        let want = polygon_irradiance(p, Vec3::Y, &corners, le) as f64;
+        assert!((mean - want).abs() < 4.0 * se + 1e-5 * want, "at {p}: {mean} vs {want} (se {se})");
+    }
+}
+
+#[test]
+fn point_light_irradiance_is_inverse_square_cosine() {
+    let mesh = closed_cube(10.0, 0.5);
+    let mat = Material { name: "grey".into(), bsdf: Bsdf::Lambert { kd: Vec3::splat(0.5) }, emission: Vec3::ZERO };
+    let light = Light::Point { position: Vec3::new(0.0, 2.0, 0.0), intensity: Vec3::splat(4.0) };
+    let scene = Scene::build(vec![mesh], vec![mat], vec![light], vec![]).unwrap();
+    let settings = Settings::default();
+    let maps = PhotonMaps { global: Default::default(), caustic: Default::default() };
+    let ctx = Context::new(&scene, &maps, &settings);
+    let p = Vec3::new(1.5, 0.0, 0.0);
+    let sp =
+        SurfacePoint { p, p_error: Vec3::ZERO, frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y }, material: 0, tri: 0 };
+    let l = direct_light(
+        &ctx,
+        &sp,
+        &Bsdf::Lambert { kd: Vec3::ONE },
+        Vec3::Y,
+        &Sampler::new(1, Domain::Camera, 0),
+        &mut Default::default(),
+    );
+    let d2 = 1.5f32 * 1.5 + 4.0;
+    let want = 4.0 * (2.0 / d2.sqrt()) / d2; // I·cos θ / d²
+    assert!((std::f32::consts::PI * l.x - want).abs() < 1e-5 * want);
+}

@@ -1,0 +1,51 @@
+//! Shared helpers for the integration tests.
+#![allow(dead_code)]
+
+use glam::Vec3;
+use photonwave::film::Film;
+use photonwave::reference::{self, NoProgress};
+use photonwave::scene::file::{load_scene, LoadedScene};
+use photonwave::settings::Settings;
+use std::path::PathBuf;
+
+/// Path of a bundled scene file.
+pub fn bundled(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name)
+}
+
+/// Loads a bundled scene.
+pub fn load(name: &str) -> LoadedScene {
+    load_scene(&bundled(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// Renders a loaded scene with the reference engine.
+pub fn render(loaded: &LoadedScene, settings: &Settings) -> Film {
+    let cam = loaded.camera.expect("bundled scenes have cameras").prepare(settings.width, settings.height).unwrap();
+    reference::render(&loaded.scene, &cam, settings, &NoProgress).unwrap().0
+}
+
+/// Renders with the path tracer.
+pub fn render_path(loaded: &LoadedScene, settings: &Settings) -> Film {
+    let cam = loaded.camera.unwrap().prepare(settings.width, settings.height).unwrap();
+    reference::path::render_path_traced(&loaded.scene, &cam, settings, &NoProgress).0
+}
+
+/// Mean and standard error of the mean of a per-pixel scalar.
+pub fn mean_and_se(values: &[f32]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().map(|&v| v as f64).sum::<f64>() / n;
+    let var = values.iter().map(|&v| (v as f64 - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+/// Per-pixel luminance-free average of RGB.
+pub fn grey(film: &Film) -> Vec<f32> {
+    film.beauty().iter().map(|c: &Vec3| c.element_sum() / 3.0).collect()
+}
+
+/// A unique scratch directory for a test.
+pub fn scratch_dir(test: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("photonwave-{}-{test}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}

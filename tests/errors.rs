@@ -1,0 +1,186 @@
+//! Bad input gets a clear error naming the file and line or the field — never a panic.
+
+mod common;
+
+use common::*;
+use photonwave::scene::file::load_scene;
+use std::path::Path;
+use std::process::Command;
+
+fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const MTL: &str = "newmtl light\nKd 0.5 0.5 0.5\nKe 1 1 1\nnewmtl white\nKd 0.5 0.5 0.5\n";
+const OBJ: &str = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nusemtl light\nf 1 3 2\nusemtl white\nf 1 2 4\n";
+
+fn err(path: &Path) -> String {
+    match load_scene(path) {
+        Ok(_) => panic!("{} loaded, expected an error", path.display()),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn good_input_loads() {
+    let d = scratch_dir("good");
+    write(&d, "m.mtl", MTL);
+    let obj = write(&d, "a.obj", OBJ);
+    let s = load_scene(&obj).unwrap().scene;
+    assert_eq!(s.triangle_count(), 2);
+}
+
+#[test]
+fn missing_files_are_named() {
+    let d = scratch_dir("missing");
+    assert!(err(&d.join("nope.toml")).contains("nope.toml"));
+    let obj = write(&d, "a.obj", OBJ); // m.mtl not written
+    let e = err(&obj);
+    assert!(e.contains("m.mtl") && e.contains("cannot read"), "{e}");
+    let toml = write(&d, "s.toml", "[[mesh]]\nfile = \"absent.obj\"\n");
+    assert!(err(&toml).contains("absent.obj"));
+}
+
+#[test]
+fn malformed_obj_names_the_line() {
+    let d = scratch_dir("obj");
+    write(&d, "m.mtl", MTL);
+    let e = err(&write(&d, "a.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7\n"));
+    assert!(e.contains("a.obj:3:") && e.contains("vertex 7"), "{e}");
+    let e = err(&write(&d, "b.obj", "v 0 0 0\nv 1 0 zero\n"));
+    assert!(e.contains("b.obj:2:"), "{e}");
+    let e = err(&write(&d, "c.obj", "v 0 0 0\nfoo bar\n"));
+    assert!(e.contains("c.obj:2:") && e.contains("foo"), "{e}");
+    let e = err(&write(&d, "d.obj", "v 0 0 0\n"));
+    assert!(e.contains("no faces"), "{e}");
+}
+
+#[test]
+fn non_finite_vertices_are_refused() {
+    let d = scratch_dir("nan");
+    write(&d, "m.mtl", MTL);
+    for (i, bad) in ["nan", "inf", "-inf", "NaN"].iter().enumerate() {
+        let e =
+            err(&write(&d, &format!("n{i}.obj"), &format!("mtllib m.mtl\nv 0 0 0\nv 1 {bad} 0\nv 0 1 0\nf 1 2 3\n")));
+        assert!(e.contains(":3:") && e.contains("not finite"), "{e}");
+    }
+}
+
+#[test]
+fn malformed_mtl_names_the_line() {
+    let d = scratch_dir("mtl");
+    write(&d, "m.mtl", "newmtl light\nKd 0.5 0.5\n");
+    let e = err(&write(&d, "a.obj", OBJ));
+    assert!(e.contains("m.mtl:2:") && e.contains("Kd"), "{e}");
+    write(&d, "m.mtl", "newmtl light\nKe 1 -1 1\n");
+    assert!(err(&d.join("a.obj")).contains("m.mtl:2:"));
+    write(&d, "m.mtl", "Kd 1 1 1\n");
+    assert!(err(&d.join("a.obj")).contains("before any `newmtl`"));
+}
+
+#[test]
+fn malformed_scene_files_name_the_line_or_field() {
+    let d = scratch_dir("toml");
+    write(&d, "m.mtl", MTL);
+    write(&d, "a.obj", OBJ);
+    let e = err(&write(&d, "s1.toml", "[[mesh]]\nfile = \"a.obj\"\n[camera\n"));
+    assert!(e.contains("s1.toml:3:"), "{e}");
+    let e = err(&write(&d, "s2.toml", "[[mesh]]\nfile = \"a.obj\"\n\n[render]\nspp = 4\nspeed = 9\n"));
+    assert!(e.contains("s2.toml:") && e.contains("speed"), "{e}");
+    let e = err(&write(&d, "s3.toml", "[[mesh]]\nfile = \"a.obj\"\n[render]\nwidth = 0\n"));
+    assert!(e.contains("`width`"), "{e}");
+    let e = err(&write(&d, "s4.toml", "[[mesh]]\nfile = \"a.obj\"\n[materials.white]\ntype = \"glass\"\nior = -1\n"));
+    assert!(e.contains("materials.white.ior"), "{e}");
+    let e = err(&write(&d, "s5.toml", "[[mesh]]\nfile = \"a.obj\"\n[materials.nosuch]\ntype = \"mirror\"\n"));
+    assert!(e.contains("materials.nosuch"), "{e}");
+    let e = err(&write(&d, "s6.toml", "[[mesh]]\nfile = \"a.obj\"\n[[light]]\ntype = \"spot\"\nposition = [0,0,0]\ntarget = [0,0,0]\nintensity = [1,1,1]\nangle = 30\n"));
+    assert!(e.contains("light[0].target"), "{e}");
+    let e = err(&write(
+        &d,
+        "s7.toml",
+        "[[mesh]]\nfile = \"a.obj\"\n[materials.white]\ntype = \"lambert\"\nkd = [1.5, 0, 0]\n",
+    ));
+    assert!(e.contains("materials.white.kd"), "{e}");
+}
+
+#[test]
+fn scenes_without_usable_light_are_refused() {
+    let d = scratch_dir("light");
+    write(&d, "dark.mtl", "newmtl white\nKd 0.5 0.5 0.5\n");
+    let e = err(&write(&d, "dark.obj", "mtllib dark.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl white\nf 1 2 3\n"));
+    assert!(e.contains("no light"), "{e}");
+    // An emitter whose only triangle has zero area.
+    write(&d, "m.mtl", MTL);
+    let e = err(&write(
+        &d,
+        "zero.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nusemtl light\nf 1 2 3\nusemtl white\nf 1 2 4\n",
+    ));
+    assert!(e.contains("`light`") && e.contains("zero area"), "{e}");
+}
+
+fn cli(args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_photonwave")).args(args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    (out.status.code().unwrap_or(-1), stderr)
+}
+
+#[test]
+fn the_cli_reports_errors_with_a_nonzero_exit() {
+    let d = scratch_dir("cli");
+    let scene = bundled("cornell-box.toml");
+    let scene = scene.to_str().unwrap();
+    let out = d.join("x.exr");
+    let out = out.to_str().unwrap();
+    let (code, e) = cli(&["render", "/no/such/scene.toml", "-o", out]);
+    assert!(code != 0 && e.contains("/no/such/scene.toml"), "{e}");
+    let (code, e) = cli(&["render", scene, "--width", "0", "-o", out]);
+    assert!(code != 0 && e.contains("`width`"), "{e}");
+    let (code, e) = cli(&["render", scene, "--photons", "0", "-o", out]);
+    assert!(code != 0 && e.contains("`photons`"), "{e}");
+    let (code, e) = cli(&["render", scene, "--spp=-3", "-o", out]);
+    assert!(code != 0 && e.contains("spp"), "{e}");
+    let (code, e) = cli(&["render", scene, "--eye", "0,0.273,0", "--target", "0,0.273,0", "-o", out]);
+    assert!(code != 0 && e.contains("camera.target"), "{e}");
+    let (code, e) = cli(&["render", scene, "--k", "1", "-o", out]);
+    assert!(code != 0 && e.contains("`k`"), "{e}");
+    let (code, e) = cli(&["render", scene, "--width", "4", "--height", "4", "--spp", "1", "-o", "/no/such/dir/x.exr"]);
+    assert!(code != 0 && e.contains("/no/such/dir/x.exr"), "{e}");
+}
+
+#[test]
+fn the_cli_renders_and_writes_stats() {
+    let d = scratch_dir("cli-ok");
+    let scene = bundled("cornell-spheres.toml");
+    let (exr, png, json) = (d.join("o.exr"), d.join("o.png"), d.join("s.json"));
+    let (code, e) = cli(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+        "--stats",
+        json.to_str().unwrap(),
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--spp",
+        "1",
+        "--photons",
+        "2000",
+        "--caustic-photons",
+        "2000",
+    ]);
+    assert_eq!(code, 0, "{e}");
+    assert!(e.contains("caustic map on") && e.contains("summary"), "{e}");
+    let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(stats["caustic_map"]["built"], true);
+    assert!(stats["global_map"]["stored"].as_u64().unwrap() >= 2000);
+    assert!(stats["rays"]["camera"].as_u64().unwrap() >= 256);
+    assert!(std::fs::metadata(&png).unwrap().len() > 0);
+}
