@@ -97,6 +97,23 @@ impl Bvh {
         })
     }
 
+    /// Number of triangle tests a closest-hit query makes (a measure of BVH quality that does not
+    /// depend on machine load; see the Morton-wrap note above).
+    #[must_use]
+    pub fn triangle_tests(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3) -> u32 {
+        if self.bvh.nodes.is_empty() || !o.is_finite() || !d.is_finite() {
+            return 0;
+        }
+        let mut tests = 0u32;
+        let mut rh = obvhs::ray::RayHit::none();
+        let ray = Ray::new(Vec3A::from(o), Vec3A::from(d), 0.0, f32::INFINITY);
+        self.bvh.ray_traverse(ray, &mut rh, |r, id| {
+            tests += 1;
+            intersect_triangle(o, d, r.tmax, tris.p0[id], tris.p1[id], tris.p2[id]).map_or(f32::INFINITY, |h| h.t)
+        });
+        tests
+    }
+
     /// The underlying obvhs BVH2 (for benchmarks and packet traversal).
     #[must_use]
     pub fn bvh2(&self) -> &Bvh2 {
