@@ -80,7 +80,7 @@ struct RenderArgs {
     /// Density-estimation kernel: box, cone, epanechnikov [cone].
     #[arg(long)]
     kernel: Option<Kernel>,
-    /// Final-gather rays per camera sample [4].
+    /// Final-gather rays per camera sample [16].
     #[arg(long)]
     gather_rays: Option<u32>,
     /// Read the global map directly at the first diffuse hit instead of final gathering.

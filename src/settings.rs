@@ -57,6 +57,10 @@ pub struct Settings {
     pub gather_rays: u32,
     /// Final gather (true) or read the global map directly at the first diffuse hit (false).
     pub final_gather: bool,
+    /// Final-gather rays that end on a Lambertian surface read irradiance precomputed at every
+    /// 4th global photon (Christensen 1999) instead of a full density estimate: one
+    /// nearest-neighbour search instead of k. Slightly blurrier, several times faster.
+    pub precompute_irradiance: bool,
     /// Longest photon path and longest specular chain of a camera path (bounces).
     pub max_depth: u32,
     /// Area-light samples per shading point.
@@ -80,8 +84,9 @@ impl Default for Settings {
             global_radius: 0.05,
             caustic_radius: 0.015,
             kernel: Kernel::Cone,
-            gather_rays: 4,
+            gather_rays: 16,
             final_gather: true,
+            precompute_irradiance: true,
             max_depth: 10,
             light_samples: 1,
             seed: 1,

@@ -87,6 +87,8 @@ pub struct RenderStats {
     pub global_map: MapStats,
     /// Caustic photon map.
     pub caustic_map: MapStats,
+    /// Points with precomputed irradiance (0 when not used).
+    pub irradiance_points: u64,
     /// Passes that ran: photon passes, final gather or direct global-map reading.
     pub passes: Vec<String>,
     /// Rays traced.

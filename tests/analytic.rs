@@ -48,10 +48,17 @@ fn white_furnace_through_the_photon_map() {
     // Final gather: emission + direct + a × (global map at the gather hit: orders 1..=depth),
     // i.e. orders up to depth + 1.
     let gathered = render(&loaded, &base);
+    // The same through full density estimates at the gather hits instead of precomputed irradiance.
+    let gathered_full = render(&loaded, &Settings { precompute_irradiance: false, ..base.clone() });
     // The photon-map part (≈ 0.44) is a k-NN estimate with relative σ ≈ 1/√(k−2) ≈ 0.13 per
     // lookup; ~60 000·3 photons / 64 per lookup ≈ 2 800 independent neighbourhoods → σ ≈ 0.0025·0.44.
     // Tolerance 1 %: more than 4σ of that, plus the tessellation's tiny non-uniformity.
-    for (film, want) in [(direct_read, furnace_expected(depth)), (gathered, furnace_expected(depth + 1))] {
+    let cases = [
+        (direct_read, furnace_expected(depth)),
+        (gathered, furnace_expected(depth + 1)),
+        (gathered_full, furnace_expected(depth + 1)),
+    ];
+    for (film, want) in cases {
         let (mean, _) = mean_and_se(&grey(&film));
         assert!((mean - want).abs() < 0.01 * want, "{mean} vs {want}");
     }
@@ -191,7 +198,7 @@ fn quad_light_irradiance_matches_lamberts_formula() {
     let light = Material { name: "light".into(), bsdf: Bsdf::Lambert { kd: Vec3::ZERO }, emission: Vec3::splat(le) };
     let scene = Scene::build(vec![mesh], vec![light], vec![], vec![]).unwrap();
     let settings = Settings { light_samples: 256, ..Default::default() };
-    let maps = PhotonMaps { global: Default::default(), caustic: Default::default() };
+    let maps = PhotonMaps::default();
     let ctx = Context::new(&scene, &maps, &settings);
     let white = Bsdf::Lambert { kd: Vec3::ONE };
     for p in [Vec3::ZERO, Vec3::new(0.7, 0.0, 0.3), Vec3::new(2.0, 0.3, -1.0)] {
@@ -223,7 +230,7 @@ fn point_light_irradiance_is_inverse_square_cosine() {
     let light = Light::Point { position: Vec3::new(0.0, 2.0, 0.0), intensity: Vec3::splat(4.0) };
     let scene = Scene::build(vec![mesh], vec![mat], vec![light], vec![]).unwrap();
     let settings = Settings::default();
-    let maps = PhotonMaps { global: Default::default(), caustic: Default::default() };
+    let maps = PhotonMaps::default();
     let ctx = Context::new(&scene, &maps, &settings);
     let p = Vec3::new(1.5, 0.0, 0.0);
     let sp =
@@ -239,4 +246,83 @@ fn point_light_irradiance_is_inverse_square_cosine() {
     let d2 = 1.5f32 * 1.5 + 4.0;
     let want = 4.0 * (2.0 / d2.sqrt()) / d2; // I·cos θ / d²
     assert!((std::f32::consts::PI * l.x - want).abs() < 1e-5 * want);
+}
+
+#[test]
+fn directional_light_irradiance_is_cosine_weighted_by_both_methods() {
+    // A white Lambertian floor lit by a directional light at θ from its normal: E = E⊥·cos θ, so
+    // reflected radiance is kd·E⊥·cos θ/π. Light sampling is exact; the photon estimate (direct
+    // photons, box kernel, k = 400 → relative σ ≈ 1/√398 = 5 % per lookup, averaged over 64
+    // disjoint lookups → 0.6 %) gets 3 %.
+    let kd = 0.8f32;
+    let e_perp = 2.0f32;
+    for deg in [0.0f32, 60.0] {
+        let half = 10.0;
+        let floor = MeshInput {
+            source: "floor".into(),
+            positions: vec![
+                Vec3::new(-half, 0.0, -half),
+                Vec3::new(half, 0.0, -half),
+                Vec3::new(half, 0.0, half),
+                Vec3::new(-half, 0.0, half),
+            ],
+            normals: vec![],
+            triangles: vec![[0, 2, 1], [0, 3, 2]],
+            material: vec![0, 0],
+        };
+        let mat = Material { name: "white".into(), bsdf: Bsdf::Lambert { kd: Vec3::splat(kd) }, emission: Vec3::ZERO };
+        let th = deg.to_radians();
+        let light =
+            Light::Directional { direction: Vec3::new(th.sin(), -th.cos(), 0.0), irradiance: Vec3::splat(e_perp) };
+        let scene = Scene::build(vec![floor], vec![mat.clone()], vec![light], vec![]).unwrap();
+        let want = kd * e_perp * th.cos() / std::f32::consts::PI;
+        let settings = Settings { photons: 400_000, max_depth: 1, ..Default::default() };
+        let maps = PhotonMaps {
+            global: PhotonMap::build(
+                trace_photons(&scene, &settings, Domain::GlobalPhoton, 400_000, 2, &NoProgress).photons,
+            ),
+            ..Default::default()
+        };
+        let ctx = Context::new(&scene, &maps, &settings);
+        let mut scratch = Vec::new();
+        let mut photon_sum = 0.0;
+        for i in 0..8 {
+            for j in 0..8 {
+                let p = Vec3::new(-4.0 + i as f32, 0.0, -4.0 + j as f32);
+                let sp = SurfacePoint {
+                    p,
+                    p_error: Vec3::ZERO,
+                    frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y },
+                    material: 0,
+                    tri: 0,
+                };
+                let direct = direct_light(
+                    &ctx,
+                    &sp,
+                    &mat.bsdf,
+                    Vec3::Y,
+                    &Sampler::new(1, Domain::Camera, 0),
+                    &mut Default::default(),
+                );
+                assert!(
+                    (direct.x - want).abs() < 1e-5 * want.max(1.0),
+                    "θ={deg}: light sampling {} vs {want}",
+                    direct.x
+                );
+                let e = maps.global.estimate(
+                    p,
+                    Vec3::Y,
+                    400,
+                    1.0,
+                    Kernel::Box,
+                    0,
+                    |wi| mat.bsdf.eval(&sp.frame, Vec3::Y, wi),
+                    &mut scratch,
+                );
+                photon_sum += e.radiance.x;
+            }
+        }
+        let photon = photon_sum / 64.0;
+        assert!((photon - want).abs() < 0.03 * want, "θ={deg}: photons {photon} vs {want}");
+    }
 }

@@ -325,7 +325,7 @@ fn incoming_from_map(
         let sp = scene.surface(&hit);
         let bsdf = &scene.materials[sp.material as usize].bsdf;
         if !bsdf.is_delta() {
-            return beta * global_estimate(ctx, &sp, bsdf, -d, 0, scratch);
+            return beta * map_radiance(ctx, &sp, bsdf, -d, scratch);
         }
         let u = [s.get(depth, 0), s.get(depth, 1), s.get(depth, 2)];
         let Some(bs) = bsdf.sample(&sp.frame, -d, u, Transport::Radiance) else { return Vec3::ZERO };
@@ -334,6 +334,21 @@ fn incoming_from_map(
         d = bs.wi;
     }
     Vec3::ZERO
+}
+
+/// Radiance leaving a non-specular point toward `wo` as the photon maps see it: kd/π × the
+/// nearest precomputed irradiance for Lambertian surfaces when that is available (and a point
+/// with a similar normal lies within the global radius), the full global-map estimate otherwise.
+fn map_radiance(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, scratch: &mut Vec<(f32, u32)>) -> Vec3 {
+    let irr = &ctx.maps.irradiance;
+    if let (Bsdf::Lambert { kd }, false) = (bsdf, irr.is_empty()) {
+        let (ng, _) = sp.frame.oriented(wo);
+        irr.nearest(sp.p, 1, ctx.global_radius, |key| key.normal().dot(ng) > 0.7, scratch);
+        if let Some(&(_, i)) = scratch.first() {
+            return *kd * std::f32::consts::FRAC_1_PI * irr.photons()[i as usize].power;
+        }
+    }
+    global_estimate(ctx, sp, bsdf, wo, 0, scratch)
 }
 
 /// The glossy lobe's reflection: one ray sampled from the lobe; at its first non-specular hit,

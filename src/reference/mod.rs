@@ -11,12 +11,13 @@ pub mod photons;
 
 use crate::error::{Error, Result};
 use crate::film::Film;
-use crate::photon_map::PhotonMap;
+use crate::photon_map::{Photon, PhotonMap};
 use crate::rng::Domain;
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::Settings;
 use crate::stats::{MapStats, RenderStats};
+use glam::Vec3;
 use std::time::Instant;
 
 /// Which photon maps a scene needs, and why.
@@ -69,12 +70,79 @@ impl MapPlan {
     }
 }
 
-/// Both photon maps (empty where the plan skipped one).
+/// Both photon maps (empty where the plan skipped one), and the irradiance precomputed at
+/// global photons for final gathering.
+#[derive(Default)]
 pub struct PhotonMaps {
     /// Global map (all non-specular hits).
     pub global: PhotonMap,
     /// Caustic map (`LS+D` paths).
     pub caustic: PhotonMap,
+    /// Irradiance at every [`IRRADIANCE_STRIDE`]-th global photon (`power` holds E); empty unless
+    /// `precompute_irradiance` is on.
+    pub irradiance: PhotonMap,
+}
+
+/// Irradiance is precomputed at every this-many-th global photon (Christensen 1999 used 4).
+pub const IRRADIANCE_STRIDE: usize = 4;
+
+impl PhotonMaps {
+    /// Builds the kd-trees and, if the settings ask for final gathering with precomputed
+    /// irradiance, the irradiance map.
+    #[must_use]
+    pub fn build(
+        scene: &Scene,
+        settings: &Settings,
+        global: Vec<Photon>,
+        caustic: Vec<Photon>,
+        threads: usize,
+    ) -> Self {
+        let mut maps = PhotonMaps {
+            global: PhotonMap::build(global),
+            caustic: PhotonMap::build(caustic),
+            irradiance: PhotonMap::default(),
+        };
+        if settings.final_gather && settings.precompute_irradiance && !maps.global.is_empty() {
+            maps.irradiance = precompute_irradiance(&maps.global, scene, settings, threads);
+        }
+        maps
+    }
+}
+
+/// Christensen's precomputation: the global-map irradiance estimate E at every
+/// [`IRRADIANCE_STRIDE`]-th photon, stored as a photon whose `power` is E. A final-gather ray that
+/// ends on a Lambertian surface then reads kd/π·E of the nearest such point (one nearest-neighbour
+/// search instead of a k-nearest density estimate).
+fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings, threads: usize) -> PhotonMap {
+    let radius = settings.global_radius * scene.diagonal();
+    let sources = global.photons();
+    let picks: Vec<usize> = (0..sources.len()).step_by(IRRADIANCE_STRIDE).collect();
+    let chunks = parallel::map_chunks(
+        picks.len(),
+        4096,
+        threads,
+        |range| {
+            let mut scratch = Vec::new();
+            range
+                .map(|j| {
+                    let src = &sources[picks[j]];
+                    let e = global.estimate(
+                        src.position,
+                        src.normal,
+                        settings.k as usize,
+                        radius,
+                        settings.kernel,
+                        0,
+                        |_| Vec3::ONE,
+                        &mut scratch,
+                    );
+                    Photon { position: src.position, power: e.radiance, wi: src.normal, normal: src.normal, flags: 0 }
+                })
+                .collect::<Vec<_>>()
+        },
+        |_| {},
+    );
+    PhotonMap::build(chunks.into_iter().flatten().collect())
 }
 
 /// Progress reporting hooks (the CLI wires these to progress bars; tests pass [`NoProgress`]).
@@ -150,7 +218,8 @@ pub fn render(
     let t = Instant::now();
     stats.global_map.stored = global_photons.len() as u64;
     stats.caustic_map.stored = caustic_photons.len() as u64;
-    let maps = PhotonMaps { global: PhotonMap::build(global_photons), caustic: PhotonMap::build(caustic_photons) };
+    let maps = PhotonMaps::build(scene, settings, global_photons, caustic_photons, threads);
+    stats.irradiance_points = maps.irradiance.len() as u64;
     stats.times.map_build_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -198,5 +267,5 @@ pub fn build_maps(scene: &Scene, settings: &Settings) -> (PhotonMaps, MapStats, 
     };
     g.stored = gp.len() as u64;
     c.stored = cp.len() as u64;
-    (PhotonMaps { global: PhotonMap::build(gp), caustic: PhotonMap::build(cp) }, g, c)
+    (PhotonMaps::build(scene, settings, gp, cp, threads), g, c)
 }

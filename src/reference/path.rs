@@ -28,7 +28,7 @@ pub fn render_path_traced(
     settings: &Settings,
     progress: &dyn Progress,
 ) -> (Film, RayCounts, u64) {
-    let empty = super::PhotonMaps { global: Default::default(), caustic: Default::default() };
+    let empty = super::PhotonMaps::default();
     let ctx = super::camera::Context::new(scene, &empty, settings);
     render_pixels(settings, camera, settings.thread_count(), progress, |o, d, s, rays, _| {
         trace_path(&ctx, o, d, s, rays)
