@@ -11,7 +11,7 @@
 use super::parallel::map_chunks;
 use super::Progress;
 use crate::geometry::offset::{barycentric_error, offset_ray_origin};
-use crate::material::Transport;
+use crate::material::{SurfaceFrame, Transport};
 use crate::photon_map::{flags, Photon};
 use crate::rng::{Domain, Sampler};
 use crate::scene::Scene;
@@ -152,18 +152,39 @@ pub fn trace_path(
         if !bs.delta {
             specular_only = false;
         }
+        // Photons carry power, the adjoint of radiance: with shading normals the BSDF is not
+        // symmetric, and Veach's correction |wo·ns||wi·ng| / (|wo·ng||wi·ns|) makes photon
+        // transport agree with camera paths (Veach 1997 §5.3; pbrt-v4 CorrectShadingNormal).
+        let weight = bs.weight * shading_normal_correction(&sp.frame, wo, bs.wi);
         // Russian roulette keeps the largest channel's power constant: never gains energy.
-        let p_survive = bs.weight.max_element().min(1.0);
+        let p_survive = weight.max_element().min(1.0);
         if !(p_survive > 0.0) || s.get(bounce + 1, 3) >= p_survive {
             break;
         }
-        power *= bs.weight / p_survive;
+        power *= weight / p_survive;
         if !power.is_finite() {
             *non_finite += 1;
             break;
         }
         origin = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi);
         dir = bs.wi;
+    }
+}
+
+/// Veach's adjoint correction for shading normals, `|wo·ns||wi·ng| / (|wo·ng||wi·ns|)`; 1 where
+/// the shading normal is the geometric one, 0 where a denominator vanishes.
+#[must_use]
+pub fn shading_normal_correction(frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> f32 {
+    let (ng, ns) = frame.oriented(wo);
+    if ns == ng {
+        return 1.0;
+    }
+    let num = wo.dot(ns).abs() * wi.dot(ng).abs();
+    let den = wo.dot(ng).abs() * wi.dot(ns).abs();
+    if den > 0.0 {
+        num / den
+    } else {
+        0.0
     }
 }
 
