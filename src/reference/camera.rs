@@ -307,33 +307,49 @@ pub fn final_gather(
     kd * sum / n as f32
 }
 
-/// Radiance arriving at `o` from direction `-d`, as the global map sees it at the first
-/// non-specular hit (through at most `max_depth` mirror/glass bounces; no emission).
-fn incoming_from_map(
+/// Follows a ray through mirrors and glass (at most `max_depth` bounces, sampling each with `s`
+/// at bounce `first_bounce + depth`) to its first non-specular hit: that point, the incoming
+/// direction and the throughput of the specular chain. `None` if it escapes or is absorbed.
+fn first_non_specular(
     ctx: &Context,
     mut o: Vec3,
     mut d: Vec3,
     s: &Sampler,
+    first_bounce: u32,
     rays: &mut RayCounts,
-    scratch: &mut Vec<(f32, u32)>,
-) -> Vec3 {
+) -> Option<(SurfacePoint, Vec3, Vec3)> {
     let scene = ctx.scene;
     let mut beta = Vec3::ONE;
     for depth in 0..=ctx.settings.max_depth {
         rays.gather += 1;
-        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else { return Vec3::ZERO };
+        let hit = scene.intersect(o, d, f32::INFINITY)?;
         let sp = scene.surface(&hit);
         let bsdf = &scene.materials[sp.material as usize].bsdf;
         if !bsdf.is_delta() {
-            return beta * map_radiance(ctx, &sp, bsdf, -d, scratch);
+            return Some((sp, d, beta));
         }
-        let u = [s.get(depth, 0), s.get(depth, 1), s.get(depth, 2)];
-        let Some(bs) = bsdf.sample(&sp.frame, -d, u, Transport::Radiance) else { return Vec3::ZERO };
+        let b = first_bounce + depth;
+        let bs = bsdf.sample(&sp.frame, -d, [s.get(b, 0), s.get(b, 1), s.get(b, 2)], Transport::Radiance)?;
         beta *= bs.weight;
         o = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi);
         d = bs.wi;
     }
-    Vec3::ZERO
+    None
+}
+
+/// Radiance arriving at `o` from direction `-d`, as the global map sees it at the first
+/// non-specular hit (through mirrors and glass; no emission).
+fn incoming_from_map(
+    ctx: &Context,
+    o: Vec3,
+    d: Vec3,
+    s: &Sampler,
+    rays: &mut RayCounts,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Vec3 {
+    let Some((y, d, beta)) = first_non_specular(ctx, o, d, s, 0, rays) else { return Vec3::ZERO };
+    let bsdf = &ctx.scene.materials[y.material as usize].bsdf;
+    beta * map_radiance(ctx, &y, bsdf, -d, scratch)
 }
 
 /// Radiance leaving a non-specular point toward `wo` as the photon maps see it: kd/π × the
@@ -364,26 +380,11 @@ pub fn glossy_reflection(
     scratch: &mut Vec<(f32, u32)>,
 ) -> Vec3 {
     let Some(bs) = bsdf.sample_glossy(&sp.frame, wo, [s.get(0, 0), s.get(0, 1)]) else { return Vec3::ZERO };
-    let mut o = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi);
-    let mut d = bs.wi;
-    let mut beta = bs.weight;
-    let scene = ctx.scene;
-    for depth in 0..=ctx.settings.max_depth {
-        rays.gather += 1;
-        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else { return Vec3::ZERO };
-        let y = scene.surface(&hit);
-        let b = &scene.materials[y.material as usize].bsdf;
-        if !b.is_delta() {
-            let direct = direct_light(ctx, &y, b, -d, &s.fork(7), rays);
-            let caustic = caustic_estimate(ctx, &y, b, -d, scratch);
-            let rest = global_estimate(ctx, &y, b, -d, flags::DIRECT | flags::CAUSTIC, scratch);
-            return beta * (direct + caustic + rest);
-        }
-        let u = [s.get(depth + 1, 0), s.get(depth + 1, 1), s.get(depth + 1, 2)];
-        let Some(bs) = b.sample(&y.frame, -d, u, Transport::Radiance) else { return Vec3::ZERO };
-        beta *= bs.weight;
-        o = offset_ray_origin(y.p, y.p_error, y.frame.ng, bs.wi);
-        d = bs.wi;
-    }
-    Vec3::ZERO
+    let o = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi);
+    let Some((y, d, beta)) = first_non_specular(ctx, o, bs.wi, s, 1, rays) else { return Vec3::ZERO };
+    let b = &ctx.scene.materials[y.material as usize].bsdf;
+    let direct = direct_light(ctx, &y, b, -d, &s.fork(7), rays);
+    let caustic = caustic_estimate(ctx, &y, b, -d, scratch);
+    let rest = global_estimate(ctx, &y, b, -d, flags::DIRECT | flags::CAUSTIC, scratch);
+    bs.weight * beta * (direct + caustic + rest)
 }

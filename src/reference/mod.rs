@@ -187,40 +187,7 @@ pub fn render(
         ..Default::default()
     };
 
-    let mut global_photons = Vec::new();
-    if plan.global {
-        let t = Instant::now();
-        let pass = photons::trace_photons(scene, settings, Domain::GlobalPhoton, settings.photons, threads, progress);
-        stats.times.global_photons_s = t.elapsed().as_secs_f64();
-        stats.rays.photon += pass.rays;
-        stats.non_finite_photons += pass.non_finite;
-        stats.global_map.emitted = pass.emitted;
-        global_photons = pass.photons;
-        stats.passes.push("global photon pass".into());
-    }
-    stats.global_map.built = plan.global;
-    stats.global_map.reason = plan.global_reason.clone();
-    let mut caustic_photons = Vec::new();
-    if plan.caustic {
-        let t = Instant::now();
-        let pass =
-            photons::trace_photons(scene, settings, Domain::CausticPhoton, settings.caustic_photons, threads, progress);
-        stats.times.caustic_photons_s = t.elapsed().as_secs_f64();
-        stats.rays.photon += pass.rays;
-        stats.non_finite_photons += pass.non_finite;
-        stats.caustic_map.emitted = pass.emitted;
-        caustic_photons = pass.photons;
-        stats.passes.push("caustic photon pass".into());
-    }
-    stats.caustic_map.built = plan.caustic;
-    stats.caustic_map.reason = plan.caustic_reason.clone();
-
-    let t = Instant::now();
-    stats.global_map.stored = global_photons.len() as u64;
-    stats.caustic_map.stored = caustic_photons.len() as u64;
-    let maps = PhotonMaps::build(scene, settings, global_photons, caustic_photons, threads);
-    stats.irradiance_points = maps.irradiance.len() as u64;
-    stats.times.map_build_s = t.elapsed().as_secs_f64();
+    let maps = photon_passes(scene, settings, &plan, threads, progress, &mut stats);
 
     let t = Instant::now();
     let (film, rays, non_finite) = camera::render_image(scene, &maps, camera, settings, threads, progress);
@@ -237,35 +204,52 @@ pub fn render(
     Ok((film, stats))
 }
 
+/// Runs the photon passes the plan calls for and builds the maps, recording counts and times
+/// in `stats`.
+pub fn photon_passes(
+    scene: &Scene,
+    settings: &Settings,
+    plan: &MapPlan,
+    threads: usize,
+    progress: &dyn Progress,
+    stats: &mut RenderStats,
+) -> PhotonMaps {
+    let mut pass = |build: bool, domain: Domain, target: u32, name: &str, time: &mut f64| -> Vec<Photon> {
+        if !build {
+            return Vec::new();
+        }
+        let t = Instant::now();
+        let p = photons::trace_photons(scene, settings, domain, target, threads, progress);
+        *time = t.elapsed().as_secs_f64();
+        stats.rays.photon += p.rays;
+        stats.non_finite_photons += p.non_finite;
+        stats.passes.push(name.to_string());
+        let map = if domain == Domain::CausticPhoton { &mut stats.caustic_map } else { &mut stats.global_map };
+        map.emitted = p.emitted;
+        map.stored = p.photons.len() as u64;
+        p.photons
+    };
+    let mut times = (0.0, 0.0);
+    let global = pass(plan.global, Domain::GlobalPhoton, settings.photons, "global photon pass", &mut times.0);
+    let caustic =
+        pass(plan.caustic, Domain::CausticPhoton, settings.caustic_photons, "caustic photon pass", &mut times.1);
+    (stats.times.global_photons_s, stats.times.caustic_photons_s) = times;
+    stats.global_map.built = plan.global;
+    stats.global_map.reason = plan.global_reason.clone();
+    stats.caustic_map.built = plan.caustic;
+    stats.caustic_map.reason = plan.caustic_reason.clone();
+    let t = Instant::now();
+    let maps = PhotonMaps::build(scene, settings, global, caustic, threads);
+    stats.irradiance_points = maps.irradiance.len() as u64;
+    stats.times.map_build_s = t.elapsed().as_secs_f64();
+    maps
+}
+
 /// Builds just the photon maps (for tests and tools), with the plan's decisions.
 #[must_use]
 pub fn build_maps(scene: &Scene, settings: &Settings) -> (PhotonMaps, MapStats, MapStats) {
-    let plan = MapPlan::for_scene(scene);
-    let threads = settings.thread_count();
-    let mut g = MapStats { built: plan.global, reason: plan.global_reason, ..Default::default() };
-    let mut c = MapStats { built: plan.caustic, reason: plan.caustic_reason, ..Default::default() };
-    let gp = if plan.global {
-        let p = photons::trace_photons(scene, settings, Domain::GlobalPhoton, settings.photons, threads, &NoProgress);
-        g.emitted = p.emitted;
-        p.photons
-    } else {
-        vec![]
-    };
-    let cp = if plan.caustic {
-        let p = photons::trace_photons(
-            scene,
-            settings,
-            Domain::CausticPhoton,
-            settings.caustic_photons,
-            threads,
-            &NoProgress,
-        );
-        c.emitted = p.emitted;
-        p.photons
-    } else {
-        vec![]
-    };
-    g.stored = gp.len() as u64;
-    c.stored = cp.len() as u64;
-    (PhotonMaps::build(scene, settings, gp, cp, threads), g, c)
+    let mut stats = RenderStats::default();
+    let maps =
+        photon_passes(scene, settings, &MapPlan::for_scene(scene), settings.thread_count(), &NoProgress, &mut stats);
+    (maps, stats.global_map, stats.caustic_map)
 }
