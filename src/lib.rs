@@ -10,6 +10,7 @@
 // NaN value is rejected by the same test as a non-positive one.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod effects;
 pub mod error;
 pub mod film;
 pub mod geometry;

@@ -3,8 +3,9 @@
 use clap::{Parser, Subcommand};
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use photonwave::effects::Effects;
 use photonwave::error::{Error, Result};
-use photonwave::reference::{self, MapPlan, Progress};
+use photonwave::reference::{self, Progress};
 use photonwave::scene::file::{fitted_camera, load_scene};
 use photonwave::settings::Kernel;
 use std::path::PathBuf;
@@ -86,6 +87,10 @@ struct RenderArgs {
     /// Read the global map directly at the first diffuse hit instead of final gathering.
     #[arg(long)]
     no_final_gather: bool,
+    /// Force a part of the effects plan on even where the scene does not need it (repeatable):
+    /// caustic_map, global_map, final_gather, refraction, shadow_rays.
+    #[arg(long)]
+    force: Vec<String>,
     /// Longest photon path / specular chain [10].
     #[arg(long)]
     max_depth: Option<u32>,
@@ -162,6 +167,7 @@ fn render(args: RenderArgs) -> Result<()> {
         settings.k = k;
         settings.caustic_k = k;
     }
+    settings.force.extend(args.force.iter().cloned());
     if args.no_final_gather {
         settings.final_gather = false;
     }
@@ -184,7 +190,7 @@ fn render(args: RenderArgs) -> Result<()> {
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
-    let plan = MapPlan::for_scene(&scene);
+    let plan = Effects::plan(&scene, &settings);
     eprintln!(
         "scene: {} triangles, {} materials, {} lights ({} emissive triangles), total power {:.3} W",
         scene.triangle_count(),
@@ -193,16 +199,7 @@ fn render(args: RenderArgs) -> Result<()> {
         scene.area_lights.len(),
         scene.total_power().element_sum() / 3.0
     );
-    eprintln!("plan: global map {} — {}", if plan.global { "on" } else { "off" }, plan.global_reason);
-    eprintln!("plan: caustic map {} — {}", if plan.caustic { "on" } else { "off" }, plan.caustic_reason);
-    eprintln!(
-        "plan: indirect light by {}",
-        if settings.final_gather {
-            format!("final gather ({} rays per sample)", settings.gather_rays)
-        } else {
-            "reading the global map at the first hit".into()
-        }
-    );
+    eprint!("{}", plan.describe());
     let quiet = args.quiet || !std::io::IsTerminal::is_terminal(&std::io::stderr());
     let bars = Bars { bar: Mutex::new(None), quiet };
     let (film, mut stats) = match args.engine {

@@ -69,6 +69,9 @@ pub struct Settings {
     pub seed: u64,
     /// Worker threads (0 = all cores).
     pub threads: u32,
+    /// Parts of the effects plan to force on even where the scene does not need them (for
+    /// comparison): any of `caustic_map`, `global_map`, `final_gather`, `refraction`, `shadow_rays`.
+    pub force: Vec<String>,
 }
 
 impl Default for Settings {
@@ -91,6 +94,7 @@ impl Default for Settings {
             light_samples: 1,
             seed: 1,
             threads: 0,
+            force: Vec::new(),
         }
     }
 }
@@ -137,6 +141,12 @@ impl Settings {
         }
         if self.threads > 1024 {
             return err("threads", "at most 1024");
+        }
+        if let Some(bad) = self.force.iter().find(|f| !crate::effects::PART_NAMES.contains(&f.as_str())) {
+            return Err(Error::setting(
+                "force",
+                format!("unknown part `{bad}` (one of {})", crate::effects::PART_NAMES.join(", ")),
+            ));
         }
         Ok(())
     }

@@ -83,6 +83,8 @@ pub struct RenderStats {
     pub threads: usize,
     /// Seed.
     pub seed: u64,
+    /// The effects plan: each part with whether it ran and why.
+    pub effects: Option<crate::effects::Effects>,
     /// Global photon map.
     pub global_map: MapStats,
     /// Caustic photon map.

@@ -177,7 +177,7 @@ fn the_cli_renders_and_writes_stats() {
         "2000",
     ]);
     assert_eq!(code, 0, "{e}");
-    assert!(e.contains("caustic map on") && e.contains("summary"), "{e}");
+    assert!(e.contains("caustic map   on") && e.contains("summary"), "{e}");
     let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(stats["caustic_map"]["built"], true);
     assert!(stats["global_map"]["stored"].as_u64().unwrap() >= 2000);

@@ -4,8 +4,8 @@
 mod common;
 
 use common::*;
+use photonwave::effects::Effects;
 use photonwave::film::{read_exr_layer, TERM_NAMES};
-use photonwave::reference::MapPlan;
 use photonwave::settings::Settings;
 
 fn small() -> Settings {
@@ -66,11 +66,15 @@ fn photon_mapping_energy_matches_path_tracing() {
 
 #[test]
 fn maps_are_built_only_where_the_scene_needs_them() {
-    let diffuse = MapPlan::for_scene(&load("cornell-box.toml").scene);
-    assert!(diffuse.global && !diffuse.caustic, "{diffuse:?}");
-    assert!(diffuse.caustic_reason.contains("no mirror or glass"));
-    let spheres = MapPlan::for_scene(&load("cornell-spheres.toml").scene);
-    assert!(spheres.global && spheres.caustic, "{spheres:?}");
+    let s = Settings::default();
+    let diffuse = Effects::plan(&load("cornell-box.toml").scene, &s);
+    assert!(diffuse.global_map.on && !diffuse.caustic_map.on && !diffuse.refraction.on, "{diffuse:?}");
+    assert!(diffuse.caustic_map.reason.contains("no mirror or glass"));
+    let forced =
+        Effects::plan(&load("cornell-box.toml").scene, &Settings { force: vec!["caustic_map".into()], ..s.clone() });
+    assert!(forced.caustic_map.on && forced.caustic_map.reason.contains("forced"));
+    let spheres = Effects::plan(&load("cornell-spheres.toml").scene, &s);
+    assert!(spheres.global_map.on && spheres.caustic_map.on && spheres.refraction.on, "{spheres:?}");
     let cam = load("cornell-box.toml");
     let c = cam.camera.unwrap().prepare(8, 8).unwrap();
     let s = Settings { width: 8, height: 8, spp: 1, photons: 5_000, ..Default::default() };

@@ -9,6 +9,7 @@
 
 use super::parallel::map_chunks;
 use super::{PhotonMaps, Progress};
+use crate::effects::Effects;
 use crate::film::{Film, Terms};
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::{Bsdf, Transport};
@@ -40,6 +41,8 @@ pub struct Context<'a> {
     pub global_radius: f32,
     /// Caustic-map radius in scene units.
     pub caustic_radius: f32,
+    /// What to simulate.
+    pub effects: Effects,
 }
 
 impl<'a> Context<'a> {
@@ -53,6 +56,7 @@ impl<'a> Context<'a> {
             settings,
             global_radius: settings.global_radius * d,
             caustic_radius: settings.caustic_radius * d,
+            effects: Effects::plan(scene, settings),
         }
     }
 }
@@ -178,7 +182,7 @@ pub fn trace_camera_path(
         let direct = beta * direct_light(ctx, &sp, &mat.bsdf, wo, &ls, rays);
         let caustic = beta * caustic_estimate(ctx, &sp, &mat.bsdf, wo, scratch);
         let indirect = beta
-            * if ctx.settings.final_gather {
+            * if ctx.effects.final_gather.on {
                 final_gather(ctx, &sp, &mat.bsdf, wo, &s.fork(TAG_GATHER + depth as u64), rays, scratch)
             } else {
                 global_estimate(ctx, &sp, &mat.bsdf, wo, flags::DIRECT | flags::CAUSTIC, scratch)

@@ -9,7 +9,8 @@ pub mod parallel;
 pub mod path;
 pub mod photons;
 
-use crate::error::{Error, Result};
+use crate::effects::Effects;
+use crate::error::Result;
 use crate::film::Film;
 use crate::photon_map::{Photon, PhotonMap};
 use crate::rng::Domain;
@@ -19,56 +20,6 @@ use crate::settings::Settings;
 use crate::stats::{MapStats, RenderStats};
 use glam::Vec3;
 use std::time::Instant;
-
-/// Which photon maps a scene needs, and why.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MapPlan {
-    /// Build the global map.
-    pub global: bool,
-    /// Why (or why not).
-    pub global_reason: String,
-    /// Build the caustic map.
-    pub caustic: bool,
-    /// Why (or why not).
-    pub caustic_reason: String,
-}
-
-impl MapPlan {
-    /// Decides from the scene's materials.
-    #[must_use]
-    pub fn for_scene(scene: &Scene) -> Self {
-        let delta = scene.has_delta_surfaces();
-        let diffuse = scene.has_diffuse_surfaces();
-        let (caustic, caustic_reason) = match (delta, diffuse) {
-            (true, true) => (true, "mirror or glass surfaces can focus light onto diffuse surfaces".to_string()),
-            (false, _) => (false, "no mirror or glass in the scene".to_string()),
-            (true, false) => (false, "no diffuse surface to receive caustics".to_string()),
-        };
-        let (global, global_reason) = if diffuse {
-            (true, "diffuse surfaces reflect indirect light".to_string())
-        } else {
-            (false, "no diffuse or glossy surface in the scene".to_string())
-        };
-        MapPlan { global, global_reason, caustic, caustic_reason }
-    }
-
-    /// Refuses settings that leave a needed map empty.
-    pub fn check(&self, settings: &Settings) -> Result<()> {
-        if self.global && settings.photons == 0 {
-            return Err(Error::setting(
-                "photons",
-                format!("must be > 0: the scene needs a global map ({})", self.global_reason),
-            ));
-        }
-        if self.caustic && settings.caustic_photons == 0 {
-            return Err(Error::setting(
-                "caustic_photons",
-                format!("must be > 0: the scene needs a caustic map ({})", self.caustic_reason),
-            ));
-        }
-        Ok(())
-    }
-}
 
 /// Both photon maps (empty where the plan skipped one), and the irradiance precomputed at
 /// global photons for final gathering.
@@ -102,7 +53,7 @@ impl PhotonMaps {
             caustic: PhotonMap::build(caustic),
             irradiance: PhotonMap::default(),
         };
-        if settings.final_gather && settings.precompute_irradiance && !maps.global.is_empty() {
+        if Effects::plan(scene, settings).final_gather.on && settings.precompute_irradiance && !maps.global.is_empty() {
             maps.irradiance = precompute_irradiance(&maps.global, scene, settings, threads);
         }
         maps
@@ -171,7 +122,7 @@ pub fn render(
     progress: &dyn Progress,
 ) -> Result<(Film, RenderStats)> {
     settings.validate()?;
-    let plan = MapPlan::for_scene(scene);
+    let plan = Effects::plan(scene, settings);
     plan.check(settings)?;
     let threads = settings.thread_count();
     let start = Instant::now();
@@ -188,17 +139,14 @@ pub fn render(
     };
 
     let maps = photon_passes(scene, settings, &plan, threads, progress, &mut stats);
+    stats.effects = Some(plan.clone());
 
     let t = Instant::now();
     let (film, rays, non_finite) = camera::render_image(scene, &maps, camera, settings, threads, progress);
     stats.times.camera_s = t.elapsed().as_secs_f64();
     stats.rays += rays;
     stats.non_finite_samples = non_finite;
-    stats.passes.push(if settings.final_gather {
-        "final gather".into()
-    } else {
-        "global map read at first hit".into()
-    });
+    stats.passes.push(if plan.final_gather.on { "final gather".into() } else { "global map read at first hit".into() });
     stats.times.total_s = start.elapsed().as_secs_f64();
     stats.mean_rgb = film.mean().to_array();
     Ok((film, stats))
@@ -209,7 +157,7 @@ pub fn render(
 pub fn photon_passes(
     scene: &Scene,
     settings: &Settings,
-    plan: &MapPlan,
+    plan: &Effects,
     threads: usize,
     progress: &dyn Progress,
     stats: &mut RenderStats,
@@ -230,14 +178,14 @@ pub fn photon_passes(
         p.photons
     };
     let mut times = (0.0, 0.0);
-    let global = pass(plan.global, Domain::GlobalPhoton, settings.photons, "global photon pass", &mut times.0);
+    let global = pass(plan.global_map.on, Domain::GlobalPhoton, settings.photons, "global photon pass", &mut times.0);
     let caustic =
-        pass(plan.caustic, Domain::CausticPhoton, settings.caustic_photons, "caustic photon pass", &mut times.1);
+        pass(plan.caustic_map.on, Domain::CausticPhoton, settings.caustic_photons, "caustic photon pass", &mut times.1);
     (stats.times.global_photons_s, stats.times.caustic_photons_s) = times;
-    stats.global_map.built = plan.global;
-    stats.global_map.reason = plan.global_reason.clone();
-    stats.caustic_map.built = plan.caustic;
-    stats.caustic_map.reason = plan.caustic_reason.clone();
+    stats.global_map.built = plan.global_map.on;
+    stats.global_map.reason = plan.global_map.reason.clone();
+    stats.caustic_map.built = plan.caustic_map.on;
+    stats.caustic_map.reason = plan.caustic_map.reason.clone();
     let t = Instant::now();
     let maps = PhotonMaps::build(scene, settings, global, caustic, threads);
     stats.irradiance_points = maps.irradiance.len() as u64;
@@ -249,7 +197,13 @@ pub fn photon_passes(
 #[must_use]
 pub fn build_maps(scene: &Scene, settings: &Settings) -> (PhotonMaps, MapStats, MapStats) {
     let mut stats = RenderStats::default();
-    let maps =
-        photon_passes(scene, settings, &MapPlan::for_scene(scene), settings.thread_count(), &NoProgress, &mut stats);
+    let maps = photon_passes(
+        scene,
+        settings,
+        &Effects::plan(scene, settings),
+        settings.thread_count(),
+        &NoProgress,
+        &mut stats,
+    );
     (maps, stats.global_map, stats.caustic_map)
 }
