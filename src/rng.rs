@@ -40,6 +40,18 @@ impl Sampler {
         Sampler { key: mix64(k ^ index) }
     }
 
+    /// The stream's key, for storing a stream in a queue column.
+    #[must_use]
+    pub fn key(&self) -> u64 {
+        self.key
+    }
+
+    /// The stream with a stored key.
+    #[must_use]
+    pub fn from_key(key: u64) -> Self {
+        Sampler { key }
+    }
+
     /// A uniform f32 in [0, 1) for (`bounce`, `dim`).
     #[inline]
     #[must_use]

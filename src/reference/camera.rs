@@ -25,9 +25,9 @@ use glam::Vec3;
 /// Shadow rays stop this fraction short of the light point (relative, so scale-free).
 const SHADOW_SHORTEN: f32 = 1e-4;
 /// Sub-stream tags.
-const TAG_GATHER: u64 = 1 << 32;
-const TAG_GLOSSY: u64 = 2 << 32;
-const TAG_LIGHT: u64 = 3 << 32;
+pub const TAG_GATHER: u64 = 1 << 32;
+pub const TAG_GLOSSY: u64 = 2 << 32;
+pub const TAG_LIGHT: u64 = 3 << 32;
 
 /// Everything a camera path needs.
 pub struct Context<'a> {
@@ -202,20 +202,33 @@ pub fn trace_camera_path(
     terms
 }
 
-/// Direct light at `sp` toward `wo`: every delta light once, area lights by `light_samples`
-/// samples chosen by power; each with a shadow ray.
-pub fn direct_light(
+/// A shadow ray and what it carries if nothing blocks it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowRay {
+    /// Origin (offset off the surface).
+    pub origin: Vec3,
+    /// Direction; not unit for rays to a point (the point is at t = 1).
+    pub direction: Vec3,
+    /// Blocked by hits with t below this.
+    pub t_max: f32,
+    /// Reflected radiance it adds when unblocked: f·L·|cos|/pdf.
+    pub contribution: Vec3,
+}
+
+/// The shadow rays of direct light at `sp` toward `wo`: every delta light once, then
+/// `light_samples` area-light samples chosen by power. Lights that cannot contribute (behind
+/// the surface, back faces, outside a spot cone) get no ray.
+pub fn direct_light_rays(
     ctx: &Context,
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
     s: &Sampler,
-    rays: &mut RayCounts,
-) -> Vec3 {
+    mut emit: impl FnMut(ShadowRay),
+) {
     let scene = ctx.scene;
     let (_, ns) = sp.frame.oriented(wo);
-    let mut sum = Vec3::ZERO;
-    let mut add = |light_index: u32, u: [f32; 2], weight: f32, rays: &mut RayCounts| {
+    let mut add = |light_index: u32, u: [f32; 2], weight: f32| {
         let light = &scene.lights[light_index as usize];
         let tri = scene.light_triangle(light);
         let Some(inc) = light.sample_incident(tri.as_ref(), sp.p, u) else { return };
@@ -224,27 +237,42 @@ pub fn direct_light(
         if f == Vec3::ZERO || cos == 0.0 {
             return;
         }
-        rays.shadow += 1;
         let origin = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, inc.wi);
-        let blocked = match inc.point {
-            Some((q, _)) => scene.occluded(origin, q - origin, 1.0 - SHADOW_SHORTEN),
-            None => scene.occluded(origin, inc.wi, f32::INFINITY),
+        let (direction, t_max) = match inc.point {
+            Some((q, _)) => (q - origin, 1.0 - SHADOW_SHORTEN),
+            None => (inc.wi, f32::INFINITY),
         };
-        if !blocked {
-            sum += f * inc.value * (cos * weight);
-        }
+        emit(ShadowRay { origin, direction, t_max, contribution: f * inc.value * (cos * weight) });
     };
     for &li in &scene.delta_lights {
-        add(li, [0.5, 0.5], 1.0, rays);
+        add(li, [0.5, 0.5], 1.0);
     }
     if let Some(dist) = &scene.area_power {
         let n = ctx.settings.light_samples;
         for j in 0..n {
             let pick = dist.sample(s.get(j, 0));
             let pmf = dist.pmf(pick) as f32;
-            add(scene.area_lights[pick], [s.get(j, 1), s.get(j, 2)], 1.0 / (pmf * n as f32), rays);
+            add(scene.area_lights[pick], [s.get(j, 1), s.get(j, 2)], 1.0 / (pmf * n as f32));
         }
     }
+}
+
+/// Direct light at `sp` toward `wo`: the unblocked shadow rays' contributions summed.
+pub fn direct_light(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    s: &Sampler,
+    rays: &mut RayCounts,
+) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    direct_light_rays(ctx, sp, bsdf, wo, s, |r| {
+        rays.shadow += 1;
+        if !ctx.scene.occluded(r.origin, r.direction, r.t_max) {
+            sum += r.contribution;
+        }
+    });
     sum
 }
 
@@ -359,7 +387,7 @@ fn incoming_from_map(
 /// Radiance leaving a non-specular point toward `wo` as the photon maps see it: kd/π × the
 /// nearest precomputed irradiance for Lambertian surfaces when that is available (and a point
 /// with a similar normal lies within the global radius), the full global-map estimate otherwise.
-fn map_radiance(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, scratch: &mut Vec<(f32, u32)>) -> Vec3 {
+pub fn map_radiance(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, scratch: &mut Vec<(f32, u32)>) -> Vec3 {
     let irr = &ctx.maps.irradiance;
     if let (Bsdf::Lambert { kd }, false) = (bsdf, irr.is_empty()) {
         let (ng, _) = sp.frame.oriented(wo);

@@ -11,10 +11,10 @@
 use super::parallel::map_chunks;
 use super::Progress;
 use crate::geometry::offset::{barycentric_error, offset_ray_origin};
-use crate::material::{SurfaceFrame, Transport};
+use crate::material::{Bsdf, SurfaceFrame, Transport};
 use crate::photon_map::{flags, Photon};
 use crate::rng::{Domain, Sampler};
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfacePoint};
 use crate::settings::Settings;
 use glam::Vec3;
 
@@ -86,16 +86,23 @@ pub fn trace_photons(
     PhotonPass { photons, emitted, rays, non_finite }
 }
 
-/// Traces photon path `index` of `domain`, appending stored photons (un-normalised power) to `out`.
-pub fn trace_path(
-    scene: &Scene,
-    settings: &Settings,
-    domain: Domain,
-    index: u64,
-    out: &mut Vec<Photon>,
-    rays: &mut u64,
-    non_finite: &mut u64,
-) {
+/// A photon between bounces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhotonRay {
+    /// Ray origin.
+    pub origin: Vec3,
+    /// Unit direction.
+    pub dir: Vec3,
+    /// Power (not yet divided by the paths emitted).
+    pub power: Vec3,
+    /// True while every bounce so far was specular.
+    pub specular_only: bool,
+}
+
+/// Starts photon path `index` of `domain`: picks a light by power and samples its emission.
+/// `None` if the emission is not finite.
+#[must_use]
+pub fn start_photon(scene: &Scene, settings: &Settings, domain: Domain, index: u64) -> Option<PhotonRay> {
     let s = Sampler::new(settings.seed, domain, index);
     let li = scene.light_power.sample(s.get(0, 0));
     let pmf = scene.light_power.pmf(li) as f32;
@@ -106,68 +113,120 @@ pub fn trace_path(
         (scene.centre(), scene.radius()),
         [s.get(0, 1), s.get(0, 2), s.get(0, 3), s.get(0, 4)],
     );
-    let mut power = em.power / pmf;
+    let power = em.power / pmf;
     if !power.is_finite() || !em.direction.is_finite() {
-        *non_finite += 1;
-        return;
+        return None;
     }
-    let mut dir = em.direction;
-    let mut origin = match (em.normal, tri) {
+    let origin = match (em.normal, tri) {
         (Some(n), Some(t)) => {
             // The emission point's rounding error is bounded like any barycentric point.
             let err = barycentric_error([1.0, 1.0, 1.0], t.p[0], t.p[1], t.p[2]);
-            offset_ray_origin(em.origin, err, n, dir)
+            offset_ray_origin(em.origin, err, n, em.direction)
         }
         _ => em.origin,
     };
+    Some(PhotonRay { origin, dir: em.direction, power, specular_only: true })
+}
+
+/// At a non-specular hit: stores the photon where its map wants it; returns whether the path
+/// goes on. The caustic pass keeps only paths whose first hit is specular and ends each at its
+/// first non-specular hit.
+pub fn deposit_photon(
+    domain: Domain,
+    sp: &SurfacePoint,
+    photon: &PhotonRay,
+    bounce: u32,
+    out: &mut Vec<Photon>,
+) -> bool {
     let caustic = domain == Domain::CausticPhoton;
-    let mut specular_only = true;
+    if caustic && bounce == 0 {
+        return false;
+    }
+    let wo = -photon.dir;
+    let (ng, _) = sp.frame.oriented(wo);
+    let mut f = 0;
+    if bounce == 0 {
+        f |= flags::DIRECT;
+    }
+    if photon.specular_only && bounce > 0 {
+        f |= flags::CAUSTIC;
+    }
+    if !caustic || f & flags::CAUSTIC != 0 {
+        out.push(Photon { position: sp.p, power: photon.power, wi: wo, normal: ng, flags: f });
+    }
+    !caustic
+}
+
+/// What scattering did to a photon.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Scattered {
+    /// It goes on.
+    Continue(PhotonRay),
+    /// Absorbed (Russian roulette or no valid direction).
+    Absorbed,
+    /// Its power stopped being finite; dropped and counted.
+    NonFinite,
+}
+
+/// Scatters a photon at `sp` (BSDF sample, shading-normal correction, Russian roulette) with the
+/// random numbers of bounce `bounce + 1`.
+#[must_use]
+pub fn scatter_photon(s: &Sampler, sp: &SurfacePoint, bsdf: &Bsdf, photon: &PhotonRay, bounce: u32) -> Scattered {
+    let wo = -photon.dir;
+    let u = [s.get(bounce + 1, 0), s.get(bounce + 1, 1), s.get(bounce + 1, 2)];
+    let Some(bs) = bsdf.sample(&sp.frame, wo, u, Transport::Power) else { return Scattered::Absorbed };
+    // Photons carry power, the adjoint of radiance: with shading normals the BSDF is not
+    // symmetric, and Veach's correction |wo·ns||wi·ng| / (|wo·ng||wi·ns|) makes photon
+    // transport agree with camera paths (Veach 1997 §5.3; pbrt-v4 CorrectShadingNormal).
+    let weight = bs.weight * shading_normal_correction(&sp.frame, wo, bs.wi);
+    // Russian roulette keeps the largest channel's power constant: never gains energy.
+    let p_survive = weight.max_element().min(1.0);
+    if !(p_survive > 0.0) || s.get(bounce + 1, 3) >= p_survive {
+        return Scattered::Absorbed;
+    }
+    let power = photon.power * weight / p_survive;
+    if !power.is_finite() {
+        return Scattered::NonFinite;
+    }
+    Scattered::Continue(PhotonRay {
+        origin: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi),
+        dir: bs.wi,
+        power,
+        specular_only: photon.specular_only && bs.delta,
+    })
+}
+
+/// Traces photon path `index` of `domain`, appending stored photons (un-normalised power) to `out`.
+pub fn trace_path(
+    scene: &Scene,
+    settings: &Settings,
+    domain: Domain,
+    index: u64,
+    out: &mut Vec<Photon>,
+    rays: &mut u64,
+    non_finite: &mut u64,
+) {
+    let Some(mut photon) = start_photon(scene, settings, domain, index) else {
+        *non_finite += 1;
+        return;
+    };
+    let s = Sampler::new(settings.seed, domain, index);
     for bounce in 0..settings.max_depth {
         *rays += 1;
-        let Some(hit) = scene.intersect(origin, dir, f32::INFINITY) else { break };
+        let Some(hit) = scene.intersect(photon.origin, photon.dir, f32::INFINITY) else { break };
         let sp = scene.surface(&hit);
         let bsdf = scene.materials[sp.material as usize].bsdf;
-        let wo = -dir;
-        if !bsdf.is_delta() {
-            if caustic && bounce == 0 {
-                break;
-            }
-            let (ng, _) = sp.frame.oriented(wo);
-            let mut f = 0;
-            if bounce == 0 {
-                f |= flags::DIRECT;
-            }
-            if specular_only && bounce > 0 {
-                f |= flags::CAUSTIC;
-            }
-            if !caustic || f & flags::CAUSTIC != 0 {
-                out.push(Photon { position: sp.p, power, wi: wo, normal: ng, flags: f });
-            }
-            if caustic {
+        if !bsdf.is_delta() && !deposit_photon(domain, &sp, &photon, bounce, out) {
+            break;
+        }
+        match scatter_photon(&s, &sp, &bsdf, &photon, bounce) {
+            Scattered::Continue(next) => photon = next,
+            Scattered::Absorbed => break,
+            Scattered::NonFinite => {
+                *non_finite += 1;
                 break;
             }
         }
-        let u = [s.get(bounce + 1, 0), s.get(bounce + 1, 1), s.get(bounce + 1, 2)];
-        let Some(bs) = bsdf.sample(&sp.frame, wo, u, Transport::Power) else { break };
-        if !bs.delta {
-            specular_only = false;
-        }
-        // Photons carry power, the adjoint of radiance: with shading normals the BSDF is not
-        // symmetric, and Veach's correction |wo·ns||wi·ng| / (|wo·ng||wi·ns|) makes photon
-        // transport agree with camera paths (Veach 1997 §5.3; pbrt-v4 CorrectShadingNormal).
-        let weight = bs.weight * shading_normal_correction(&sp.frame, wo, bs.wi);
-        // Russian roulette keeps the largest channel's power constant: never gains energy.
-        let p_survive = weight.max_element().min(1.0);
-        if !(p_survive > 0.0) || s.get(bounce + 1, 3) >= p_survive {
-            break;
-        }
-        power *= weight / p_survive;
-        if !power.is_finite() {
-            *non_finite += 1;
-            break;
-        }
-        origin = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi);
-        dir = bs.wi;
     }
 }
 

@@ -82,6 +82,8 @@ pub struct Scene {
     /// Non-fatal observations made while loading.
     pub warnings: Vec<String>,
     bvh: Bvh,
+    /// (any delta, any glass, any non-delta) material on a triangle, computed once.
+    kinds: (bool, bool, bool),
 }
 
 impl Scene {
@@ -188,7 +190,17 @@ impl Scene {
             dropped_degenerate: dropped,
             warnings,
             bvh,
+            kinds: (false, false, false),
         };
+        let mut used = vec![false; scene.materials.len()];
+        for &m in &scene.material {
+            used[m as usize] = true;
+        }
+        for (m, _) in scene.materials.iter().zip(&used).filter(|(_, u)| **u) {
+            scene.kinds.0 |= m.bsdf.is_delta();
+            scene.kinds.1 |= matches!(m.bsdf, Bsdf::Glass { .. });
+            scene.kinds.2 |= !m.bsdf.is_delta();
+        }
         let radius = scene.radius();
         let powers: Vec<f64> = scene
             .lights
@@ -301,18 +313,18 @@ impl Scene {
     /// True if any triangle has a delta (mirror or glass) material.
     #[must_use]
     pub fn has_delta_surfaces(&self) -> bool {
-        self.material.iter().any(|&m| self.materials[m as usize].bsdf.is_delta())
+        self.kinds.0
     }
 
     /// True if any triangle is glass.
     #[must_use]
     pub fn has_glass(&self) -> bool {
-        self.material.iter().any(|&m| matches!(self.materials[m as usize].bsdf, Bsdf::Glass { .. }))
+        self.kinds.1
     }
 
     /// True if any triangle has a non-delta (diffuse or glossy) material.
     #[must_use]
     pub fn has_diffuse_surfaces(&self) -> bool {
-        self.material.iter().any(|&m| !self.materials[m as usize].bsdf.is_delta())
+        self.kinds.2
     }
 }
