@@ -22,5 +22,6 @@ pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod stats;
+pub mod wavefront;
 
 pub use error::{Error, Result};

@@ -106,8 +106,9 @@ struct RenderArgs {
     /// Write a tone-mapped PNG preview to this file.
     #[arg(long)]
     png: Option<PathBuf>,
-    /// Engine: `reference` (scalar photon mapper) or `path` (unbiased path tracer, for validation).
-    #[arg(long, default_value = "reference")]
+    /// Engine: `wavefront` (bevy_ecs stages over SoA queues), `reference` (scalar photon mapper)
+    /// or `path` (unbiased path tracer, for validation).
+    #[arg(long, default_value = "wavefront")]
     engine: Engine,
     /// No progress bars.
     #[arg(long, short)]
@@ -116,6 +117,8 @@ struct RenderArgs {
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum Engine {
+    /// The wavefront photon mapper: bevy_ecs systems over structure-of-arrays queues.
+    Wavefront,
     /// The scalar reference photon mapper.
     Reference,
     /// An unbiased path tracer with next-event estimation (slow; for checking energy).
@@ -157,7 +160,7 @@ impl Progress for Bars {
 fn render(args: RenderArgs) -> Result<()> {
     let t0 = Instant::now();
     let loaded = load_scene(&args.scene)?;
-    let scene = loaded.scene;
+    let scene = std::sync::Arc::new(loaded.scene);
     let mut settings = loaded.settings;
     macro_rules! set {
         ($($f:ident),*) => { $( if let Some(v) = args.$f { settings.$f = v; } )* };
@@ -203,6 +206,7 @@ fn render(args: RenderArgs) -> Result<()> {
     let quiet = args.quiet || !std::io::IsTerminal::is_terminal(&std::io::stderr());
     let bars = Bars { bar: Mutex::new(None), quiet };
     let (film, mut stats) = match args.engine {
+        Engine::Wavefront => photonwave::wavefront::render(scene.clone(), &rays, &settings, &bars)?,
         Engine::Reference => reference::render(&scene, &rays, &settings, &bars)?,
         Engine::Path => reference::path::render_path_traced_with_stats(&scene, &rays, &settings, &bars)?,
     };

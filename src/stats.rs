@@ -101,6 +101,8 @@ pub struct RenderStats {
     pub non_finite_photons: u64,
     /// Phase times.
     pub times: PhaseTimes,
+    /// Per-system runs, lanes and time (wavefront engine).
+    pub stages: Option<crate::wavefront::StageStats>,
     /// Mean of the beauty image (RGB).
     pub mean_rgb: [f32; 3],
 }

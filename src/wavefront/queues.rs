@@ -109,7 +109,11 @@ impl HitColumns {
     #[inline]
     #[must_use]
     pub fn get(&self, i: usize) -> Option<Hit> {
-        (self.tri[i] != Self::MISS).then(|| Hit { tri: self.tri[i], t: self.t[i], b: [self.b0[i], self.b1[i], self.b2[i]] })
+        (self.tri[i] != Self::MISS).then(|| Hit {
+            tri: self.tri[i],
+            t: self.t[i],
+            b: [self.b0[i], self.b1[i], self.b2[i]],
+        })
     }
 }
 

@@ -1,0 +1,73 @@
+//! Emit: new lanes. Reads the scene and settings; writes the photon queue (a batch of paths
+//! starting at lights) or the path queue (a wave of camera rays) and the wave's empty terms.
+
+use super::queues::{PathKind, Segment};
+use super::{par_lanes, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
+use crate::film::Terms;
+use crate::reference::photons::{start_photon, BATCH};
+use crate::rng::{Domain, Sampler};
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use std::time::Instant;
+
+/// Starts [`BATCH`] photon paths at the batch's first path index.
+pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let (scene, settings) = (&*shared.scene, &shared.settings);
+    let domain = work.domain.unwrap_or(Domain::GlobalPhoton);
+    let first = work.first_path;
+    let starts = par_lanes(BATCH, CHUNK, shared.threads, |r| {
+        r.map(|i| start_photon(scene, settings, domain, first + i as u64)).collect()
+    });
+    let w = &mut *work;
+    w.queue.clear();
+    for (i, s) in starts.into_iter().enumerate() {
+        match s {
+            Some(p) => w.queue.push(p.origin, p.dir, first + i as u64, 0, p.power, true),
+            None => w.non_finite += 1,
+        }
+    }
+    stats.record("emit_photons", BATCH, t);
+}
+
+/// Generates the wave's camera rays: sample `g` is sample `g % spp` of pixel `g / spp`, jittered
+/// (stratified when spp is a square) exactly as the reference engine does.
+pub fn emit_camera_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let settings = &shared.settings;
+    let w = &mut *work;
+    let spp = settings.spp as u64;
+    let strata = (settings.spp as f32).sqrt() as u32;
+    let stratified = strata * strata == settings.spp;
+    w.paths.clear();
+    w.next.clear();
+    w.shadows.clear();
+    w.terms.clear();
+    w.terms.resize(w.count, Terms::default());
+    for lane in 0..w.count {
+        let g = w.first_sample + lane as u64;
+        let (pixel, s) = (g / spp, (g % spp) as u32);
+        let (x, y) = ((pixel % settings.width as u64) as f32, (pixel / settings.width as u64) as f32);
+        let sampler = Sampler::new(settings.seed, Domain::Camera, g);
+        let (jx, jy) = (sampler.get(0, 0), sampler.get(0, 1));
+        let (fx, fy) = if stratified {
+            (((s % strata) as f32 + jx) / strata as f32, ((s / strata) as f32 + jy) / strata as f32)
+        } else {
+            (jx, jy)
+        };
+        let (o, d) = w.camera.ray(x + fx, y + fy);
+        w.paths.push(Segment {
+            o,
+            d,
+            sample: lane as u32,
+            kind: PathKind::Camera,
+            key: sampler.key(),
+            base: 1,
+            depth: 0,
+            beta: Vec3::ONE,
+            slot: 0,
+            through_specular: false,
+        });
+    }
+    stats.record("emit_camera_rays", w.count, t);
+}

@@ -1,0 +1,61 @@
+//! Intersect: closest hits for every lane of the photon or path queue, and any-hit tests for
+//! the shadow queue. Reads rays; writes hit columns (and, for shadow rays, the unblocked
+//! contributions into the wave's terms, in lane order).
+
+use super::queues::PathKind;
+use super::{add_term, par_lanes, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
+use bevy_ecs::prelude::*;
+use std::time::Instant;
+
+/// Closest hits of the photon queue.
+pub fn intersect_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let scene = &*shared.scene;
+    let w = &mut *work;
+    let rays = &w.queue.rays;
+    let hits = par_lanes(rays.len(), CHUNK, shared.threads, |r| {
+        r.map(|i| scene.intersect(rays.origin(i), rays.direction(i), f32::INFINITY)).collect()
+    });
+    w.queue.hits.fill(hits.into_iter());
+    w.rays += rays.len() as u64;
+    stats.record("intersect_photons", rays.len(), t);
+}
+
+/// Closest hits of the path queue.
+pub fn intersect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let scene = &*shared.scene;
+    let w = &mut *work;
+    let rays = &w.paths.rays;
+    let hits = par_lanes(rays.len(), CHUNK, shared.threads, |r| {
+        r.map(|i| scene.intersect(rays.origin(i), rays.direction(i), f32::INFINITY)).collect()
+    });
+    w.paths.hits.fill(hits.into_iter());
+    for k in &w.paths.kind {
+        match k {
+            PathKind::Camera => w.rays.camera += 1,
+            _ => w.rays.gather += 1,
+        }
+    }
+    stats.record("intersect_paths", rays.len(), t);
+}
+
+/// Any-hit tests of the shadow queue; unblocked rays add their contribution.
+pub fn trace_shadow_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let scene = &*shared.scene;
+    let w = &mut *work;
+    let q = &w.shadows;
+    let n = q.len();
+    let blocked = par_lanes(n, CHUNK, shared.threads, |r| {
+        r.map(|i| scene.occluded(q.rays.origin(i), q.rays.direction(i), q.t_max[i])).collect()
+    });
+    for (i, b) in blocked.into_iter().enumerate() {
+        if !b {
+            add_term(&mut w.terms[q.sample[i] as usize], q.slot[i], q.contribution[i]);
+        }
+    }
+    w.rays.shadow += n as u64;
+    w.shadows.clear();
+    stats.record("trace_shadow_rays", n, t);
+}

@@ -1,0 +1,281 @@
+//! Shade: what each lane does next. Photons scatter (BSDF sample, Russian roulette) into the
+//! next photon queue. Camera-pass lanes at diffuse hits queue shadow rays (direct light) and
+//! spawn final-gather and glossy rays; lanes at mirrors and glass continue. After the bounce loop,
+//! `resolve_wave` turns the wave's samples into pixels. Reads classified lanes and hits; writes
+//! the next queues, the shadow queue and the film.
+
+use super::gather::camera_slot;
+use super::queues::{PathKind, PhotonQueue, Segment};
+use super::{par_lanes, slot, CameraWork, Maps, PhotonWork, Shared, StageStats, CHUNK};
+use crate::film::Terms;
+use crate::geometry::offset::offset_ray_origin;
+use crate::material::{Bsdf, Transport};
+use crate::reference::camera::{direct_light_rays, Context, ShadowRay, TAG_GATHER, TAG_GLOSSY, TAG_LIGHT};
+use crate::reference::photons::{scatter_photon, PhotonRay, Scattered};
+use crate::rng::{Domain, Sampler};
+use crate::sampling::{cosine_hemisphere, Frame};
+use bevy_ecs::prelude::*;
+use std::time::Instant;
+
+/// Scatters the photon lanes `lanes` into `next`; returns the count of non-finite drops.
+fn scatter_lanes(shared: &Shared, work: &PhotonWork, lanes: &[u32], next: &mut PhotonQueue) -> u64 {
+    let scene = &*shared.scene;
+    let domain = work.domain.unwrap_or(Domain::GlobalPhoton);
+    let q = &work.queue;
+    let results = par_lanes(lanes.len(), CHUNK, shared.threads, |r| {
+        r.filter_map(|j| {
+            let i = lanes[j] as usize;
+            let sp = scene.surface(&q.hits.get(i)?);
+            let bsdf = scene.materials[sp.material as usize].bsdf;
+            let photon = PhotonRay {
+                origin: q.rays.origin(i),
+                dir: q.rays.direction(i),
+                power: q.power[i],
+                specular_only: q.specular_only[i] != 0,
+            };
+            let s = Sampler::new(shared.settings.seed, domain, q.path[i]);
+            Some((i, scatter_photon(&s, &sp, &bsdf, &photon, q.bounce[i])))
+        })
+        .collect()
+    });
+    let mut non_finite = 0;
+    for (i, r) in results {
+        match r {
+            Scattered::Continue(p) if q.bounce[i] + 1 < shared.settings.max_depth => {
+                next.push(p.origin, p.dir, q.path[i], q.bounce[i] + 1, p.power, p.specular_only);
+            }
+            Scattered::NonFinite => non_finite += 1,
+            _ => {}
+        }
+    }
+    non_finite
+}
+
+/// Photons at mirrors and surviving diffuse photons scatter into the next queue.
+pub fn scatter_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let lanes: Vec<u32> = work.classified.mirror.iter().chain(&work.survivors).copied().collect();
+    let mut next = std::mem::take(&mut work.next);
+    work.non_finite += scatter_lanes(&shared, &work, &lanes, &mut next);
+    work.next = next;
+    stats.record("scatter_photons", lanes.len(), t);
+}
+
+/// Photons at glass reflect or refract into the next queue (only in scenes with glass).
+pub fn refract_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let lanes = work.classified.glass.clone();
+    let mut next = std::mem::take(&mut work.next);
+    work.non_finite += scatter_lanes(&shared, &work, &lanes, &mut next);
+    work.next = next;
+    stats.record("refract_photons", lanes.len(), t);
+}
+
+/// Diffuse lanes of camera and glossy rays queue their shadow rays (direct light).
+pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let ctx = Context::new(&shared.scene, &maps.0, &shared.settings);
+    let w = &*work;
+    let lanes: Vec<u32> =
+        w.classified.diffuse.iter().copied().filter(|&l| w.paths.kind[l as usize] != PathKind::Gather).collect();
+    let rays: Vec<(u32, u8, ShadowRay)> = par_lanes(lanes.len(), CHUNK, shared.threads, |r| {
+        let mut out = Vec::new();
+        for j in r {
+            let i = lanes[j] as usize;
+            let Some(hit) = w.paths.hits.get(i) else { continue };
+            let sp = ctx.scene.surface(&hit);
+            let bsdf = &ctx.scene.materials[sp.material as usize].bsdf;
+            let s = Sampler::from_key(w.paths.key[i]);
+            let (stream, target) = match w.paths.kind[i] {
+                PathKind::Camera => (
+                    s.fork(TAG_LIGHT + w.paths.depth[i] as u64),
+                    camera_slot(w.paths.through_specular[i], slot::DIRECT),
+                ),
+                _ => (s.fork(7), w.paths.slot[i]),
+            };
+            let beta = w.paths.beta[i];
+            direct_light_rays(&ctx, &sp, bsdf, -w.paths.rays.direction(i), &stream, |mut ray| {
+                ray.contribution *= beta;
+                out.push((w.paths.sample[i], target, ray));
+            });
+        }
+        out
+    });
+    let n = rays.len();
+    for (sample, s, r) in rays {
+        work.shadows.push(r.origin, r.direction, r.t_max, sample, s, r.contribution);
+    }
+    stats.record("shade_direct", n, t);
+}
+
+/// Diffuse camera lanes spawn `gather_rays` cosine-weighted rays, each weighted beta·kd/N.
+pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let scene = &*shared.scene;
+    let n = shared.settings.gather_rays;
+    let w = &*work;
+    let lanes: Vec<u32> =
+        w.classified.diffuse.iter().copied().filter(|&l| w.paths.kind[l as usize] == PathKind::Camera).collect();
+    let segments: Vec<Segment> = par_lanes(lanes.len(), CHUNK, shared.threads, |r| {
+        let mut out = Vec::new();
+        for j in r {
+            let i = lanes[j] as usize;
+            let Some(hit) = w.paths.hits.get(i) else { continue };
+            let sp = scene.surface(&hit);
+            let kd = scene.materials[sp.material as usize].bsdf.diffuse();
+            if kd == glam::Vec3::ZERO {
+                continue;
+            }
+            let wo = -w.paths.rays.direction(i);
+            let (ng, ns) = sp.frame.oriented(wo);
+            let frame = Frame::new(ns);
+            let gs = Sampler::from_key(w.paths.key[i]).fork(TAG_GATHER + w.paths.depth[i] as u64);
+            let weight = w.paths.beta[i] * kd / n as f32;
+            for g in 0..n {
+                let wi = frame.to_world(cosine_hemisphere([gs.get(g, 0), gs.get(g, 1)]));
+                if wi.dot(ng) <= 0.0 {
+                    continue;
+                }
+                out.push(Segment {
+                    o: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, wi),
+                    d: wi,
+                    sample: w.paths.sample[i],
+                    kind: PathKind::Gather,
+                    key: gs.fork(g as u64).key(),
+                    base: 0,
+                    depth: 0,
+                    beta: weight,
+                    slot: camera_slot(w.paths.through_specular[i], slot::INDIRECT),
+                    through_specular: false,
+                });
+            }
+        }
+        out
+    });
+    let count = segments.len();
+    for s in segments {
+        work.next.push(s);
+    }
+    stats.record("spawn_gather_rays", count, t);
+}
+
+/// Diffuse camera lanes on glossy materials spawn one ray from the glossy lobe.
+pub fn spawn_glossy_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let scene = &*shared.scene;
+    let w = &*work;
+    let mut segments = Vec::new();
+    for &l in &w.classified.diffuse {
+        let i = l as usize;
+        if w.paths.kind[i] != PathKind::Camera {
+            continue;
+        }
+        let Some(hit) = w.paths.hits.get(i) else { continue };
+        let sp = scene.surface(&hit);
+        let bsdf = &scene.materials[sp.material as usize].bsdf;
+        if !matches!(bsdf, Bsdf::Glossy { .. }) {
+            continue;
+        }
+        let gls = Sampler::from_key(w.paths.key[i]).fork(TAG_GLOSSY + w.paths.depth[i] as u64);
+        let wo = -w.paths.rays.direction(i);
+        let Some(bs) = bsdf.sample_glossy(&sp.frame, wo, [gls.get(0, 0), gls.get(0, 1)]) else { continue };
+        segments.push(Segment {
+            o: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi),
+            d: bs.wi,
+            sample: w.paths.sample[i],
+            kind: PathKind::Glossy,
+            key: gls.key(),
+            base: 1,
+            depth: 0,
+            beta: w.paths.beta[i] * bs.weight,
+            slot: slot::SPECULAR,
+            through_specular: false,
+        });
+    }
+    let count = segments.len();
+    for s in segments {
+        work.next.push(s);
+    }
+    stats.record("spawn_glossy_rays", count, t);
+}
+
+/// Continues the lanes `lanes` (at mirrors or glass) by sampling the delta BSDF with the
+/// random numbers of bounce `base + depth`; chains stop after `max_depth` bounces.
+fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32]) -> Vec<Segment> {
+    let scene = &*shared.scene;
+    let max_depth = shared.settings.max_depth;
+    let w = work;
+    par_lanes(lanes.len(), CHUNK, shared.threads, |r| {
+        r.filter_map(|j| {
+            let i = lanes[j] as usize;
+            if w.paths.depth[i] >= max_depth {
+                return None;
+            }
+            let sp = scene.surface(&w.paths.hits.get(i)?);
+            let bsdf = &scene.materials[sp.material as usize].bsdf;
+            let s = Sampler::from_key(w.paths.key[i]);
+            let b = w.paths.base[i] as u32 + w.paths.depth[i];
+            let bs = bsdf.sample(
+                &sp.frame,
+                -w.paths.rays.direction(i),
+                [s.get(b, 0), s.get(b, 1), s.get(b, 2)],
+                Transport::Radiance,
+            )?;
+            Some(Segment {
+                o: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi),
+                d: bs.wi,
+                sample: w.paths.sample[i],
+                kind: w.paths.kind[i],
+                key: w.paths.key[i],
+                base: w.paths.base[i],
+                depth: w.paths.depth[i] + 1,
+                beta: w.paths.beta[i] * bs.weight,
+                slot: w.paths.slot[i],
+                through_specular: w.paths.kind[i] == PathKind::Camera,
+            })
+        })
+        .collect()
+    })
+}
+
+/// Lanes at mirrors continue.
+pub fn reflect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let lanes = work.classified.mirror.clone();
+    let segments = continue_specular(&shared, &work, &lanes);
+    for s in segments {
+        work.next.push(s);
+    }
+    stats.record("reflect_paths", lanes.len(), t);
+}
+
+/// Lanes at glass reflect or refract (only in scenes with glass).
+pub fn refract_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let lanes = work.classified.glass.clone();
+    let segments = continue_specular(&shared, &work, &lanes);
+    for s in segments {
+        work.next.push(s);
+    }
+    stats.record("refract_paths", lanes.len(), t);
+}
+
+/// Averages each pixel's samples (dropping non-finite ones, as the reference does) into the film.
+pub fn resolve_wave(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let spp = shared.settings.spp as usize;
+    let w = &mut *work;
+    let first_pixel = (w.first_sample / spp as u64) as usize;
+    for (k, samples) in w.terms.chunks(spp).enumerate() {
+        let mut sum = Terms::default();
+        for t in samples {
+            if t.is_finite() {
+                sum += *t;
+            } else {
+                w.non_finite += 1;
+            }
+        }
+        w.film[first_pixel + k] = sum * (1.0 / spp as f32);
+    }
+    stats.record("resolve_wave", w.count, t);
+}
