@@ -140,6 +140,18 @@ impl RenderStats {
             t.total_s,
             self.non_finite_samples,
             self.non_finite_photons,
-        )
+        ) + &self.stage_summary()
+    }
+
+    /// Per-system lines (wavefront engine): runs, lanes, time and lanes per second.
+    #[must_use]
+    pub fn stage_summary(&self) -> String {
+        let Some(stages) = &self.stages else { return String::new() };
+        let mut out = String::from("  stages (runs, lanes, seconds, lanes/s):\n");
+        for (name, s) in &stages.0 {
+            let rate = if s.seconds > 0.0 { s.items as f64 / s.seconds } else { 0.0 };
+            out += &format!("    {name:<18} {:>7} {:>11} {:>8.3} {:>12.0}\n", s.runs, s.items, s.seconds, rate);
+        }
+        out
     }
 }

@@ -15,6 +15,19 @@ pub fn map_chunks<T: Send>(
 ) -> Vec<T> {
     let chunk = chunk.max(1);
     let count = n.div_ceil(chunk);
+    if threads <= 1 || count <= 1 {
+        // One worker: no thread to spawn (the wavefront engine calls this for every stage of every
+        // bounce, and deep bounces hold few lanes; spawning cost more than their work).
+        return (0..count)
+            .map(|c| {
+                let range = c * chunk..((c + 1) * chunk).min(n);
+                let len = range.len();
+                let r = work(range);
+                done(len);
+                r
+            })
+            .collect();
+    }
     let next = AtomicUsize::new(0);
     let slots: Vec<Mutex<Option<T>>> = (0..count).map(|_| Mutex::new(None)).collect();
     std::thread::scope(|s| {

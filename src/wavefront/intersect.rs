@@ -2,8 +2,9 @@
 //! the shadow queue. Reads rays; writes hit columns (and, for shadow rays, the unblocked
 //! contributions into the wave's terms, in lane order).
 
+use super::queues::HitColumns;
 use super::queues::PathKind;
-use super::{add_term, par_lanes, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
+use super::{add_term, par_columns, par_lanes, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
@@ -13,10 +14,17 @@ pub fn intersect_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut 
     let scene = &*shared.scene;
     let w = &mut *work;
     let rays = &w.queue.rays;
-    let hits = par_lanes(rays.len(), CHUNK, shared.threads, |r| {
-        r.map(|i| scene.intersect(rays.origin(i), rays.direction(i), f32::INFINITY)).collect()
-    });
-    w.queue.hits.fill(hits.into_iter());
+    let hits = &mut w.queue.hits;
+    hits.clear();
+    par_columns(
+        rays.len(),
+        CHUNK,
+        shared.threads,
+        |r, part: &mut HitColumns| {
+            part.extend(r.map(|i| scene.intersect(rays.origin(i), rays.direction(i), f32::INFINITY)))
+        },
+        |part| hits.append(part),
+    );
     w.rays += rays.len() as u64;
     stats.record("intersect_photons", rays.len(), t);
 }
@@ -27,10 +35,17 @@ pub fn intersect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut st
     let scene = &*shared.scene;
     let w = &mut *work;
     let rays = &w.paths.rays;
-    let hits = par_lanes(rays.len(), CHUNK, shared.threads, |r| {
-        r.map(|i| scene.intersect(rays.origin(i), rays.direction(i), f32::INFINITY)).collect()
-    });
-    w.paths.hits.fill(hits.into_iter());
+    let hits = &mut w.paths.hits;
+    hits.clear();
+    par_columns(
+        rays.len(),
+        CHUNK,
+        shared.threads,
+        |r, part: &mut HitColumns| {
+            part.extend(r.map(|i| scene.intersect(rays.origin(i), rays.direction(i), f32::INFINITY)))
+        },
+        |part| hits.append(part),
+    );
     for k in &w.paths.kind {
         match k {
             PathKind::Camera => w.rays.camera += 1,

@@ -173,6 +173,31 @@ impl StageStats {
     }
 }
 
+/// Runs `f` over `0..n` in chunks on `threads` threads; each chunk fills its own `T` (a queue
+/// or columns) and the chunks are appended in lane order with `append` (column copies, so the
+/// sequential part stays small).
+pub fn par_columns<T: Send + Default>(
+    n: usize,
+    chunk: usize,
+    threads: usize,
+    f: impl Fn(std::ops::Range<usize>, &mut T) + Sync,
+    mut append: impl FnMut(&mut T),
+) {
+    for mut part in map_chunks(
+        n,
+        chunk,
+        threads,
+        |r| {
+            let mut t = T::default();
+            f(r, &mut t);
+            t
+        },
+        |_| {},
+    ) {
+        append(&mut part);
+    }
+}
+
 /// Runs `f` over `0..n` in chunks on `threads` threads; results in lane order.
 pub fn par_lanes<T: Send>(
     n: usize,

@@ -3,8 +3,8 @@
 //!
 //! Bytes per lane (why each field is there):
 //! - rays: origin 12, direction 12 (f32 columns, as traversal reads them);
-//! - hits: triangle 4 (u32::MAX = escaped), t 4, barycentrics 8 (b1, b2; b0 = 1 − b1 − b2 is
-//!   recomputed exactly as the reference engine computes it);
+//! - hits: triangle 4 (u32::MAX = escaped), t 4, barycentrics 12 (all three, exactly as the
+//!   triangle test returned them, so surface points match the reference engine's bit for bit);
 //! - photons: path index 8, bounce 4, power 12, specular-only flag 1 → 61 B a lane with ray and hit;
 //! - camera-pass paths: sample 4, kind 1, sampler key 8, bounce base 1, depth 4, term slot 1,
 //!   throughput 12, through-specular flag 1 → 64 B a lane with ray and hit;
@@ -68,6 +68,15 @@ impl RayColumns {
             c.clear();
         }
     }
+    /// Moves `other`'s lanes to the end (column copies).
+    pub fn append(&mut self, other: &mut RayColumns) {
+        self.ox.append(&mut other.ox);
+        self.oy.append(&mut other.oy);
+        self.oz.append(&mut other.oz);
+        self.dx.append(&mut other.dx);
+        self.dy.append(&mut other.dy);
+        self.dz.append(&mut other.dz);
+    }
 }
 
 /// Closest hits as columns, one per lane of the queue that was intersected.
@@ -89,13 +98,32 @@ impl HitColumns {
     /// Marks an escaped lane.
     pub const MISS: u32 = u32::MAX;
 
-    /// Replaces the contents with `hits`.
-    pub fn fill(&mut self, hits: impl Iterator<Item = Option<Hit>>) {
+    /// Removes every lane.
+    pub fn clear(&mut self) {
         self.tri.clear();
         self.t.clear();
         self.b0.clear();
         self.b1.clear();
         self.b2.clear();
+    }
+
+    /// Moves `other`'s lanes to the end (column copies).
+    pub fn append(&mut self, other: &mut HitColumns) {
+        self.tri.append(&mut other.tri);
+        self.t.append(&mut other.t);
+        self.b0.append(&mut other.b0);
+        self.b1.append(&mut other.b1);
+        self.b2.append(&mut other.b2);
+    }
+
+    /// Replaces the contents with `hits`.
+    pub fn fill(&mut self, hits: impl Iterator<Item = Option<Hit>>) {
+        self.clear();
+        self.extend(hits);
+    }
+
+    /// Appends `hits`.
+    pub fn extend(&mut self, hits: impl Iterator<Item = Option<Hit>>) {
         for h in hits {
             let h = h.unwrap_or(Hit { tri: Self::MISS, t: f32::INFINITY, b: [0.0; 3] });
             self.tri.push(h.tri);
@@ -259,6 +287,19 @@ impl PathQueue {
     pub fn is_empty(&self) -> bool {
         self.sample.is_empty()
     }
+    /// Moves `other`'s lanes to the end (column copies; hits are not moved).
+    pub fn append(&mut self, other: &mut PathQueue) {
+        self.rays.append(&mut other.rays);
+        self.sample.append(&mut other.sample);
+        self.kind.append(&mut other.kind);
+        self.key.append(&mut other.key);
+        self.base.append(&mut other.base);
+        self.depth.append(&mut other.depth);
+        self.beta.append(&mut other.beta);
+        self.slot.append(&mut other.slot);
+        self.through_specular.append(&mut other.through_specular);
+    }
+
     /// Appends a segment.
     pub fn push(&mut self, s: Segment) {
         self.rays.push(s.o, s.d);

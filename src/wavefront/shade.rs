@@ -5,8 +5,8 @@
 //! the next queues, the shadow queue and the film.
 
 use super::gather::camera_slot;
-use super::queues::{PathKind, PhotonQueue, Segment};
-use super::{par_lanes, slot, CameraWork, Maps, PhotonWork, Shared, StageStats, CHUNK};
+use super::queues::{PathKind, PathQueue, PhotonQueue, Segment};
+use super::{par_columns, par_lanes, slot, CameraWork, Maps, PhotonWork, Shared, StageStats, CHUNK};
 use crate::film::Terms;
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::{Bsdf, Transport};
@@ -116,46 +116,49 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
     let w = &*work;
     let lanes: Vec<u32> =
         w.classified.diffuse.iter().copied().filter(|&l| w.paths.kind[l as usize] == PathKind::Camera).collect();
-    let segments: Vec<Segment> = par_lanes(lanes.len(), CHUNK, shared.threads, |r| {
-        let mut out = Vec::new();
-        for j in r {
-            let i = lanes[j] as usize;
-            let Some(hit) = w.paths.hits.get(i) else { continue };
-            let sp = scene.surface(&hit);
-            let kd = scene.materials[sp.material as usize].bsdf.diffuse();
-            if kd == glam::Vec3::ZERO {
-                continue;
-            }
-            let wo = -w.paths.rays.direction(i);
-            let (ng, ns) = sp.frame.oriented(wo);
-            let frame = Frame::new(ns);
-            let gs = Sampler::from_key(w.paths.key[i]).fork(TAG_GATHER + w.paths.depth[i] as u64);
-            let weight = w.paths.beta[i] * kd / n as f32;
-            for g in 0..n {
-                let wi = frame.to_world(cosine_hemisphere([gs.get(g, 0), gs.get(g, 1)]));
-                if wi.dot(ng) <= 0.0 {
+    let mut spawned = PathQueue::default();
+    par_columns(
+        lanes.len(),
+        CHUNK,
+        shared.threads,
+        |r, out: &mut PathQueue| {
+            for j in r {
+                let i = lanes[j] as usize;
+                let Some(hit) = w.paths.hits.get(i) else { continue };
+                let sp = scene.surface(&hit);
+                let kd = scene.materials[sp.material as usize].bsdf.diffuse();
+                if kd == glam::Vec3::ZERO {
                     continue;
                 }
-                out.push(Segment {
-                    o: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, wi),
-                    d: wi,
-                    sample: w.paths.sample[i],
-                    kind: PathKind::Gather,
-                    key: gs.fork(g as u64).key(),
-                    base: 0,
-                    depth: 0,
-                    beta: weight,
-                    slot: camera_slot(w.paths.through_specular[i], slot::INDIRECT),
-                    through_specular: false,
-                });
+                let wo = -w.paths.rays.direction(i);
+                let (ng, ns) = sp.frame.oriented(wo);
+                let frame = Frame::new(ns);
+                let gs = Sampler::from_key(w.paths.key[i]).fork(TAG_GATHER + w.paths.depth[i] as u64);
+                let weight = w.paths.beta[i] * kd / n as f32;
+                for g in 0..n {
+                    let wi = frame.to_world(cosine_hemisphere([gs.get(g, 0), gs.get(g, 1)]));
+                    if wi.dot(ng) <= 0.0 {
+                        continue;
+                    }
+                    out.push(Segment {
+                        o: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, wi),
+                        d: wi,
+                        sample: w.paths.sample[i],
+                        kind: PathKind::Gather,
+                        key: gs.fork(g as u64).key(),
+                        base: 0,
+                        depth: 0,
+                        beta: weight,
+                        slot: camera_slot(w.paths.through_specular[i], slot::INDIRECT),
+                        through_specular: false,
+                    });
+                }
             }
-        }
-        out
-    });
-    let count = segments.len();
-    for s in segments {
-        work.next.push(s);
-    }
+        },
+        |part| spawned.append(part),
+    );
+    let count = spawned.len();
+    work.next.append(&mut spawned);
     stats.record("spawn_gather_rays", count, t);
 }
 
