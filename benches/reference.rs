@@ -48,11 +48,10 @@ fn density(c: &mut Criterion) {
     let scene = &loaded.scene;
     let settings = Settings { photons: 200_000, ..Default::default() };
     let (maps, _, _) = build_maps(scene, &settings);
-    let photons = maps.global.photons();
     // Queries at stored photon positions (on surfaces), in a scattered order.
     let queries: Vec<(Vec3, Vec3)> = (0..16_384usize)
         .map(|i| {
-            let p = &photons[(i * 7919) % photons.len()];
+            let p = maps.global.photon((i * 7919) % maps.global.len());
             (p.position, p.normal)
         })
         .collect();

@@ -132,14 +132,14 @@ struct RayOrigin(Vec3);
 #[derive(Component)]
 struct RayDir(Vec3);
 #[derive(Component, Default)]
-struct RayHit(Option<u32>);
+struct RayHit(Option<photonwave::geometry::Hit>);
 
 #[derive(Resource)]
 struct SceneRes(Arc<Scene>);
 
 fn intersect_entities(scene: Res<SceneRes>, mut q: Query<(&RayOrigin, &RayDir, &mut RayHit)>) {
     for (o, d, mut h) in &mut q {
-        h.0 = scene.0.intersect(o.0, d.0, f32::INFINITY).map(|h| h.tri);
+        h.0 = scene.0.intersect(o.0, d.0, f32::INFINITY);
     }
 }
 

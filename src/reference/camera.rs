@@ -393,7 +393,7 @@ pub fn map_radiance(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, scr
         let (ng, _) = sp.frame.oriented(wo);
         irr.nearest(sp.p, 1, ctx.global_radius, |key| key.normal().dot(ng) > 0.7, scratch);
         if let Some(&(_, i)) = scratch.first() {
-            return *kd * std::f32::consts::FRAC_1_PI * irr.photons()[i as usize].power;
+            return *kd * std::f32::consts::FRAC_1_PI * irr.power(i as usize);
         }
     }
     global_estimate(ctx, sp, bsdf, wo, 0, scratch)

@@ -66,8 +66,7 @@ impl PhotonMaps {
 /// search instead of a k-nearest density estimate).
 fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings, threads: usize) -> PhotonMap {
     let radius = settings.global_radius * scene.diagonal();
-    let sources = global.photons();
-    let picks: Vec<usize> = (0..sources.len()).step_by(IRRADIANCE_STRIDE).collect();
+    let picks: Vec<usize> = (0..global.len()).step_by(IRRADIANCE_STRIDE).collect();
     let chunks = parallel::map_chunks(
         picks.len(),
         4096,
@@ -76,7 +75,7 @@ fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings,
             let mut scratch = Vec::new();
             range
                 .map(|j| {
-                    let src = &sources[picks[j]];
+                    let src = global.photon(picks[j]);
                     let e = global.estimate(
                         src.position,
                         src.normal,
