@@ -143,6 +143,24 @@ fn intersect_entities(scene: Res<SceneRes>, mut q: Query<(&RayOrigin, &RayDir, &
     }
 }
 
+/// The entity layout's classify: material kind of each hit into a per-entity component.
+#[derive(Component, Default)]
+struct RayClass(u8);
+
+fn classify_entities(scene: Res<SceneRes>, mut q: Query<(&RayHit, &mut RayClass)>) {
+    let s = &scene.0;
+    for (h, mut c) in &mut q {
+        c.0 = match h.0 {
+            None => 3,
+            Some(h) => match s.materials[s.material[h.tri as usize] as usize].bsdf {
+                photonwave::material::Bsdf::Mirror { .. } => 1,
+                photonwave::material::Bsdf::Glass { .. } => 2,
+                _ => 0,
+            },
+        };
+    }
+}
+
 fn layout(c: &mut Criterion) {
     let mut w = setup(1);
     w.run_system_once(emit::emit_camera_rays).unwrap();
@@ -151,8 +169,10 @@ fn layout(c: &mut Criterion) {
     let mut ew = World::new();
     ew.insert_resource(SceneRes(scene));
     for i in 0..rays.len() {
-        ew.spawn((RayOrigin(rays.origin(i)), RayDir(rays.direction(i)), RayHit::default()));
+        ew.spawn((RayOrigin(rays.origin(i)), RayDir(rays.direction(i)), RayHit::default(), RayClass::default()));
     }
+    w.run_system_once(intersect::intersect_paths).unwrap();
+    ew.run_system_once(intersect_entities).unwrap();
     let mut g = c.benchmark_group("layout");
     g.throughput(Throughput::Elements(rays.len() as u64));
     g.bench_function(BenchmarkId::new("intersect", "soa_resource"), |b| {
@@ -160,6 +180,12 @@ fn layout(c: &mut Criterion) {
     });
     g.bench_function(BenchmarkId::new("intersect", "entity_per_ray"), |b| {
         b.iter(|| ew.run_system_once(intersect_entities).unwrap())
+    });
+    g.bench_function(BenchmarkId::new("classify", "soa_resource"), |b| {
+        b.iter(|| w.run_system_once(classify::classify_paths).unwrap())
+    });
+    g.bench_function(BenchmarkId::new("classify", "entity_per_ray"), |b| {
+        b.iter(|| ew.run_system_once(classify_entities).unwrap())
     });
     g.finish();
 }

@@ -109,3 +109,17 @@ fn glass_scenes_run_refraction_and_caustics() {
         assert!(stages[system].runs > 0 && stages[system].items > 0, "{system}: {:?}", stages[system]);
     }
 }
+
+#[test]
+fn both_engines_emit_and_store_the_same_photons() {
+    // The wavefront engine traces several reference batches per wave but applies the
+    // reference's stopping rule batch by batch.
+    let s = Settings { photons: 50_000, caustic_photons: 30_000, ..small() };
+    let loaded = load("cornell-spheres.toml");
+    let cam = loaded.camera.unwrap().prepare(s.width, s.height).unwrap();
+    let (_, r) = photonwave::reference::render(&loaded.scene, &cam, &s, &NoProgress).unwrap();
+    let (_, w, _) = wavefront(load("cornell-spheres.toml"), &s);
+    assert_eq!((r.global_map.emitted, r.global_map.stored), (w.global_map.emitted, w.global_map.stored));
+    assert_eq!((r.caustic_map.emitted, r.caustic_map.stored), (w.caustic_map.emitted, w.caustic_map.stored));
+    assert_eq!(r.irradiance_points, w.irradiance_points);
+}

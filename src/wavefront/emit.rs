@@ -10,13 +10,14 @@ use bevy_ecs::prelude::*;
 use glam::Vec3;
 use std::time::Instant;
 
-/// Starts [`BATCH`] photon paths at the batch's first path index.
+/// Starts `batches` × [`BATCH`] photon paths at the wave's first path index.
 pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let (scene, settings) = (&*shared.scene, &shared.settings);
     let domain = work.domain.unwrap_or(Domain::GlobalPhoton);
     let first = work.first_path;
-    let starts = par_lanes(BATCH, CHUNK, shared.threads, |r| {
+    let n = work.batches.max(1) * BATCH;
+    let starts = par_lanes(n, CHUNK, shared.threads, |r| {
         r.map(|i| start_photon(scene, settings, domain, first + i as u64)).collect()
     });
     let w = &mut *work;
@@ -27,7 +28,7 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
             None => w.non_finite += 1,
         }
     }
-    stats.record("emit_photons", BATCH, t);
+    stats.record("emit_photons", n, t);
 }
 
 /// Generates the wave's camera rays: sample `g` is sample `g % spp` of pixel `g / spp`, jittered

@@ -74,6 +74,8 @@ pub enum Stage {
     Shade,
 }
 
+/// At most this many reference batches per photon wave.
+pub const MAX_BATCHES_PER_WAVE: usize = 8;
 /// Samples per camera wave (bounded memory: ~100 B of queue per lane in flight).
 pub const WAVE: usize = 32_768;
 /// Lanes per work chunk for cheap kernels (traversal, scattering).
@@ -103,8 +105,10 @@ pub struct Maps(pub Arc<PhotonMaps>);
 pub struct PhotonWork {
     /// Which map this pass fills.
     pub domain: Option<Domain>,
-    /// Path index of the batch's first photon.
+    /// Path index of the wave's first photon.
     pub first_path: u64,
+    /// Reference-engine batches ([`BATCH`] paths each) in this wave.
+    pub batches: usize,
     /// Photons to trace this bounce.
     pub queue: PhotonQueue,
     /// Photons for the next bounce.
@@ -387,14 +391,37 @@ pub fn render(
             let mut w = world.resource_mut::<PhotonWork>();
             *w = PhotonWork { domain: Some(domain), ..Default::default() };
         }
+        // A wave holds several of the reference engine's batches — large queues keep both cores
+        // busy in the deep bounces — sized from the photons per batch seen so far. The reference
+        // stopping rule is then applied batch by batch, so the photons are the same; paths traced
+        // past the stopping batch are discarded.
+        let mut per_batch = 0.0f64;
         while (photons.len() as u64) < target as u64 && emitted < cap {
-            world.resource_mut::<PhotonWork>().first_path = emitted;
+            let left = (cap - emitted).div_ceil(BATCH as u64) as usize;
+            let wanted =
+                if per_batch > 0.0 { ((target as f64 - photons.len() as f64) / per_batch).ceil() as usize } else { 1 };
+            let batches = wanted.clamp(1, MAX_BATCHES_PER_WAVE).min(left);
+            {
+                let mut w = world.resource_mut::<PhotonWork>();
+                w.first_path = emitted;
+                w.batches = batches;
+            }
             world.run_schedule(PhotonPass);
             let mut w = world.resource_mut::<PhotonWork>();
-            let mut batch = std::mem::take(&mut w.deposits);
-            batch.sort_by_key(|(path, bounce, _)| (*path, *bounce));
-            photons.extend(batch.into_iter().map(|(_, _, p)| p));
-            emitted += BATCH as u64;
+            let mut deposits = std::mem::take(&mut w.deposits);
+            deposits.sort_by_key(|(path, bounce, _)| (*path, *bounce));
+            let mut rest = deposits.as_slice();
+            for _ in 0..batches {
+                if (photons.len() as u64) >= target as u64 || emitted >= cap {
+                    break;
+                }
+                let end = emitted + BATCH as u64;
+                let n = rest.partition_point(|(path, _, _)| *path < end);
+                photons.extend(rest[..n].iter().map(|(_, _, p)| *p));
+                rest = &rest[n..];
+                emitted = end;
+            }
+            per_batch = photons.len() as f64 / (emitted / BATCH as u64) as f64;
             let now = (photons.len() as u64).min(target as u64);
             progress.advance(now - reported);
             reported = now;
