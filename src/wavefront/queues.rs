@@ -107,6 +107,15 @@ impl HitColumns {
         self.b2.clear();
     }
 
+    /// Reserves room for `n` more lanes.
+    pub fn reserve(&mut self, n: usize) {
+        self.tri.reserve(n);
+        self.t.reserve(n);
+        self.b0.reserve(n);
+        self.b1.reserve(n);
+        self.b2.reserve(n);
+    }
+
     /// Moves `other`'s lanes to the end (column copies).
     pub fn append(&mut self, other: &mut HitColumns) {
         self.tri.append(&mut other.tri);
@@ -287,6 +296,21 @@ impl PathQueue {
     pub fn is_empty(&self) -> bool {
         self.sample.is_empty()
     }
+    /// Reserves room for `n` more lanes.
+    pub fn reserve(&mut self, n: usize) {
+        for c in [&mut self.rays.ox, &mut self.rays.oy, &mut self.rays.oz, &mut self.rays.dx, &mut self.rays.dy, &mut self.rays.dz] {
+            c.reserve(n);
+        }
+        self.sample.reserve(n);
+        self.kind.reserve(n);
+        self.key.reserve(n);
+        self.base.reserve(n);
+        self.depth.reserve(n);
+        self.beta.reserve(n);
+        self.slot.reserve(n);
+        self.through_specular.reserve(n);
+    }
+
     /// Moves `other`'s lanes to the end (column copies; hits are not moved).
     pub fn append(&mut self, other: &mut PathQueue) {
         self.rays.append(&mut other.rays);

@@ -117,11 +117,13 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
     let lanes: Vec<u32> =
         w.classified.diffuse.iter().copied().filter(|&l| w.paths.kind[l as usize] == PathKind::Camera).collect();
     let mut spawned = PathQueue::default();
+    spawned.reserve(lanes.len() * n as usize);
     par_columns(
         lanes.len(),
         CHUNK,
         shared.threads,
         |r, out: &mut PathQueue| {
+            out.reserve(r.len() * n as usize);
             for j in r {
                 let i = lanes[j] as usize;
                 let Some(hit) = w.paths.hits.get(i) else { continue };
