@@ -298,7 +298,14 @@ impl PathQueue {
     }
     /// Reserves room for `n` more lanes.
     pub fn reserve(&mut self, n: usize) {
-        for c in [&mut self.rays.ox, &mut self.rays.oy, &mut self.rays.oz, &mut self.rays.dx, &mut self.rays.dy, &mut self.rays.dz] {
+        for c in [
+            &mut self.rays.ox,
+            &mut self.rays.oy,
+            &mut self.rays.oz,
+            &mut self.rays.dx,
+            &mut self.rays.dy,
+            &mut self.rays.dz,
+        ] {
             c.reserve(n);
         }
         self.sample.reserve(n);
