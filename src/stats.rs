@@ -108,6 +108,27 @@ pub struct RenderStats {
 }
 
 impl RenderStats {
+    /// The stats of a render about to start: engine, scene size, image and sampling settings.
+    #[must_use]
+    pub fn new(
+        engine: &str,
+        scene: &crate::scene::Scene,
+        settings: &crate::settings::Settings,
+        threads: usize,
+    ) -> Self {
+        RenderStats {
+            engine: engine.into(),
+            triangles: scene.triangle_count(),
+            lights: scene.lights.len(),
+            width: settings.width,
+            height: settings.height,
+            spp: settings.spp,
+            threads,
+            seed: settings.seed,
+            ..Default::default()
+        }
+    }
+
     /// A human-readable summary.
     #[must_use]
     pub fn summary(&self) -> String {

@@ -125,17 +125,7 @@ pub fn render(
     plan.check(settings)?;
     let threads = settings.thread_count();
     let start = Instant::now();
-    let mut stats = RenderStats {
-        engine: "reference".into(),
-        triangles: scene.triangle_count(),
-        lights: scene.lights.len(),
-        width: settings.width,
-        height: settings.height,
-        spp: settings.spp,
-        threads,
-        seed: settings.seed,
-        ..Default::default()
-    };
+    let mut stats = RenderStats::new("reference", scene, settings, threads);
 
     let maps = photon_passes(scene, settings, &plan, threads, progress, &mut stats);
     stats.effects = Some(plan.clone());

@@ -79,11 +79,16 @@ pub fn trace_photons(
         reported = now;
     }
     progress.finish();
+    normalise_power(&mut photons, emitted);
+    PhotonPass { photons, emitted, rays, non_finite }
+}
+
+/// Divides stored photons' power by the number of paths emitted: each then carries Φ/N.
+pub fn normalise_power(photons: &mut [Photon], emitted: u64) {
     let scale = 1.0 / emitted as f32;
-    for p in &mut photons {
+    for p in photons {
         p.power *= scale;
     }
-    PhotonPass { photons, emitted, rays, non_finite }
 }
 
 /// A photon between bounces.

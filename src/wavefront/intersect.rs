@@ -2,57 +2,51 @@
 //! the shadow queue. Reads rays; writes hit columns (and, for shadow rays, the unblocked
 //! contributions into the wave's terms, in lane order).
 
-use super::queues::HitColumns;
 use super::queues::PathKind;
+use super::queues::{HitColumns, RayColumns};
 use super::{add_term, par_columns, par_lanes, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
-/// Closest hits of the photon queue.
-pub fn intersect_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+/// Fills `hits` with the closest hits of `rays`, each chunk into its own columns.
+fn closest_hits(shared: &Shared, rays: &RayColumns, hits: &mut HitColumns) {
     let scene = &*shared.scene;
-    let w = &mut *work;
-    let rays = &w.queue.rays;
-    let hits = &mut w.queue.hits;
     hits.clear();
+    hits.reserve(rays.len());
     par_columns(
         rays.len(),
         CHUNK,
         shared.threads,
         |r, part: &mut HitColumns| {
+            part.reserve(r.len());
             part.extend(r.map(|i| scene.intersect(rays.origin(i), rays.direction(i), f32::INFINITY)))
         },
         |part| hits.append(part),
     );
-    w.rays += rays.len() as u64;
-    stats.record("intersect_photons", rays.len(), t);
+}
+
+/// Closest hits of the photon queue.
+pub fn intersect_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let q = &mut work.queue;
+    closest_hits(&shared, &q.rays, &mut q.hits);
+    let n = q.len();
+    work.rays += n as u64;
+    stats.record("intersect_photons", n, t);
 }
 
 /// Closest hits of the path queue.
 pub fn intersect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
-    let scene = &*shared.scene;
     let w = &mut *work;
-    let rays = &w.paths.rays;
-    let hits = &mut w.paths.hits;
-    hits.clear();
-    par_columns(
-        rays.len(),
-        CHUNK,
-        shared.threads,
-        |r, part: &mut HitColumns| {
-            part.extend(r.map(|i| scene.intersect(rays.origin(i), rays.direction(i), f32::INFINITY)))
-        },
-        |part| hits.append(part),
-    );
+    closest_hits(&shared, &w.paths.rays, &mut w.paths.hits);
     for k in &w.paths.kind {
         match k {
             PathKind::Camera => w.rays.camera += 1,
             _ => w.rays.gather += 1,
         }
     }
-    stats.record("intersect_paths", rays.len(), t);
+    stats.record("intersect_paths", w.paths.len(), t);
 }
 
 /// Any-hit tests of the shadow queue; unblocked rays add their contribution.

@@ -29,7 +29,7 @@ use crate::error::Result;
 use crate::film::{Film, Terms};
 use crate::photon_map::Photon;
 use crate::reference::parallel::map_chunks;
-use crate::reference::photons::BATCH;
+use crate::reference::photons::{normalise_power, BATCH};
 use crate::reference::{PhotonMaps, Progress};
 use crate::rng::Domain;
 use crate::scene::camera::CameraRays;
@@ -342,18 +342,8 @@ pub fn render(
     effects.check(settings)?;
     let threads = settings.thread_count();
     let start = Instant::now();
-    let mut stats = RenderStats {
-        engine: "wavefront".into(),
-        triangles: scene.triangle_count(),
-        lights: scene.lights.len(),
-        width: settings.width,
-        height: settings.height,
-        spp: settings.spp,
-        threads,
-        seed: settings.seed,
-        effects: Some(effects.clone()),
-        ..Default::default()
-    };
+    let mut stats =
+        RenderStats { effects: Some(effects.clone()), ..RenderStats::new("wavefront", &scene, settings, threads) };
     let mut world = World::new();
     world.insert_resource(Shared {
         scene: scene.clone(),
@@ -427,10 +417,7 @@ pub fn render(
             reported = now;
         }
         progress.finish();
-        let scale = 1.0 / emitted as f32;
-        for p in &mut photons {
-            p.power *= scale;
-        }
+        normalise_power(&mut photons, emitted);
         let w = world.resource::<PhotonWork>();
         stats.rays.photon += w.rays;
         stats.non_finite_photons += w.non_finite;
