@@ -46,17 +46,42 @@ fn wavefront_matches_reference_per_pixel_on_every_bundled_scene() {
     // the order floating-point contributions are added. Tolerance: 1e-6 relative per term and
     // channel, about 8 f32 ulps (measured: at most 9e-8).
     let glossy = glossy_spheres();
-    for scene in ["cornell-box.toml", "cornell-spheres.toml", "furnace.toml", glossy.to_str().unwrap()] {
-        for final_gather in [true, false] {
-            let s = Settings { final_gather, ..small() };
+    let lights = delta_lights();
+    let scenes = [
+        "cornell-box.toml",
+        "cornell-spheres.toml",
+        "furnace.toml",
+        glossy.to_str().unwrap(),
+        lights.to_str().unwrap(),
+    ];
+    for scene in scenes {
+        for (final_gather, precompute_irradiance) in [(true, true), (true, false), (false, true)] {
+            let s = Settings { final_gather, precompute_irradiance, ..small() };
             let loaded = || photonwave::scene::file::load_scene(&bundled(scene)).unwrap();
             let reference = render(&loaded(), &s);
             let (wave, _, _) = wavefront(loaded(), &s);
             let d = max_rel_diff(&reference, &wave);
-            println!("{scene} final_gather={final_gather}: max relative difference {d:e}");
-            assert!(d < 1e-6, "{scene} (final gather {final_gather}): max relative difference {d}");
+            println!("{scene} {final_gather} {precompute_irradiance}: max relative difference {d:e}");
+            assert!(d < 1e-6, "{scene} ({final_gather}, {precompute_irradiance}): max relative difference {d}");
         }
     }
+}
+
+/// The bundled spheres lit also by a point, a spot and a directional light (delta lights in
+/// direct lighting and photon emission).
+fn delta_lights() -> std::path::PathBuf {
+    let dir = scratch_dir("delta-lights");
+    let obj = bundled("cornell-spheres.obj");
+    let toml = format!(
+        "[[mesh]]\nfile = {:?}\n[camera]\neye = [0.0, 0.273, 1.0796]\ntarget = [0.0, 0.273, 0.0]\nfov = 39.3\n\
+         [[light]]\ntype = \"point\"\nposition = [0.1, 0.45, 0.1]\nintensity = [0.05, 0.05, 0.05]\n\
+         [[light]]\ntype = \"spot\"\nposition = [-0.2, 0.5, 0.2]\ntarget = [0.13, 0.0, 0.08]\nintensity = [0.2, 0.1, 0.05]\nangle = 25\ninner_angle = 15\n\
+         [[light]]\ntype = \"directional\"\ndirection = [0.2, -1.0, -0.3]\nirradiance = [0.3, 0.3, 0.3]\n",
+        obj.to_str().unwrap()
+    );
+    let path = dir.join("delta-lights.toml");
+    std::fs::write(&path, toml).unwrap();
+    path
 }
 
 /// The bundled spheres with the mirror sphere made glossy (exercises glossy rays).

@@ -125,12 +125,6 @@ impl HitColumns {
         self.b2.append(&mut other.b2);
     }
 
-    /// Replaces the contents with `hits`.
-    pub fn fill(&mut self, hits: impl Iterator<Item = Option<Hit>>) {
-        self.clear();
-        self.extend(hits);
-    }
-
     /// Appends `hits`.
     pub fn extend(&mut self, hits: impl Iterator<Item = Option<Hit>>) {
         for h in hits {
