@@ -377,6 +377,15 @@ impl ShadowQueue {
     pub fn is_empty(&self) -> bool {
         self.sample.is_empty()
     }
+    /// Moves `other`'s lanes to the end (column copies).
+    pub fn append(&mut self, other: &mut ShadowQueue) {
+        self.rays.append(&mut other.rays);
+        self.t_max.append(&mut other.t_max);
+        self.sample.append(&mut other.sample);
+        self.slot.append(&mut other.slot);
+        self.contribution.append(&mut other.contribution);
+    }
+
     /// Appends a shadow ray.
     pub fn push(&mut self, o: Vec3, d: Vec3, t_max: f32, sample: u32, slot: u8, contribution: Vec3) {
         self.rays.push(o, d);

@@ -5,7 +5,7 @@
 //! the next queues, the shadow queue and the film.
 
 use super::gather::camera_slot;
-use super::queues::{PathKind, PathQueue, PhotonQueue, Segment};
+use super::queues::{PathKind, PathQueue, PhotonQueue, Segment, ShadowQueue};
 use super::{par_columns, par_lanes, slot, CameraWork, Maps, PhotonWork, Shared, StageStats, CHUNK};
 use crate::film::Terms;
 use crate::geometry::offset::offset_ray_origin;
@@ -78,33 +78,35 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
     let w = &*work;
     let lanes: Vec<u32> =
         w.classified.diffuse.iter().copied().filter(|&l| w.paths.kind[l as usize] != PathKind::Gather).collect();
-    let rays: Vec<(u32, u8, ShadowRay)> = par_lanes(lanes.len(), CHUNK, shared.threads, |r| {
-        let mut out = Vec::new();
-        for j in r {
-            let i = lanes[j] as usize;
-            let Some(hit) = w.paths.hits.get(i) else { continue };
-            let sp = ctx.scene.surface(&hit);
-            let bsdf = &ctx.scene.materials[sp.material as usize].bsdf;
-            let s = Sampler::from_key(w.paths.key[i]);
-            let (stream, target) = match w.paths.kind[i] {
-                PathKind::Camera => (
-                    s.fork(TAG_LIGHT + w.paths.depth[i] as u64),
-                    camera_slot(w.paths.through_specular[i], slot::DIRECT),
-                ),
-                _ => (s.fork(7), w.paths.slot[i]),
-            };
-            let beta = w.paths.beta[i];
-            direct_light_rays(&ctx, &sp, bsdf, -w.paths.rays.direction(i), &stream, |mut ray| {
-                ray.contribution *= beta;
-                out.push((w.paths.sample[i], target, ray));
-            });
-        }
-        out
-    });
-    let n = rays.len();
-    for (sample, s, r) in rays {
-        work.shadows.push(r.origin, r.direction, r.t_max, sample, s, r.contribution);
-    }
+    let mut queued = ShadowQueue::default();
+    par_columns(
+        lanes.len(),
+        CHUNK,
+        shared.threads,
+        |r, part: &mut ShadowQueue| {
+            for j in r {
+                let i = lanes[j] as usize;
+                let Some(hit) = w.paths.hits.get(i) else { continue };
+                let sp = ctx.scene.surface(&hit);
+                let bsdf = &ctx.scene.materials[sp.material as usize].bsdf;
+                let s = Sampler::from_key(w.paths.key[i]);
+                let (stream, target) = match w.paths.kind[i] {
+                    PathKind::Camera => (
+                        s.fork(TAG_LIGHT + w.paths.depth[i] as u64),
+                        camera_slot(w.paths.through_specular[i], slot::DIRECT),
+                    ),
+                    _ => (s.fork(7), w.paths.slot[i]),
+                };
+                let (beta, sample) = (w.paths.beta[i], w.paths.sample[i]);
+                direct_light_rays(&ctx, &sp, bsdf, -w.paths.rays.direction(i), &stream, |ray: ShadowRay| {
+                    part.push(ray.origin, ray.direction, ray.t_max, sample, target, ray.contribution * beta);
+                });
+            }
+        },
+        |part| queued.append(part),
+    );
+    let n = queued.len();
+    work.shadows.append(&mut queued);
     stats.record("shade_direct", n, t);
 }
 
@@ -206,51 +208,59 @@ pub fn spawn_glossy_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
 
 /// Continues the lanes `lanes` (at mirrors or glass) by sampling the delta BSDF with the
 /// random numbers of bounce `base + depth`; chains stop after `max_depth` bounces.
-fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32]) -> Vec<Segment> {
+fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32]) -> PathQueue {
     let scene = &*shared.scene;
     let max_depth = shared.settings.max_depth;
     let w = work;
-    par_lanes(lanes.len(), CHUNK, shared.threads, |r| {
-        r.filter_map(|j| {
-            let i = lanes[j] as usize;
-            if w.paths.depth[i] >= max_depth {
-                return None;
+    let mut out = PathQueue::default();
+    par_columns(
+        lanes.len(),
+        CHUNK,
+        shared.threads,
+        |r, part: &mut PathQueue| {
+            part.reserve(r.len());
+            for s in r.filter_map(|j| {
+                let i = lanes[j] as usize;
+                if w.paths.depth[i] >= max_depth {
+                    return None;
+                }
+                let sp = scene.surface(&w.paths.hits.get(i)?);
+                let bsdf = &scene.materials[sp.material as usize].bsdf;
+                let s = Sampler::from_key(w.paths.key[i]);
+                let b = w.paths.base[i] as u32 + w.paths.depth[i];
+                let bs = bsdf.sample(
+                    &sp.frame,
+                    -w.paths.rays.direction(i),
+                    [s.get(b, 0), s.get(b, 1), s.get(b, 2)],
+                    Transport::Radiance,
+                )?;
+                Some(Segment {
+                    o: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi),
+                    d: bs.wi,
+                    sample: w.paths.sample[i],
+                    kind: w.paths.kind[i],
+                    key: w.paths.key[i],
+                    base: w.paths.base[i],
+                    depth: w.paths.depth[i] + 1,
+                    beta: w.paths.beta[i] * bs.weight,
+                    slot: w.paths.slot[i],
+                    through_specular: w.paths.kind[i] == PathKind::Camera,
+                })
+            }) {
+                part.push(s);
             }
-            let sp = scene.surface(&w.paths.hits.get(i)?);
-            let bsdf = &scene.materials[sp.material as usize].bsdf;
-            let s = Sampler::from_key(w.paths.key[i]);
-            let b = w.paths.base[i] as u32 + w.paths.depth[i];
-            let bs = bsdf.sample(
-                &sp.frame,
-                -w.paths.rays.direction(i),
-                [s.get(b, 0), s.get(b, 1), s.get(b, 2)],
-                Transport::Radiance,
-            )?;
-            Some(Segment {
-                o: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi),
-                d: bs.wi,
-                sample: w.paths.sample[i],
-                kind: w.paths.kind[i],
-                key: w.paths.key[i],
-                base: w.paths.base[i],
-                depth: w.paths.depth[i] + 1,
-                beta: w.paths.beta[i] * bs.weight,
-                slot: w.paths.slot[i],
-                through_specular: w.paths.kind[i] == PathKind::Camera,
-            })
-        })
-        .collect()
-    })
+        },
+        |part| out.append(part),
+    );
+    out
 }
 
 /// Lanes at mirrors continue.
 pub fn reflect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let lanes = work.classified.mirror.clone();
-    let segments = continue_specular(&shared, &work, &lanes);
-    for s in segments {
-        work.next.push(s);
-    }
+    let mut segments = continue_specular(&shared, &work, &lanes);
+    work.next.append(&mut segments);
     stats.record("reflect_paths", lanes.len(), t);
 }
 
@@ -258,10 +268,8 @@ pub fn reflect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stat
 pub fn refract_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let lanes = work.classified.glass.clone();
-    let segments = continue_specular(&shared, &work, &lanes);
-    for s in segments {
-        work.next.push(s);
-    }
+    let mut segments = continue_specular(&shared, &work, &lanes);
+    work.next.append(&mut segments);
     stats.record("refract_paths", lanes.len(), t);
 }
 
