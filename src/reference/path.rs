@@ -3,8 +3,10 @@
 //!
 //! Emission is added when the camera sees an emitter directly or through mirrors and glass;
 //! after a non-specular bounce it is left to light sampling (no double counting, no MIS).
-//! Terms: `emitted` (seen directly), `direct` (light sampling at the first hit), `specular`
-//! (through mirrors and glass before the first non-specular hit), `indirect` (everything else).
+//! Terms, as the photon mapper defines them: `emitted` (seen directly), `direct` (light sampling
+//! at a non-specular first hit), `specular` (everything seen when the first hit is a mirror or
+//! glass), `indirect` (everything else; the photon mapper splits it into caustic, indirect and the
+//! glossy lobe's share of specular).
 
 use super::camera::{direct_light, render_pixels};
 use super::Progress;
@@ -72,7 +74,9 @@ fn trace_path(ctx: &super::camera::Context, mut o: Vec3, mut d: Vec3, s: &Sample
     let scene = ctx.scene;
     let mut terms = Terms::default();
     let mut beta = Vec3::ONE;
-    let mut specular_chain = true; // no non-specular bounce yet
+    // The camera's first hit was a mirror or glass: everything found later is `specular`, as in
+    // the photon mapper's layers.
+    let mut via_specular = false;
     let mut last_delta = true; // previous vertex was the camera or a delta bounce
     for depth in 0..=ctx.settings.max_depth {
         rays.camera += 1;
@@ -82,7 +86,7 @@ fn trace_path(ctx: &super::camera::Context, mut o: Vec3, mut d: Vec3, s: &Sample
         let wo = -d;
         if last_delta && mat.emission != Vec3::ZERO && wo.dot(sp.frame.ng) > 0.0 {
             let e = beta * mat.emission;
-            match (depth, specular_chain) {
+            match (depth, via_specular) {
                 (0, _) => terms.emitted += e,
                 (_, true) => terms.specular += e,
                 _ => terms.indirect += e,
@@ -93,9 +97,9 @@ fn trace_path(ctx: &super::camera::Context, mut o: Vec3, mut d: Vec3, s: &Sample
         }
         if !mat.bsdf.is_delta() {
             let l = beta * direct_light(ctx, &sp, &mat.bsdf, wo, &s.fork(((depth as u64) << 32) | 0xd1), rays);
-            match (depth, specular_chain) {
-                (0, _) => terms.direct += l,
+            match (depth, via_specular) {
                 (_, true) => terms.specular += l,
+                (0, _) => terms.direct += l,
                 _ => terms.indirect += l,
             }
         }
@@ -103,8 +107,8 @@ fn trace_path(ctx: &super::camera::Context, mut o: Vec3, mut d: Vec3, s: &Sample
         let Some(bs) = mat.bsdf.sample(&sp.frame, wo, u, Transport::Radiance) else { break };
         beta *= bs.weight;
         last_delta = bs.delta;
-        if !bs.delta {
-            specular_chain = false;
+        if depth == 0 && bs.delta {
+            via_specular = true;
         }
         if depth >= RR_DEPTH {
             let q = beta.max_element().min(0.95);
