@@ -75,7 +75,7 @@ fn first_hit_photon_power_sums_to_light_power() {
     assert!(((got - want) / want).abs().max_element() < 1e-4, "{got} vs {want}");
 }
 
-fn closed_cube(half: f32, kd: f32) -> MeshInput {
+fn closed_cube(half: f32) -> MeshInput {
     // Six inward-facing faces of a cube, two triangles each.
     let mut m = MeshInput { source: "cube".into(), ..Default::default() };
     for axis in 0..3 {
@@ -93,7 +93,6 @@ fn closed_cube(half: f32, kd: f32) -> MeshInput {
             m.material.extend([0, 0]);
         }
     }
-    let _ = kd;
     m
 }
 
@@ -108,7 +107,7 @@ fn spot_light_flux_is_conserved_in_a_closed_box() {
         cos_inner: 20f32.to_radians().cos(),
         cos_outer: 40f32.to_radians().cos(),
     };
-    let scene = Scene::build(vec![closed_cube(1.0, 0.5)], vec![mat], vec![spot], vec![]).unwrap();
+    let scene = Scene::build(vec![closed_cube(1.0)], vec![mat], vec![spot], vec![]).unwrap();
     let pass = trace_photons(&scene, &Settings::default(), Domain::GlobalPhoton, 16_384, 1, &NoProgress);
     let got = first_hit_power(&pass.photons);
     let want = scene.total_power();
@@ -225,7 +224,7 @@ fn quad_light_irradiance_matches_lamberts_formula() {
 
 #[test]
 fn point_light_irradiance_is_inverse_square_cosine() {
-    let mesh = closed_cube(10.0, 0.5);
+    let mesh = closed_cube(10.0);
     let mat = Material { name: "grey".into(), bsdf: Bsdf::Lambert { kd: Vec3::splat(0.5) }, emission: Vec3::ZERO };
     let light = Light::Point { position: Vec3::new(0.0, 2.0, 0.0), intensity: Vec3::splat(4.0) };
     let scene = Scene::build(vec![mesh], vec![mat], vec![light], vec![]).unwrap();

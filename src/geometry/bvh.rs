@@ -113,12 +113,6 @@ impl Bvh {
         });
         tests
     }
-
-    /// The underlying obvhs BVH2 (for benchmarks and packet traversal).
-    #[must_use]
-    pub fn bvh2(&self) -> &Bvh2 {
-        &self.bvh
-    }
 }
 
 /// Borrowed vertex columns in BVH order.

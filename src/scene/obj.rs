@@ -109,10 +109,8 @@ pub fn load_obj(
     let (models, mtl) = tobj::load_obj(path, &options).map_err(|e| Error::parse(path, 0, format!("OBJ: {e}")))?;
     let mtl = match mtl {
         Ok(m) => m,
-        Err(e) if mtllibs.is_empty() => {
-            let _ = e;
-            Vec::new()
-        }
+        // tobj reports "no material file" as an error; an OBJ without `mtllib` simply has none.
+        Err(_) if mtllibs.is_empty() => Vec::new(),
         Err(e) => return Err(Error::parse(&dir.join(&mtllibs[0]), 0, format!("MTL: {e}"))),
     };
     let ids: Vec<u32> = mtl.iter().map(|m| table.insert(material_from_mtl(m, warnings))).collect();
