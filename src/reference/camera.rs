@@ -88,8 +88,6 @@ pub fn render_pixels(
 ) -> (Film, RayCounts, u64) {
     let (w, h) = (settings.width as usize, settings.height as usize);
     let spp = settings.spp;
-    let strata = (spp as f32).sqrt() as u32;
-    let stratified = strata * strata == spp;
     progress.start("camera", h as u64);
     let rows = map_chunks(
         h,
@@ -105,13 +103,7 @@ pub fn render_pixels(
                     let mut sum = Terms::default();
                     for s in 0..spp {
                         let index = ((y * w + x) as u64) * spp as u64 + s as u64;
-                        let sampler = Sampler::new(settings.seed, Domain::Camera, index);
-                        let (jx, jy) = (sampler.get(0, 0), sampler.get(0, 1));
-                        let (fx, fy) = if stratified {
-                            (((s % strata) as f32 + jx) / strata as f32, ((s / strata) as f32 + jy) / strata as f32)
-                        } else {
-                            (jx, jy)
-                        };
+                        let (sampler, (fx, fy)) = camera_sample(settings, index);
                         let (o, d) = camera.ray(x as f32 + fx, y as f32 + fy);
                         let t = radiance(o, d, &sampler, &mut rays, &mut scratch);
                         if t.is_finite() {
@@ -137,6 +129,23 @@ pub fn render_pixels(
         bad += b;
     }
     (Film { width: settings.width, height: settings.height, pixels }, rays, bad)
+}
+
+/// Camera sample `index` (sample `index % spp` of pixel `index / spp`): its random stream and its
+/// position inside the pixel, jittered within its stratum when spp is a square.
+#[must_use]
+pub fn camera_sample(settings: &Settings, index: u64) -> (Sampler, (f32, f32)) {
+    let spp = settings.spp;
+    let s = (index % spp as u64) as u32;
+    let strata = (spp as f32).sqrt() as u32;
+    let sampler = Sampler::new(settings.seed, Domain::Camera, index);
+    let (jx, jy) = (sampler.get(0, 0), sampler.get(0, 1));
+    let offset = if strata * strata == spp {
+        (((s % strata) as f32 + jx) / strata as f32, ((s / strata) as f32 + jy) / strata as f32)
+    } else {
+        (jx, jy)
+    };
+    (sampler, offset)
 }
 
 /// Radiance along one camera ray, split into terms.

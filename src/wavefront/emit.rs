@@ -4,8 +4,9 @@
 use super::queues::{PathKind, Segment};
 use super::{par_lanes, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
 use crate::film::Terms;
+use crate::reference::camera::camera_sample;
 use crate::reference::photons::{start_photon, BATCH};
-use crate::rng::{Domain, Sampler};
+use crate::rng::Domain;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use std::time::Instant;
@@ -38,8 +39,6 @@ pub fn emit_camera_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut s
     let settings = &shared.settings;
     let w = &mut *work;
     let spp = settings.spp as u64;
-    let strata = (settings.spp as f32).sqrt() as u32;
-    let stratified = strata * strata == settings.spp;
     w.paths.clear();
     w.next.clear();
     w.shadows.clear();
@@ -47,15 +46,9 @@ pub fn emit_camera_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut s
     w.terms.resize(w.count, Terms::default());
     for lane in 0..w.count {
         let g = w.first_sample + lane as u64;
-        let (pixel, s) = (g / spp, (g % spp) as u32);
+        let pixel = g / spp;
         let (x, y) = ((pixel % settings.width as u64) as f32, (pixel / settings.width as u64) as f32);
-        let sampler = Sampler::new(settings.seed, Domain::Camera, g);
-        let (jx, jy) = (sampler.get(0, 0), sampler.get(0, 1));
-        let (fx, fy) = if stratified {
-            (((s % strata) as f32 + jx) / strata as f32, ((s / strata) as f32 + jy) / strata as f32)
-        } else {
-            (jx, jy)
-        };
+        let (sampler, (fx, fy)) = camera_sample(settings, g);
         let (o, d) = w.camera.ray(x + fx, y + fy);
         w.paths.push(Segment {
             o,
