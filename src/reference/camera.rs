@@ -13,7 +13,7 @@ use crate::effects::Effects;
 use crate::film::{Film, Terms};
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::{Bsdf, Transport};
-use crate::photon_map::flags;
+use crate::photon_map::{flags, PhotonMap};
 use crate::rng::{Domain, Sampler};
 use crate::sampling::{cosine_hemisphere, Frame};
 use crate::scene::camera::CameraRays;
@@ -285,6 +285,25 @@ pub fn direct_light(
     sum
 }
 
+/// Radiance estimate from `map` at `sp` toward `wo` with `k` photons within `radius`, ignoring
+/// photons with any `mask` flag.
+#[allow(clippy::too_many_arguments)]
+fn map_estimate(
+    ctx: &Context,
+    map: &PhotonMap,
+    k: u32,
+    radius: f32,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    mask: u8,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Vec3 {
+    let (ng, _) = sp.frame.oriented(wo);
+    map.estimate(sp.p, ng, k as usize, radius, ctx.settings.kernel, mask, |wi| bsdf.eval(&sp.frame, wo, wi), scratch)
+        .radiance
+}
+
 /// Caustic-map radiance estimate at `sp` toward `wo`.
 pub fn caustic_estimate(
     ctx: &Context,
@@ -293,12 +312,7 @@ pub fn caustic_estimate(
     wo: Vec3,
     scratch: &mut Vec<(f32, u32)>,
 ) -> Vec3 {
-    let (ng, _) = sp.frame.oriented(wo);
-    let k = ctx.settings.caustic_k as usize;
-    ctx.maps
-        .caustic
-        .estimate(sp.p, ng, k, ctx.caustic_radius, ctx.settings.kernel, 0, |wi| bsdf.eval(&sp.frame, wo, wi), scratch)
-        .radiance
+    map_estimate(ctx, &ctx.maps.caustic, ctx.settings.caustic_k, ctx.caustic_radius, sp, bsdf, wo, 0, scratch)
 }
 
 /// Global-map radiance estimate at `sp` toward `wo`, ignoring photons with any `mask` flag.
@@ -310,12 +324,7 @@ pub fn global_estimate(
     mask: u8,
     scratch: &mut Vec<(f32, u32)>,
 ) -> Vec3 {
-    let (ng, _) = sp.frame.oriented(wo);
-    let k = ctx.settings.k as usize;
-    ctx.maps
-        .global
-        .estimate(sp.p, ng, k, ctx.global_radius, ctx.settings.kernel, mask, |wi| bsdf.eval(&sp.frame, wo, wi), scratch)
-        .radiance
+    map_estimate(ctx, &ctx.maps.global, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, scratch)
 }
 
 /// Final gather: `kd/N · Σ L(x, ωi)` over N cosine-weighted rays, L read from the global map at

@@ -6,8 +6,10 @@
 
 use super::queues::PathKind;
 use super::{add_term, par_lanes, slot, CameraWork, Maps, Shared, StageStats, GATHER_CHUNK};
+use crate::material::Bsdf;
 use crate::photon_map::flags;
 use crate::reference::camera::{caustic_estimate, global_estimate, map_radiance, Context};
+use crate::scene::SurfacePoint;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use std::time::Instant;
@@ -21,11 +23,41 @@ pub fn camera_slot(through_specular: u8, own: u8) -> u8 {
     }
 }
 
-/// Applies `(sample, slot, value)` contributions in order.
-fn apply(work: &mut CameraWork, contributions: Vec<(u32, u8, Vec3)>) {
-    for (sample, s, v) in contributions {
+/// Runs `estimate(ctx, point, bsdf, wo, kind, scratch)` at the diffuse hit of every lane whose
+/// kind passes `wanted`, in parallel, and adds `beta × value` to the lane's sample in lane order.
+/// `own_slot` is the term for camera lanes that did not pass through a mirror or glass; gather
+/// and glossy lanes use the slot they carry. Returns the number of estimates.
+fn estimate_at_diffuse_hits(
+    shared: &Shared,
+    maps: &Maps,
+    work: &mut CameraWork,
+    wanted: impl Fn(PathKind) -> bool,
+    own_slot: u8,
+    estimate: impl Fn(&Context, &SurfacePoint, &Bsdf, Vec3, PathKind, &mut Vec<(f32, u32)>) -> Vec3 + Sync,
+) -> usize {
+    let ctx = Context::new(&shared.scene, &maps.0, &shared.settings);
+    let w = &*work;
+    let lanes: Vec<u32> = w.classified.diffuse.iter().copied().filter(|&l| wanted(w.paths.kind[l as usize])).collect();
+    let out: Vec<(u32, u8, Vec3)> = par_lanes(lanes.len(), GATHER_CHUNK, shared.threads, |r| {
+        let mut scratch = Vec::new();
+        r.filter_map(|j| {
+            let i = lanes[j] as usize;
+            let sp = ctx.scene.surface(&w.paths.hits.get(i)?);
+            let bsdf = &ctx.scene.materials[sp.material as usize].bsdf;
+            let kind = w.paths.kind[i];
+            let value = estimate(&ctx, &sp, bsdf, -w.paths.rays.direction(i), kind, &mut scratch);
+            let s = match kind {
+                PathKind::Camera => camera_slot(w.paths.through_specular[i], own_slot),
+                _ => w.paths.slot[i],
+            };
+            Some((w.paths.sample[i], s, w.paths.beta[i] * value))
+        })
+        .collect()
+    });
+    for &(sample, s, v) in &out {
         add_term(&mut work.terms[sample as usize], s, v);
     }
+    lanes.len()
 }
 
 /// Caustic-map estimates at the diffuse hits of camera and glossy rays.
@@ -36,27 +68,15 @@ pub fn gather_caustics(
     mut stats: ResMut<StageStats>,
 ) {
     let t = Instant::now();
-    let ctx = Context::new(&shared.scene, &maps.0, &shared.settings);
-    let w = &*work;
-    let lanes: Vec<u32> =
-        w.classified.diffuse.iter().copied().filter(|&l| w.paths.kind[l as usize] != PathKind::Gather).collect();
-    let out = par_lanes(lanes.len(), GATHER_CHUNK, shared.threads, |r| {
-        let mut scratch = Vec::new();
-        r.filter_map(|j| {
-            let i = lanes[j] as usize;
-            let sp = ctx.scene.surface(&w.paths.hits.get(i)?);
-            let bsdf = &ctx.scene.materials[sp.material as usize].bsdf;
-            let v = w.paths.beta[i] * caustic_estimate(&ctx, &sp, bsdf, -w.paths.rays.direction(i), &mut scratch);
-            let s = match w.paths.kind[i] {
-                PathKind::Camera => camera_slot(w.paths.through_specular[i], slot::CAUSTIC),
-                _ => w.paths.slot[i],
-            };
-            Some((w.paths.sample[i], s, v))
-        })
-        .collect()
-    });
-    apply(&mut work, out);
-    stats.record("gather_caustics", lanes.len(), t);
+    let n = estimate_at_diffuse_hits(
+        &shared,
+        &maps,
+        &mut work,
+        |kind| kind != PathKind::Gather,
+        slot::CAUSTIC,
+        |ctx, sp, bsdf, wo, _, scratch| caustic_estimate(ctx, sp, bsdf, wo, scratch),
+    );
+    stats.record("gather_caustics", n, t);
 }
 
 /// Global-map estimates at diffuse hits: gather rays read the maps' radiance; glossy rays, and
@@ -69,39 +89,17 @@ pub fn gather_global(
     mut stats: ResMut<StageStats>,
 ) {
     let t = Instant::now();
-    let ctx = Context::new(&shared.scene, &maps.0, &shared.settings);
     let gather_on = shared.effects.final_gather.on;
-    let w = &*work;
-    let lanes: Vec<u32> = w
-        .classified
-        .diffuse
-        .iter()
-        .copied()
-        .filter(|&l| !(w.paths.kind[l as usize] == PathKind::Camera && gather_on))
-        .collect();
-    let out = par_lanes(lanes.len(), GATHER_CHUNK, shared.threads, |r| {
-        let mut scratch = Vec::new();
-        r.filter_map(|j| {
-            let i = lanes[j] as usize;
-            let sp = ctx.scene.surface(&w.paths.hits.get(i)?);
-            let bsdf = &ctx.scene.materials[sp.material as usize].bsdf;
-            let wo = -w.paths.rays.direction(i);
-            let (value, s) = match w.paths.kind[i] {
-                PathKind::Gather => (map_radiance(&ctx, &sp, bsdf, wo, &mut scratch), w.paths.slot[i]),
-                kind => {
-                    let v = global_estimate(&ctx, &sp, bsdf, wo, flags::DIRECT | flags::CAUSTIC, &mut scratch);
-                    let s = if kind == PathKind::Camera {
-                        camera_slot(w.paths.through_specular[i], slot::INDIRECT)
-                    } else {
-                        w.paths.slot[i]
-                    };
-                    (v, s)
-                }
-            };
-            Some((w.paths.sample[i], s, w.paths.beta[i] * value))
-        })
-        .collect()
-    });
-    apply(&mut work, out);
-    stats.record("gather_global", lanes.len(), t);
+    let n = estimate_at_diffuse_hits(
+        &shared,
+        &maps,
+        &mut work,
+        |kind| !(kind == PathKind::Camera && gather_on),
+        slot::INDIRECT,
+        |ctx, sp, bsdf, wo, kind, scratch| match kind {
+            PathKind::Gather => map_radiance(ctx, sp, bsdf, wo, scratch),
+            _ => global_estimate(ctx, sp, bsdf, wo, flags::DIRECT | flags::CAUSTIC, scratch),
+        },
+    );
+    stats.record("gather_global", n, t);
 }
