@@ -4,6 +4,8 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec3;
+use photonwave::kernels::KernelSet;
+use photonwave::photon_map::{Filter, Lookup, Reflectance};
 use photonwave::reference::build_maps;
 use photonwave::rng::{Domain, Sampler};
 use photonwave::sampling::uniform_sphere;
@@ -63,10 +65,15 @@ fn density(c: &mut Criterion) {
         b.iter(|| {
             let mut sum = Vec3::ZERO;
             for (p, n) in &queries {
-                sum += maps
-                    .global
-                    .estimate(*p, *n, settings.k as usize, r, settings.kernel, 0, |_| Vec3::ONE, &mut scratch)
-                    .radiance;
+                let q = Lookup {
+                    p: *p,
+                    k: settings.k as usize,
+                    r_max: r,
+                    kernel: settings.kernel,
+                    filter: Filter { n: *n, flags_mask: 0 },
+                };
+                sum +=
+                    maps.global.estimate(KernelSet::Simd, &q, Reflectance::Constant(Vec3::ONE), &mut scratch).radiance;
             }
             black_box(sum)
         })

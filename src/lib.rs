@@ -10,10 +10,12 @@
 // NaN value is rejected by the same test as a non-positive one.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod bench;
 pub mod effects;
 pub mod error;
 pub mod film;
 pub mod geometry;
+pub mod kernels;
 pub mod material;
 pub mod photon_map;
 pub mod reference;

@@ -23,7 +23,32 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene (.toml scene file or bare .obj) to a multi-layer EXR.
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
+    /// Throughput of the SIMD kernels against their baselines on identical rays and queries:
+    /// packet vs obvhs single-ray traversal, SIMD vs scalar density estimates.
+    Bench(BenchArgs),
+}
+
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Scenes (.toml or .obj), or `generated:sphere` for the built-in displaced sphere
+    /// (~1 M triangles). Default: the bundled Cornell boxes and the generated sphere.
+    scenes: Vec<String>,
+    /// Print one JSON object instead of tables.
+    #[arg(long)]
+    json: bool,
+    /// Worker threads for every kernel, 0 = all cores [1].
+    #[arg(long, default_value_t = 1)]
+    threads: u32,
+    /// Timed repetitions of each kernel (alternating with its baseline; medians reported).
+    #[arg(long, default_value_t = 5)]
+    reps: u32,
+    /// Also time packet closest-hit traversal at each single-ray hand-over threshold (0–4 lanes).
+    #[arg(long)]
+    thin_sweep: bool,
+    /// Sphere rings of `generated:sphere` (2·rings·2·rings triangles) [512].
+    #[arg(long, default_value_t = 512)]
+    rings: u32,
 }
 
 fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
@@ -229,10 +254,70 @@ fn render(args: RenderArgs) -> Result<()> {
     Ok(())
 }
 
+fn bench(args: BenchArgs) -> Result<()> {
+    use photonwave::bench;
+    use photonwave::scene::generated;
+    if args.reps == 0 || args.reps > 1000 {
+        return Err(Error::Setting { field: "--reps".into(), message: format!("{} is not in 1..=1000", args.reps) });
+    }
+    if !(2..=4096).contains(&args.rings) {
+        return Err(Error::Setting { field: "--rings".into(), message: format!("{} is not in 2..=4096", args.rings) });
+    }
+    let threads = if args.threads == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        args.threads as usize
+    };
+    let names = if args.scenes.is_empty() {
+        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        vec![
+            dir.join("cornell-box.toml").display().to_string(),
+            dir.join("cornell-spheres.toml").display().to_string(),
+            generated::SPHERE_NAME.to_string(),
+        ]
+    } else {
+        args.scenes.clone()
+    };
+    let (cpu, flags, features) = bench::build_flags();
+    if !args.json {
+        eprintln!("build: target-cpu {cpu}; SIMD features {features:?}; RUSTFLAGS `{flags}`; {threads} thread(s)");
+    }
+    let mut report = bench::Report::new(threads);
+    for name in &names {
+        let loaded = if name == generated::SPHERE_NAME {
+            generated::displaced_sphere(args.rings, 2 * args.rings)?
+        } else {
+            load_scene(std::path::Path::new(name))?
+        };
+        let label = std::path::Path::new(name).file_stem().map_or(name.clone(), |s| s.to_string_lossy().into_owned());
+        let camera = loaded.camera.unwrap_or_else(|| fitted_camera(&loaded.scene, 40.0));
+        let cam = camera.prepare(bench::SIDE, bench::SIDE)?;
+        if !args.json {
+            eprintln!("{label}: {} triangles", loaded.scene.triangle_count());
+        }
+        if args.thin_sweep {
+            let sets = bench::RaySets::new(&loaded.scene, &cam);
+            for (rays, thin, mrays) in bench::thin_sweep(&loaded.scene, &sets, &[0, 1, 2, 3, 4], args.reps as usize) {
+                eprintln!("  hand-over at ≤{thin} lanes: {rays:<8} closest {mrays:>7.2} Mrays/s");
+            }
+        }
+        let rows = bench::run_scene(&label, &loaded.scene, &cam, threads, args.reps as usize);
+        if !args.json {
+            eprint!("{}", bench::table(&rows.0, &rows.1));
+        }
+        report.add(rows);
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&report).map_err(|e| Error::output(std::path::Path::new("stdout"), e))?);
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render(args) => render(args),
+        Command::Render(args) => render(*args),
+        Command::Bench(args) => bench(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,17 +6,27 @@
 //! where k/(πr²) overestimates by k/(k−1). When fewer than k lie within the maximum radius, all of
 //! them are summed over the maximum radius (a fixed-radius estimate, also unbiased).
 //!
-//! Layout: structure-of-arrays columns in kd-tree order — every subtree is a contiguous index
-//! range, so spatial neighbours are contiguous. Per photon: the search column 16 B (position and
-//! a packed normal/flags filter key), power 12 B, incoming direction 12 B, normal 12 B, split
-//! axis 1 B: 53 B, plain f32 for obviousness (packing toward Jensen's 20 B is SIMD work). The
-//! search reads only the search column and the axis; power and direction only for photons it
-//! keeps. The tree is implicit: the median of each index range is its node.
+//! Layout: 20 bytes a photon (Jensen's own record was 20 B), five 4-byte columns in kd-tree
+//! order — every subtree is a contiguous index range, so spatial neighbours are contiguous and
+//! 8 of them load into one `f32x8` per column:
+//! - `x`, `y`, `z`: position, f32 (exact);
+//! - `key`: surface normal (octahedral, 6 + 6 bits), flags (2 bits), kd split axis (2 bits),
+//!   incoming direction (octahedral, 8 + 8 bits);
+//! - `power`: RGBE (Ward's shared exponent, as Jensen stored it).
+//!
+//! Error bounds of the packing: power per channel within 2⁻⁸ of the largest channel (rounded, so
+//! unbiased); incoming direction within 0.5° (octahedral step 2/254); normal within 2° (step
+//! 2/62), against a filter threshold of 45°. The tree is implicit: the median of each index range
+//! is its node; ranges of at most [`BUCKET`] photons are leaves, tested whole — 8 photons at a
+//! time by the SIMD kernels, one at a time by their scalar twins, with the same arithmetic in the
+//! same order, so both find the same photons.
 
+use crate::kernels::KernelSet;
 use crate::settings::Kernel;
 use glam::Vec3;
 use std::collections::BinaryHeap;
 use std::f32::consts::PI;
+use wide::{f32x8, i32x8, u32x8};
 
 /// Flags on a stored photon.
 pub mod flags {
@@ -41,20 +51,25 @@ pub struct Photon {
     pub flags: u8,
 }
 
+/// Leaf ranges: a range this short is tested whole rather than split further.
+pub const BUCKET: usize = 16;
+
+/// Padding after the last photon so that 8-wide loads at any bucket stay in bounds (positions
+/// +∞: never within any radius).
+const PAD: usize = 8;
+
 /// Photons in a balanced kd-tree.
 #[derive(Clone, Debug, Default)]
 pub struct PhotonMap {
-    /// Power per photon.
-    power: Vec<Vec3>,
-    /// Incoming direction per photon.
-    wi: Vec<Vec3>,
-    /// Surface normal per photon (on the side it arrived from).
-    normal: Vec<Vec3>,
-    /// What the search reads, in tree order, 16 B a photon: position, and the filter key
-    /// (normal as three snorm8 + flags) in the fourth lane's bits. The search is memory-bound;
-    /// reading the 52-byte record for the filter cost ~30 % of render time (perf, cornell-box).
-    nodes: Vec<[f32; 4]>,
-    axis: Vec<u8>,
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+    /// Normal, flags, split axis, incoming direction (see the module notes).
+    key: Vec<u32>,
+    /// RGBE power.
+    power: Vec<u32>,
+    /// Photons (without padding).
+    len: usize,
 }
 
 /// The result of a density estimate, with its search radius (for diagnostics).
@@ -66,6 +81,47 @@ pub struct Estimate {
     pub radius: f32,
     /// Photons summed.
     pub count: u32,
+}
+
+/// Which photons a lookup may use: those whose surface normal lies within ~45° of `n` (no leaks
+/// around corners or through thin walls) and that carry none of the `flags_mask` flags.
+#[derive(Clone, Copy, Debug)]
+pub struct Filter {
+    /// The query's geometric normal, on the side the light is reflected to.
+    pub n: Vec3,
+    /// Photons with any of these [`flags`] are skipped.
+    pub flags_mask: u8,
+}
+
+/// One density lookup: where, how many photons, how far, which kernel, which photons.
+#[derive(Clone, Copy, Debug)]
+pub struct Lookup {
+    /// Query point.
+    pub p: Vec3,
+    /// k nearest (k-NN lookups).
+    pub k: usize,
+    /// Maximum (k-NN) or fixed (radius lookups) search radius.
+    pub r_max: f32,
+    /// Density kernel.
+    pub kernel: Kernel,
+    /// Photon filter.
+    pub filter: Filter,
+}
+
+/// The BSDF seen by the estimate, per photon direction.
+#[derive(Clone, Copy)]
+pub enum Reflectance<'a> {
+    /// The same value for every photon (irradiance: 1).
+    Constant(Vec3),
+    /// `value` for photons arriving from above `ng`, 0 below (Lambertian).
+    Hemisphere {
+        /// f for directions above the surface.
+        value: Vec3,
+        /// The surface's geometric normal on the side of wo.
+        ng: Vec3,
+    },
+    /// Any BSDF, evaluated per photon direction.
+    PerPhoton(&'a dyn Fn(Vec3) -> Vec3),
 }
 
 /// A search candidate: (distance², photon index), ordered by distance for the max-heap.
@@ -94,6 +150,15 @@ impl Kernel {
             Kernel::Epanechnikov => 1.0 - d2 / r2,
         }
     }
+    /// [`Kernel::weight`] for 8 photons, the same operations.
+    #[inline]
+    fn weight8(self, d2: f32x8, r2: f32x8) -> f32x8 {
+        match self {
+            Kernel::Box => f32x8::ONE,
+            Kernel::Cone => f32x8::ONE - (d2 / r2).sqrt(),
+            Kernel::Epanechnikov => f32x8::ONE - d2 / r2,
+        }
+    }
     /// 1 / ∫ weight dA over the disk of radius² `r2`: the normalisation that returns a uniform
     /// density exactly.
     #[inline]
@@ -107,142 +172,348 @@ impl Kernel {
     }
 }
 
+// ---- packing -------------------------------------------------------------------------------
+
+/// Octahedral map of a unit vector to [−1, 1]².
+fn oct_encode(n: Vec3) -> (f32, f32) {
+    let s = n.x.abs() + n.y.abs() + n.z.abs();
+    if !(s > 0.0) || !s.is_finite() {
+        return (0.0, 0.0);
+    }
+    let (x, y) = (n.x / s, n.y / s);
+    if n.z < 0.0 {
+        ((1.0 - y.abs()) * x.signum(), (1.0 - x.abs()) * y.signum())
+    } else {
+        (x, y)
+    }
+}
+
+/// Quantises v ∈ [−1, 1] to 0..=`steps` (even, so 0 and ±1 are exact).
+fn quantise(v: f32, steps: u32) -> u32 {
+    (((v.clamp(-1.0, 1.0) + 1.0) * 0.5 * steps as f32).round() as u32).min(steps)
+}
+
+const NORMAL_STEPS: u32 = 62;
+const DIR_STEPS: u32 = 254;
+
+/// Packs normal, flags (2 bits), split axis and incoming direction into a key.
+fn pack_key(normal: Vec3, flags: u8, axis: u8, wi: Vec3) -> u32 {
+    let (nu, nv) = oct_encode(normal);
+    let (wu, wv) = oct_encode(wi);
+    quantise(nu, NORMAL_STEPS)
+        | quantise(nv, NORMAL_STEPS) << 6
+        | u32::from(flags & 3) << 12
+        | u32::from(axis & 3) << 14
+        | quantise(wu, DIR_STEPS) << 16
+        | quantise(wv, DIR_STEPS) << 24
+}
+
+/// Octahedral decode (not normalised): the same operations in [`oct_decode8`].
+#[inline]
+fn oct_decode(u: f32, v: f32) -> Vec3 {
+    let z = 1.0 - u.abs() - v.abs();
+    let t = (-z).max(0.0);
+    Vec3::new(u + if u >= 0.0 { -t } else { t }, v + if v >= 0.0 { -t } else { t }, z)
+}
+
+#[inline]
+fn oct_decode8(u: f32x8, v: f32x8) -> [f32x8; 3] {
+    let z = f32x8::ONE - u.abs() - v.abs();
+    let t = (-z).max(f32x8::ZERO);
+    let zero = f32x8::ZERO;
+    [u + u.simd_ge(zero).select(-t, t), v + v.simd_ge(zero).select(-t, t), z]
+}
+
+#[inline]
+fn dequantise(q: u32, steps: u32) -> f32 {
+    q as f32 * (2.0 / steps as f32) - 1.0
+}
+
+#[inline]
+fn dequantise8(q: u32x8, steps: u32) -> f32x8 {
+    let q: i32x8 = bytemuck_cast(q);
+    q.round_float() * f32x8::splat(2.0 / steps as f32) - f32x8::ONE
+}
+
+/// Reinterprets lanes (all values here are < 2³¹).
+#[inline]
+fn bytemuck_cast(v: u32x8) -> i32x8 {
+    wide::bytemuck::cast(v)
+}
+
+/// The stored normal of a key (not normalised).
+#[inline]
+fn key_normal(key: u32) -> Vec3 {
+    oct_decode(dequantise(key & 63, NORMAL_STEPS), dequantise(key >> 6 & 63, NORMAL_STEPS))
+}
+
+/// The stored incoming direction of a key (not normalised).
+#[inline]
+fn key_wi(key: u32) -> Vec3 {
+    oct_decode(dequantise(key >> 16 & 255, DIR_STEPS), dequantise(key >> 24, DIR_STEPS))
+}
+
+/// Flags of a key.
+#[inline]
+fn key_flags(key: u32) -> u8 {
+    (key >> 12 & 3) as u8
+}
+
+/// RGBE: three 8-bit mantissas sharing the exponent of the largest channel, rounded.
+fn rgbe_encode(c: Vec3) -> u32 {
+    let c = c.max(Vec3::ZERO);
+    let m = c.max_element();
+    if !(m > 0.0) || !m.is_finite() {
+        return 0;
+    }
+    // m < 2^(e − 127) with m ≥ 2^(e − 128): e = biased exponent of m, plus one.
+    let mut e = (m.to_bits() >> 23 & 255) as i32 + 1;
+    loop {
+        if e <= 8 {
+            return 0; // below 2⁻¹¹⁸ W: nothing any estimate could see
+        }
+        let scale = 2f32.powi(135 - e);
+        let q = (c * scale).round();
+        if q.max_element() < 256.0 || e >= 255 {
+            let q = q.min(Vec3::splat(255.0));
+            return q.x as u32 | (q.y as u32) << 8 | (q.z as u32) << 16 | (e as u32) << 24;
+        }
+        e += 1;
+    }
+}
+
+#[inline]
+fn rgbe_decode(v: u32) -> Vec3 {
+    let e = v >> 24_u32;
+    if e <= 8 {
+        return Vec3::ZERO;
+    }
+    let scale = f32::from_bits((e - 8) << 23);
+    Vec3::new((v & 255) as f32, (v >> 8 & 255) as f32, (v >> 16 & 255) as f32) * scale
+}
+
+#[inline]
+fn rgbe_decode8(v: u32x8) -> [f32x8; 3] {
+    let byte = |shift: u32| bytemuck_cast((v >> shift) & u32x8::splat(255)).round_float();
+    let e = v >> 24_u32;
+    let valid = e.simd_gt(u32x8::splat(8));
+    let bits = valid.select((e - u32x8::splat(8)) << 23_u32, u32x8::ZERO);
+    let scale: f32x8 = wide::bytemuck::cast(bits);
+    [byte(0) * scale, byte(8) * scale, byte(16) * scale]
+}
+
 impl PhotonMap {
-    /// Builds the tree (takes ownership, reorders).
+    /// Builds the tree (takes ownership, reorders) and packs the photons.
     #[must_use]
     pub fn build(mut photons: Vec<Photon>) -> Self {
-        let mut axis = vec![0u8; photons.len()];
         let n = photons.len();
+        let mut axis = vec![0u8; n];
         build_range(&mut photons, &mut axis, 0, n);
-        let nodes = photons
-            .iter()
-            .map(|p| {
-                let [x, y, z] = p.position.to_array();
-                [x, y, z, f32::from_bits(FilterKey::pack(p.normal, p.flags).0)]
-            })
-            .collect();
+        let inf = f32::INFINITY;
+        let col = |f: &dyn Fn(&Photon) -> f32| {
+            photons.iter().map(f).chain(std::iter::repeat_n(inf, PAD)).collect::<Vec<f32>>()
+        };
         PhotonMap {
-            power: photons.iter().map(|p| p.power).collect(),
-            wi: photons.iter().map(|p| p.wi).collect(),
-            normal: photons.iter().map(|p| p.normal).collect(),
-            nodes,
-            axis,
+            x: col(&|p| p.position.x),
+            y: col(&|p| p.position.y),
+            z: col(&|p| p.position.z),
+            key: photons
+                .iter()
+                .zip(&axis)
+                .map(|(p, &a)| pack_key(p.normal, p.flags, a, p.wi))
+                .chain(std::iter::repeat_n(0, PAD))
+                .collect(),
+            power: photons.iter().map(|p| rgbe_encode(p.power)).chain(std::iter::repeat_n(0, PAD)).collect(),
+            len: n,
         }
     }
 
     /// Number of stored photons.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.nodes.len()
+        self.len
     }
 
     /// True if the map holds no photon.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.nodes.is_empty()
+        self.len == 0
     }
 
-    /// Photon `i` (in tree order) as a record.
+    /// Bytes per stored photon (the five columns).
+    #[must_use]
+    pub const fn bytes_per_photon() -> usize {
+        5 * 4
+    }
+
+    /// Photon `i` (in tree order) as a record, with its packed fields decoded.
     #[must_use]
     pub fn photon(&self, i: usize) -> Photon {
-        let n = self.nodes[i];
+        let key = self.key[i];
         Photon {
-            position: Vec3::new(n[0], n[1], n[2]),
-            power: self.power[i],
-            wi: self.wi[i],
-            normal: self.normal[i],
-            flags: FilterKey(n[3].to_bits()).flags(),
+            position: self.position(i),
+            power: self.power(i),
+            wi: key_wi(key).normalize_or_zero(),
+            normal: key_normal(key).normalize_or_zero(),
+            flags: key_flags(key),
         }
     }
 
-    /// Power of photon `i`.
+    /// Position of photon `i`.
+    #[inline]
+    #[must_use]
+    pub fn position(&self, i: usize) -> Vec3 {
+        Vec3::new(self.x[i], self.y[i], self.z[i])
+    }
+
+    /// Power of photon `i` (decoded).
     #[must_use]
     pub fn power(&self, i: usize) -> Vec3 {
-        self.power[i]
+        rgbe_decode(self.power[i])
     }
 
-    /// The `k` nearest photons to `p` within `r_max` that pass `accept`, as (distance², index),
-    /// unordered, into `out`.
-    pub fn nearest(
-        &self,
-        p: Vec3,
-        k: usize,
-        r_max: f32,
-        accept: impl Fn(FilterKey) -> bool,
-        out: &mut Vec<(f32, u32)>,
-    ) {
-        out.clear();
-        if k == 0 || self.nodes.is_empty() {
-            return;
-        }
-        let mut heap: BinaryHeap<Candidate> = BinaryHeap::with_capacity(k);
-        let mut r2 = r_max * r_max;
+    #[inline]
+    fn axis(&self, i: usize) -> usize {
+        (self.key[i] >> 14 & 3) as usize
+    }
+
+    /// Squared distance of photon `i` from `p`: the same operations as the 8-wide form.
+    #[inline]
+    fn d2(&self, i: usize, p: Vec3) -> f32 {
+        let (dx, dy, dz) = (self.x[i] - p.x, self.y[i] - p.y, self.z[i] - p.z);
+        dx * dx + dy * dy + dz * dz
+    }
+
+    /// Walks the implicit tree, calling `visit(lo, hi, simd_ok, r2)` for every bucket (`simd_ok`
+    /// true) and every inner node's photon (a range of one, `simd_ok` false) that can lie within
+    /// the (shrinking) radius² `r2`.
+    fn walk(&self, p: Vec3, r2: &mut f32, mut visit: impl FnMut(usize, usize, bool, &mut f32)) {
         // Explicit stack of index ranges, each with the squared distance from `p` to the
         // splitting plane that separated it (0 for ranges on p's side): a far range is skipped
         // when r² has since shrunk below it.
         let mut stack: [(u32, u32, f32); 64] = [(0, 0, 0.0); 64];
         let mut top = 1;
-        stack[0] = (0, self.nodes.len() as u32, 0.0);
+        stack[0] = (0, self.len as u32, 0.0);
         while top > 0 {
             top -= 1;
             let (mut lo, mut hi, plane2) = stack[top];
-            if plane2 >= r2 {
+            if plane2 >= *r2 {
                 continue;
             }
             while lo < hi {
-                let mid = lo + (hi - lo) / 2;
-                let node = self.nodes[mid as usize];
-                let q = Vec3::new(node[0], node[1], node[2]);
-                let a = self.axis[mid as usize] as usize;
-                let delta = p[a] - q[a];
-                let d2 = (q - p).length_squared();
-                if d2 < r2 && accept(FilterKey(node[3].to_bits())) {
-                    let c = Candidate(d2, mid);
-                    if heap.len() < k {
-                        heap.push(c);
-                    } else if let Some(mut worst) = heap.peek_mut() {
-                        *worst = c;
-                    }
-                    if heap.len() == k {
-                        r2 = heap.peek().map_or(r2, |c| c.0);
-                    }
+                if (hi - lo) as usize <= BUCKET {
+                    visit(lo as usize, hi as usize, true, r2);
+                    break;
                 }
+                let mid = lo + (hi - lo) / 2;
+                let m = mid as usize;
+                let a = self.axis(m);
+                let q = [self.x[m], self.y[m], self.z[m]][a];
+                let delta = p[a] - q;
+                visit(m, m + 1, false, r2);
                 // Descend into p's side now; remember the other side.
                 let (near, far) = if delta < 0.0 { ((lo, mid), (mid + 1, hi)) } else { ((mid + 1, hi), (lo, mid)) };
-                if far.0 < far.1 && delta * delta < r2 && top < stack.len() {
+                if far.0 < far.1 && delta * delta < *r2 && top < stack.len() {
                     stack[top] = (far.0, far.1, delta * delta);
                     top += 1;
                 }
                 (lo, hi) = near;
             }
         }
+    }
+
+    /// True if photon `key` passes `filter`: flags, and the normal test n·m > 0.7·|m| evaluated as
+    /// n·m > 0 ∧ (n·m)² > 0.49·|m|² (no square root), the same operations as the 8-wide form.
+    #[inline]
+    fn accepts(key: u32, filter: &Filter) -> bool {
+        if key_flags(key) & filter.flags_mask != 0 {
+            return false;
+        }
+        let m = key_normal(key);
+        let dot = m.x * filter.n.x + m.y * filter.n.y + m.z * filter.n.z;
+        let len2 = m.x * m.x + m.y * m.y + m.z * m.z;
+        dot > 0.0 && dot * dot > 0.49 * len2
+    }
+
+    /// Lanes of the 8 photons from `base` that lie within `r2` of `p` and pass `filter`.
+    #[inline]
+    fn accepts8(&self, base: usize, p: Vec3, r2: f32, filter: &Filter) -> (u32, f32x8) {
+        let load = |c: &[f32]| f32x8::from(<[f32; 8]>::try_from(&c[base..base + 8]).expect("padded column"));
+        let (dx, dy, dz) =
+            (load(&self.x) - f32x8::splat(p.x), load(&self.y) - f32x8::splat(p.y), load(&self.z) - f32x8::splat(p.z));
+        let d2 = dx * dx + dy * dy + dz * dz;
+        let key = u32x8::from(<[u32; 8]>::try_from(&self.key[base..base + 8]).expect("padded column"));
+        let flags = (key >> 12_u32) & u32x8::splat(3);
+        let flags_ok = (flags & u32x8::splat(u32::from(filter.flags_mask))).simd_eq(u32x8::ZERO);
+        let [mx, my, mz] = oct_decode8(
+            dequantise8(key & u32x8::splat(63), NORMAL_STEPS),
+            dequantise8((key >> 6_u32) & u32x8::splat(63), NORMAL_STEPS),
+        );
+        let dot = mx * f32x8::splat(filter.n.x) + my * f32x8::splat(filter.n.y) + mz * f32x8::splat(filter.n.z);
+        let len2 = mx * mx + my * my + mz * mz;
+        let normal_ok = dot.simd_gt(f32x8::ZERO) & (dot * dot).simd_gt(f32x8::splat(0.49) * len2);
+        let inside = d2.simd_lt(f32x8::splat(r2)) & normal_ok;
+        let flags_bits = flags_ok.to_bitmask();
+        (inside.to_bitmask() & flags_bits, d2)
+    }
+
+    /// The `k` nearest photons to `q.p` within `q.r_max` that pass `q.filter`, as
+    /// (distance², index), unordered, into `out`.
+    pub fn nearest(&self, set: KernelSet, q: &Lookup, out: &mut Vec<(f32, u32)>) {
+        out.clear();
+        if q.k == 0 || self.is_empty() {
+            return;
+        }
+        let k = q.k;
+        let mut heap: BinaryHeap<Candidate> = BinaryHeap::with_capacity(k);
+        let offer = |heap: &mut BinaryHeap<Candidate>, r2: &mut f32, d2: f32, i: usize| {
+            let c = Candidate(d2, i as u32);
+            if heap.len() < k {
+                heap.push(c);
+            } else if let Some(mut worst) = heap.peek_mut() {
+                *worst = c;
+            }
+            if heap.len() == k {
+                *r2 = heap.peek().map_or(*r2, |c| c.0);
+            }
+        };
+        let mut r2 = q.r_max * q.r_max;
+        self.walk(q.p, &mut r2, |lo, hi, simd_ok, r2| {
+            if simd_ok && set == KernelSet::Simd {
+                for base in (lo..hi).step_by(8) {
+                    let (mut m, d2) = self.accepts8(base, q.p, *r2, &q.filter);
+                    m &= (1u32 << (hi - base).min(8)) - 1;
+                    let d2 = d2.to_array();
+                    while m != 0 {
+                        let l = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        // r² may have shrunk since the 8-wide test: re-check, as the scalar
+                        // twin does at this photon.
+                        if d2[l] < *r2 {
+                            offer(&mut heap, r2, d2[l], base + l);
+                        }
+                    }
+                }
+            } else {
+                for i in lo..hi {
+                    let d2 = self.d2(i, q.p);
+                    if d2 < *r2 && Self::accepts(self.key[i], &q.filter) {
+                        offer(&mut heap, r2, d2, i);
+                    }
+                }
+            }
+        });
         out.extend(heap.into_iter().map(|Candidate(d, i)| (d, i)));
     }
 
-    /// Reflected radiance at `p` toward `wo` from photons near `p`: Σ f(wi_p)·Φ_p·K over the
-    /// (k−1)-of-k rule above. `n` is the query's geometric normal on the side of `wo`; photons
-    /// whose surface normal (stored on the side they arrived from) differs by more than ~45°
-    /// are ignored: no leaks around corners or through thin walls. Photons with any flag in
-    /// `flags_mask` are ignored too. `f` evaluates the BSDF for a photon direction.
-    #[allow(clippy::too_many_arguments)]
-    pub fn estimate(
-        &self,
-        p: Vec3,
-        n: Vec3,
-        k: usize,
-        r_max: f32,
-        kernel: Kernel,
-        flags_mask: u8,
-        f: impl Fn(Vec3) -> Vec3,
-        scratch: &mut Vec<(f32, u32)>,
-    ) -> Estimate {
+    /// Reflected radiance at `q.p` from its k nearest photons: Σ f(wi_p)·Φ_p·K over the
+    /// (k−1)-of-k rule above.
+    pub fn estimate(&self, set: KernelSet, q: &Lookup, f: Reflectance<'_>, scratch: &mut Vec<(f32, u32)>) -> Estimate {
         if self.is_empty() {
-            return Estimate { radius: r_max, ..Default::default() };
+            return Estimate { radius: q.r_max, ..Default::default() };
         }
-        // snorm8 normals are off by < 0.004 per component: the 0.7 threshold moves by < 0.7 %.
-        let accept = |key: FilterKey| key.flags() & flags_mask == 0 && key.normal().dot(n) > 0.7;
-        self.nearest(p, k, r_max, accept, scratch);
-        let (r2, skip) = if scratch.len() == k {
+        self.nearest(set, q, scratch);
+        let (r2, skip) = if scratch.len() == q.k {
             // The k-th photon defines r and lies on the boundary: sum the other k − 1.
             let (far_i, far) = scratch
                 .iter()
@@ -252,51 +523,151 @@ impl PhotonMap {
                 .unwrap_or((0, 0.0));
             (far, Some(far_i))
         } else {
-            (r_max * r_max, None)
+            (q.r_max * q.r_max, None)
         };
         if !(r2 > 0.0) {
             return Estimate { radius: 0.0, ..Default::default() };
         }
-        let mut sum = Vec3::ZERO;
-        let mut count = 0;
-        for (j, &(d2, i)) in scratch.iter().enumerate() {
-            if Some(j) == skip {
-                continue;
-            }
-            let i = i as usize;
-            sum += f(self.wi[i]) * self.power[i] * kernel.weight(d2, r2);
-            count += 1;
+        if let Some(j) = skip {
+            scratch.swap_remove(j);
         }
-        Estimate { radiance: sum * kernel.normalisation(r2), radius: r2.sqrt(), count }
+        let sum = match set {
+            KernelSet::Scalar => self.sum_scalar(scratch, r2, q.kernel, f),
+            KernelSet::Simd => self.sum_simd(scratch, r2, q.kernel, f),
+        };
+        Estimate { radiance: sum * q.kernel.normalisation(r2), radius: r2.sqrt(), count: scratch.len() as u32 }
     }
-}
 
-/// A photon's surface normal (three snorm8) and flags (u8) in 32 bits.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct FilterKey(pub u32);
+    /// Reflected radiance at `q.p` from every photon within the fixed radius `q.r_max`.
+    pub fn estimate_radius(&self, set: KernelSet, q: &Lookup, f: Reflectance<'_>) -> Estimate {
+        let r2 = q.r_max * q.r_max;
+        if self.is_empty() || !(r2 > 0.0) || !r2.is_finite() {
+            return Estimate { radius: q.r_max, ..Default::default() };
+        }
+        let mut count = 0u32;
+        let mut sum = Vec3::ZERO;
+        let mut sum8 = [f32x8::ZERO; 3];
+        let mut r2_walk = r2;
+        self.walk(q.p, &mut r2_walk, |lo, hi, simd_ok, _| {
+            if simd_ok && set == KernelSet::Simd {
+                for base in (lo..hi).step_by(8) {
+                    let (mut m, d2) = self.accepts8(base, q.p, r2, &q.filter);
+                    m &= (1u32 << (hi - base).min(8)) - 1;
+                    if m == 0 {
+                        continue;
+                    }
+                    count += m.count_ones();
+                    let idx: [usize; 8] = std::array::from_fn(|l| base + l);
+                    let c = self.contribution8(&idx, m, d2, r2, q.kernel, f);
+                    for (s, v) in sum8.iter_mut().zip(c) {
+                        *s += v;
+                    }
+                }
+            } else {
+                for i in lo..hi {
+                    let d2 = self.d2(i, q.p);
+                    if d2 < r2 && Self::accepts(self.key[i], &q.filter) {
+                        sum += self.contribution(i, d2, r2, q.kernel, f);
+                        count += 1;
+                    }
+                }
+            }
+        });
+        let simd = Vec3::new(sum8[0].reduce_add(), sum8[1].reduce_add(), sum8[2].reduce_add());
+        Estimate { radiance: (sum + simd) * q.kernel.normalisation(r2), radius: q.r_max, count }
+    }
 
-impl FilterKey {
-    /// Packs a unit normal and flags.
-    #[must_use]
-    pub fn pack(n: Vec3, flags: u8) -> Self {
-        let q = |c: f32| ((c.clamp(-1.0, 1.0) * 127.0).round() as i8) as u8 as u32;
-        FilterKey(q(n.x) | q(n.y) << 8 | q(n.z) << 16 | (flags as u32) << 24)
+    /// f(wi)·Φ·weight of photon `i` at squared distance `d2` (scalar twin of [`Self::contribution8`]).
+    #[inline]
+    fn contribution(&self, i: usize, d2: f32, r2: f32, kernel: Kernel, f: Reflectance<'_>) -> Vec3 {
+        let key = self.key[i];
+        let w = kernel.weight(d2, r2);
+        let fp = match f {
+            Reflectance::Constant(v) => v,
+            Reflectance::Hemisphere { value, ng } => {
+                let wi = key_wi(key);
+                if wi.x * ng.x + wi.y * ng.y + wi.z * ng.z > 0.0 {
+                    value
+                } else {
+                    Vec3::ZERO
+                }
+            }
+            Reflectance::PerPhoton(g) => g(key_wi(key).normalize_or_zero()),
+        };
+        fp * rgbe_decode(self.power[i]) * w
     }
-    /// The normal (not renormalised).
-    #[must_use]
-    pub fn normal(self) -> Vec3 {
-        let c = |shift: u32| ((self.0 >> shift) as u8 as i8) as f32 * (1.0 / 127.0);
-        Vec3::new(c(0), c(8), c(16))
+
+    /// f(wi)·Φ·weight of the 8 photons `idx` in lanes `mask` (others 0), per channel.
+    #[inline]
+    fn contribution8(
+        &self,
+        idx: &[usize; 8],
+        mask: u32,
+        d2: f32x8,
+        r2: f32,
+        kernel: Kernel,
+        f: Reflectance<'_>,
+    ) -> [f32x8; 3] {
+        let lane = |l: usize| mask >> l & 1 == 1;
+        let key = u32x8::from(std::array::from_fn::<u32, 8, _>(|l| if lane(l) { self.key[idx[l]] } else { 0 }));
+        let power = u32x8::from(std::array::from_fn::<u32, 8, _>(|l| if lane(l) { self.power[idx[l]] } else { 0 }));
+        let w = kernel.weight8(d2, f32x8::splat(r2));
+        let w = f32x8::from(std::array::from_fn::<f32, 8, _>(|l| if lane(l) { w.to_array()[l] } else { 0.0 }));
+        let [pr, pg, pb] = rgbe_decode8(power);
+        let (pr, pg, pb) = (pr * w, pg * w, pb * w);
+        match f {
+            Reflectance::Constant(v) => [pr * f32x8::splat(v.x), pg * f32x8::splat(v.y), pb * f32x8::splat(v.z)],
+            Reflectance::Hemisphere { value, ng } => {
+                let [wx, wy, wz] = oct_decode8(
+                    dequantise8((key >> 16_u32) & u32x8::splat(255), DIR_STEPS),
+                    dequantise8(key >> 24_u32, DIR_STEPS),
+                );
+                let up =
+                    (wx * f32x8::splat(ng.x) + wy * f32x8::splat(ng.y) + wz * f32x8::splat(ng.z)).simd_gt(f32x8::ZERO);
+                let zero = f32x8::ZERO;
+                [
+                    up.select(pr * f32x8::splat(value.x), zero),
+                    up.select(pg * f32x8::splat(value.y), zero),
+                    up.select(pb * f32x8::splat(value.z), zero),
+                ]
+            }
+            Reflectance::PerPhoton(g) => {
+                let (pr, pg, pb) = (pr.to_array(), pg.to_array(), pb.to_array());
+                let mut out = [[0f32; 8]; 3];
+                for l in 0..8 {
+                    if lane(l) {
+                        let fp = g(key_wi(self.key[idx[l]]).normalize_or_zero());
+                        out[0][l] = fp.x * pr[l];
+                        out[1][l] = fp.y * pg[l];
+                        out[2][l] = fp.z * pb[l];
+                    }
+                }
+                out.map(f32x8::from)
+            }
+        }
     }
-    /// The flags.
-    #[must_use]
-    pub fn flags(self) -> u8 {
-        (self.0 >> 24) as u8
+
+    fn sum_scalar(&self, found: &[(f32, u32)], r2: f32, kernel: Kernel, f: Reflectance<'_>) -> Vec3 {
+        found.iter().map(|&(d2, i)| self.contribution(i as usize, d2, r2, kernel, f)).sum()
+    }
+
+    fn sum_simd(&self, found: &[(f32, u32)], r2: f32, kernel: Kernel, f: Reflectance<'_>) -> Vec3 {
+        let mut acc = [f32x8::ZERO; 3];
+        for chunk in found.chunks(8) {
+            let mask = (1u32 << chunk.len()) - 1;
+            let idx: [usize; 8] = std::array::from_fn(|l| chunk.get(l).map_or(0, |c| c.1 as usize));
+            let d2 = f32x8::from(std::array::from_fn::<f32, 8, _>(|l| chunk.get(l).map_or(0.0, |c| c.0)));
+            let c = self.contribution8(&idx, mask, d2, r2, kernel, f);
+            for (a, v) in acc.iter_mut().zip(c) {
+                *a += v;
+            }
+        }
+        Vec3::new(acc[0].reduce_add(), acc[1].reduce_add(), acc[2].reduce_add())
     }
 }
 
 fn build_range(photons: &mut [Photon], axis: &mut [u8], lo: usize, hi: usize) {
-    if hi - lo <= 1 {
+    if hi - lo <= BUCKET {
         return;
     }
     let mut mn = Vec3::splat(f32::INFINITY);
@@ -340,7 +711,9 @@ mod tests {
         let mut out = vec![];
         for _ in 0..50 {
             let q = Vec3::new(rnd(), 0.0, rnd());
-            map.nearest(q, 10, 0.2, |_| true, &mut out);
+            let lookup =
+                Lookup { p: q, k: 10, r_max: 0.2, kernel: Kernel::Box, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
+            map.nearest(KernelSet::Simd, &lookup, &mut out);
             let mut got: Vec<f32> = out.iter().map(|c| c.0).collect();
             got.sort_by(f32::total_cmp);
             let mut want: Vec<f32> =

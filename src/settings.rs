@@ -53,6 +53,9 @@ pub struct Settings {
     pub caustic_radius: f32,
     /// Density-estimation kernel for both maps.
     pub kernel: Kernel,
+    /// SIMD kernels (`simd`, the default) or their scalar twins (`scalar`) for BVH traversal
+    /// and photon lookups; the images agree (tests/simd.rs).
+    pub kernels: crate::kernels::KernelSet,
     /// Final-gather rays per camera sample.
     pub gather_rays: u32,
     /// Final gather (true) or read the global map directly at the first diffuse hit (false).
@@ -87,6 +90,7 @@ impl Default for Settings {
             global_radius: 0.05,
             caustic_radius: 0.015,
             kernel: Kernel::Cone,
+            kernels: crate::kernels::KernelSet::Simd,
             gather_rays: 16,
             final_gather: true,
             precompute_irradiance: true,

@@ -5,8 +5,9 @@ mod common;
 
 use common::*;
 use glam::Vec3;
+use photonwave::kernels::KernelSet;
 use photonwave::material::{Bsdf, Material, SurfaceFrame};
-use photonwave::photon_map::{Photon, PhotonMap};
+use photonwave::photon_map::{Filter, Lookup, Photon, PhotonMap, Reflectance};
 use photonwave::reference::camera::{direct_light, Context};
 use photonwave::reference::photons::{first_hit_power, trace_photons};
 use photonwave::reference::{NoProgress, PhotonMaps};
@@ -131,7 +132,9 @@ fn every_kernel_returns_a_uniform_density() {
     let map = PhotonMap::build(photons);
     let mut scratch = Vec::new();
     for kernel in [Kernel::Box, Kernel::Cone, Kernel::Epanechnikov] {
-        let e = map.estimate(Vec3::ZERO, Vec3::Y, 100_000, 50.0 * h, kernel, 0, |_| Vec3::ONE, &mut scratch);
+        let q =
+            Lookup { p: Vec3::ZERO, k: 100_000, r_max: 50.0 * h, kernel, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
+        let e = map.estimate(KernelSet::Simd, &q, Reflectance::Constant(Vec3::ONE), &mut scratch);
         let rel = e.radiance.x * h * h;
         assert!((rel - 1.0).abs() < 0.005, "{kernel:?}: {rel}");
     }
@@ -160,7 +163,9 @@ fn knn_estimate_is_unbiased_on_a_uniform_plane() {
     for i in 0..80 {
         for j in 0..80 {
             let p = Vec3::new(0.1 + i as f32 * 0.01, 0.0, 0.1 + j as f32 * 0.01);
-            let e = map.estimate(p, Vec3::Y, 16, 0.1, Kernel::Box, 0, |_| Vec3::ONE, &mut scratch);
+            let look =
+                Lookup { p, k: 16, r_max: 0.1, kernel: Kernel::Box, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
+            let e = map.estimate(KernelSet::Simd, &look, Reflectance::Constant(Vec3::ONE), &mut scratch);
             sum += e.radiance.x as f64 / n as f64;
             q += 1;
         }
@@ -308,16 +313,10 @@ fn directional_light_irradiance_is_cosine_weighted_by_both_methods() {
                     "θ={deg}: light sampling {} vs {want}",
                     direct.x
                 );
-                let e = maps.global.estimate(
-                    p,
-                    Vec3::Y,
-                    400,
-                    1.0,
-                    Kernel::Box,
-                    0,
-                    |wi| mat.bsdf.eval(&sp.frame, Vec3::Y, wi),
-                    &mut scratch,
-                );
+                let q =
+                    Lookup { p, k: 400, r_max: 1.0, kernel: Kernel::Box, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
+                let eval = |wi| mat.bsdf.eval(&sp.frame, Vec3::Y, wi);
+                let e = maps.global.estimate(KernelSet::Simd, &q, Reflectance::PerPhoton(&eval), &mut scratch);
                 photon_sum += e.radiance.x;
             }
         }

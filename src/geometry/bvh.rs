@@ -59,9 +59,29 @@ impl Bvh {
         (Bvh { bvh }, order)
     }
 
-    /// Closest hit with 0 < t < `t_max` among triangles given by the BVH-ordered columns.
+    /// The obvhs nodes (root first; children of an inner node at `first_index` and the next).
+    #[must_use]
+    pub fn nodes(&self) -> &[obvhs::bvh2::node::Bvh2Node] {
+        &self.bvh.nodes
+    }
+
+    /// Closest hit with 0 < t < `t_max` among triangles given by the BVH-ordered columns
+    /// (single-ray traversal; ties in t go to the lower triangle index).
     #[must_use]
     pub fn closest(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> Option<Hit> {
+        super::traverse::closest(self, tris, &super::traverse::RayQuery::new(o, d, t_max))
+    }
+
+    /// True if any triangle is hit with 0 < t < `t_max` (shadow rays).
+    #[must_use]
+    pub fn occluded(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> bool {
+        super::traverse::occluded(self, tris, &super::traverse::RayQuery::new(o, d, t_max))
+    }
+
+    /// obvhs's own single-ray traversal (closest hit) calling the same triangle test: the
+    /// baseline the packet traversal is benchmarked against. Ties go to the first found.
+    #[must_use]
+    pub fn closest_obvhs(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> Option<Hit> {
         if self.bvh.nodes.is_empty() || !o.is_finite() || !d.is_finite() {
             return None;
         }
@@ -82,9 +102,9 @@ impl Bvh {
         best.map(|h| Hit { tri: best_tri, t: h.t, b: h.b })
     }
 
-    /// True if any triangle is hit with 0 < t < `t_max` (shadow rays).
+    /// obvhs's single-ray any-hit traversal (baseline for the packet traversal).
     #[must_use]
-    pub fn occluded(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> bool {
+    pub fn occluded_obvhs(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> bool {
         if self.bvh.nodes.is_empty() || !o.is_finite() || !d.is_finite() {
             return false;
         }

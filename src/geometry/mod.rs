@@ -2,8 +2,11 @@
 
 pub mod bvh;
 pub mod offset;
+pub mod packet;
+pub mod traverse;
 pub mod triangle;
 
 pub use bvh::{Bvh, Hit};
 pub use offset::{gamma, offset_ray_origin};
+pub use traverse::RayQuery;
 pub use triangle::intersect_triangle;

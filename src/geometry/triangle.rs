@@ -18,21 +18,21 @@ pub struct TriangleHit {
     pub b: [f32; 3],
 }
 
+/// `v` with axis `kz` moved to z and the other two following cyclically (x, y keep handedness).
 #[inline]
-fn permute(v: Vec3, kx: usize, ky: usize, kz: usize) -> Vec3 {
+#[must_use]
+pub fn permute(v: Vec3, kz: usize) -> Vec3 {
+    let kx = (kz + 1) % 3;
+    let ky = (kx + 1) % 3;
     Vec3::new(v[kx], v[ky], v[kz])
 }
 
-/// Intersects the ray `o + t·d`, 0 < t < `t_max`, with the triangle (p0, p1, p2).
-/// Degenerate (zero-area) triangles and rays with a zero or non-finite direction never hit.
+/// The axis along which |d| is largest (ties resolved toward z, then y).
+#[inline]
 #[must_use]
-pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<TriangleHit> {
-    if (p2 - p0).cross(p1 - p0).length_squared() == 0.0 {
-        return None;
-    }
+pub fn dominant_axis(d: Vec3) -> usize {
     let ad = d.abs();
-    // Axis along which the direction is largest becomes z.
-    let kz = if ad.x > ad.y {
+    if ad.x > ad.y {
         if ad.x > ad.z {
             0
         } else {
@@ -42,16 +42,32 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
         1
     } else {
         2
-    };
-    let kx = (kz + 1) % 3;
-    let ky = (kx + 1) % 3;
-    let d = permute(d, kx, ky, kz);
+    }
+}
+
+/// True for a zero-area triangle (never hit).
+#[inline]
+#[must_use]
+pub fn is_degenerate(p0: Vec3, p1: Vec3, p2: Vec3) -> bool {
+    (p2 - p0).cross(p1 - p0).length_squared() == 0.0
+}
+
+/// Intersects the ray `o + t·d`, 0 < t < `t_max`, with the triangle (p0, p1, p2).
+/// Degenerate (zero-area) triangles and rays with a zero or non-finite direction never hit.
+#[must_use]
+pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<TriangleHit> {
+    if is_degenerate(p0, p1, p2) {
+        return None;
+    }
+    // Axis along which the direction is largest becomes z.
+    let kz = dominant_axis(d);
+    let d = permute(d, kz);
     if d.z == 0.0 || !d.is_finite() {
         return None;
     }
-    let mut p0t = permute(p0 - o, kx, ky, kz);
-    let mut p1t = permute(p1 - o, kx, ky, kz);
-    let mut p2t = permute(p2 - o, kx, ky, kz);
+    let mut p0t = permute(p0 - o, kz);
+    let mut p1t = permute(p1 - o, kz);
+    let mut p2t = permute(p2 - o, kz);
 
     let sx = -d.x / d.z;
     let sy = -d.y / d.z;

@@ -13,7 +13,7 @@ use crate::effects::Effects;
 use crate::film::{Film, Terms};
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::{Bsdf, Transport};
-use crate::photon_map::{flags, PhotonMap};
+use crate::photon_map::{flags, Filter, Lookup, PhotonMap, Reflectance};
 use crate::rng::{Domain, Sampler};
 use crate::sampling::{cosine_hemisphere, Frame};
 use crate::scene::camera::CameraRays;
@@ -300,8 +300,20 @@ fn map_estimate(
     scratch: &mut Vec<(f32, u32)>,
 ) -> Vec3 {
     let (ng, _) = sp.frame.oriented(wo);
-    map.estimate(sp.p, ng, k as usize, radius, ctx.settings.kernel, mask, |wi| bsdf.eval(&sp.frame, wo, wi), scratch)
-        .radiance
+    let lookup = Lookup {
+        p: sp.p,
+        k: k as usize,
+        r_max: radius,
+        kernel: ctx.settings.kernel,
+        filter: Filter { n: ng, flags_mask: mask },
+    };
+    let eval = |wi| bsdf.eval(&sp.frame, wo, wi);
+    let f = match *bsdf {
+        // Lambertian: f = kd/π above the surface, 0 below — no per-photon call.
+        Bsdf::Lambert { kd } => Reflectance::Hemisphere { value: kd * std::f32::consts::FRAC_1_PI, ng },
+        _ => Reflectance::PerPhoton(&eval),
+    };
+    map.estimate(ctx.settings.kernels, &lookup, f, scratch).radiance
 }
 
 /// Caustic-map radiance estimate at `sp` toward `wo`.
@@ -409,7 +421,14 @@ pub fn map_radiance(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, scr
     let irr = &ctx.maps.irradiance;
     if let (Bsdf::Lambert { kd }, false) = (bsdf, irr.is_empty()) {
         let (ng, _) = sp.frame.oriented(wo);
-        irr.nearest(sp.p, 1, ctx.global_radius, |key| key.normal().dot(ng) > 0.7, scratch);
+        let lookup = Lookup {
+            p: sp.p,
+            k: 1,
+            r_max: ctx.global_radius,
+            kernel: ctx.settings.kernel,
+            filter: Filter { n: ng, flags_mask: 0 },
+        };
+        irr.nearest(ctx.settings.kernels, &lookup, scratch);
         if let Some(&(_, i)) = scratch.first() {
             return *kd * std::f32::consts::FRAC_1_PI * irr.power(i as usize);
         }

@@ -12,7 +12,7 @@ pub mod photons;
 use crate::effects::Effects;
 use crate::error::Result;
 use crate::film::Film;
-use crate::photon_map::{Photon, PhotonMap};
+use crate::photon_map::{Filter, Lookup, Photon, PhotonMap, Reflectance};
 use crate::rng::Domain;
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
@@ -76,16 +76,14 @@ fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings,
             range
                 .map(|j| {
                     let src = global.photon(picks[j]);
-                    let e = global.estimate(
-                        src.position,
-                        src.normal,
-                        settings.k as usize,
-                        radius,
-                        settings.kernel,
-                        0,
-                        |_| Vec3::ONE,
-                        &mut scratch,
-                    );
+                    let lookup = Lookup {
+                        p: src.position,
+                        k: settings.k as usize,
+                        r_max: radius,
+                        kernel: settings.kernel,
+                        filter: Filter { n: src.normal, flags_mask: 0 },
+                    };
+                    let e = global.estimate(settings.kernels, &lookup, Reflectance::Constant(Vec3::ONE), &mut scratch);
                     Photon { position: src.position, power: e.radiance, wi: src.normal, normal: src.normal, flags: 0 }
                 })
                 .collect::<Vec<_>>()

@@ -3,6 +3,7 @@
 
 pub mod camera;
 pub mod file;
+pub mod generated;
 pub mod light;
 pub mod obj;
 pub mod validate;

@@ -1,0 +1,438 @@
+//! `photonwave bench`: throughput of the SIMD kernels against their baselines, in one process, on
+//! identical rays and queries. Each pair of kernels is timed alternately (packet, single, packet,
+//! …) and the median of the repetitions is reported, so machine noise hits both sides alike.
+//!
+//! Ray sets per scene, all from a 512 × 512 camera in 8 × 8 pixel tiles (packets of 8 are rows
+//! of a tile):
+//! - `camera`: primary rays;
+//! - `shadow`: from each camera hit to a uniform point on a light above its surface (t_max just
+//!   short of the light);
+//! - `diffuse`: cosine-distributed bounce rays from each camera hit, sorted by the renderer's
+//!   coherence key (direction octant, then origin cell) as the wavefront engine sorts its queues.
+//!
+//! Each set is traced for the closest hit and for any hit (shadow rays use their t_max, the
+//! others t = ∞ — any hit then answers "is anything there").
+
+use crate::geometry::packet::{closest_packets, occluded_packets};
+use crate::geometry::{offset_ray_origin, Hit, RayQuery};
+use crate::reference::parallel::map_chunks;
+use crate::rng::{Domain, Sampler};
+use crate::sampling::{cosine_hemisphere, Frame};
+use crate::scene::camera::CameraRays;
+use crate::scene::{Light, Scene};
+use glam::Vec3;
+use serde::Serialize;
+use std::time::Instant;
+
+/// The flags this build was compiled with: `(target_cpu, rustflags, enabled SIMD features)`.
+#[must_use]
+pub fn build_flags() -> (String, String, Vec<&'static str>) {
+    let flags = env!("PHOTONWAVE_RUSTFLAGS").trim().to_string();
+    let cpu = flags
+        .split_whitespace()
+        .flat_map(|w| w.split(','))
+        .find_map(|w| w.strip_prefix("target-cpu="))
+        .unwrap_or("default (x86-64: SSE2 only)")
+        .to_string();
+    let mut features = vec![];
+    if cfg!(target_feature = "sse4.2") {
+        features.push("sse4.2");
+    }
+    if cfg!(target_feature = "avx") {
+        features.push("avx");
+    }
+    if cfg!(target_feature = "avx2") {
+        features.push("avx2");
+    }
+    if cfg!(target_feature = "fma") {
+        features.push("fma");
+    }
+    (cpu, flags, features)
+}
+
+/// One traversal measurement.
+#[derive(Clone, Debug, Serialize)]
+pub struct TraversalRow {
+    /// Scene name.
+    pub scene: String,
+    /// Ray set: camera, shadow or diffuse.
+    pub rays: &'static str,
+    /// closest or any.
+    pub query: &'static str,
+    /// Rays in the set.
+    pub count: usize,
+    /// Packet traversal, million rays per second (median).
+    pub packet_mrays: f64,
+    /// obvhs single-ray traversal, million rays per second (median).
+    pub single_mrays: f64,
+    /// packet / single.
+    pub ratio: f64,
+    /// The packet kernel's scalar twin (our single-ray traversal), million rays per second.
+    pub twin_mrays: f64,
+}
+
+/// Image side of the bench camera.
+pub const SIDE: u32 = 512;
+
+/// Rays of the three sets for a scene seen through `camera`.
+pub struct RaySets {
+    /// Primary rays.
+    pub camera: Vec<RayQuery>,
+    /// Rays from camera hits toward light samples.
+    pub shadow: Vec<RayQuery>,
+    /// Bounce rays from camera hits, sorted by coherence key.
+    pub diffuse: Vec<RayQuery>,
+    /// Camera hits on surfaces: position and geometric normal facing the camera.
+    pub hits: Vec<(Vec3, Vec3)>,
+}
+
+/// Pixel (x, y) of the `i`-th ray in 8 × 8 tile order.
+fn tile_pixel(i: u32) -> (u32, u32) {
+    let tiles_x = SIDE / 8;
+    let (tile, within) = (i / 64, i % 64);
+    ((tile % tiles_x) * 8 + within % 8, (tile / tiles_x) * 8 + within / 8)
+}
+
+/// The coherence key of a ray: direction octant in the top 3 bits, then the Morton code of its
+/// origin's cell in a 64³ grid over `bounds`, then the direction within the octant quantised
+/// to 4 × 4 bins — so that a run of 8 rays in key order starts close together and points alike.
+#[must_use]
+pub fn coherence_key(o: Vec3, d: Vec3, bounds: (Vec3, Vec3)) -> u32 {
+    let octant = u32::from(d.x < 0.0) | u32::from(d.y < 0.0) << 1 | u32::from(d.z < 0.0) << 2;
+    let ext = (bounds.1 - bounds.0).max(Vec3::splat(f32::MIN_POSITIVE));
+    let cell = ((o - bounds.0) / ext * 64.0).clamp(Vec3::ZERO, Vec3::splat(63.0));
+    let spread = |v: f32| {
+        let mut x = v as u32 & 63;
+        x = (x | x << 8) & 0x0000_f00f;
+        x = (x | x << 4) & 0x0000_30c3;
+        (x | x << 2) & 0x0000_9249
+    };
+    let morton = spread(cell.x) | spread(cell.y) << 1 | spread(cell.z) << 2;
+    let a = d.abs() / d.abs().element_sum().max(f32::MIN_POSITIVE);
+    let bin = |v: f32| ((v * 4.0) as u32).min(3);
+    let dir = bin(a.x) << 2 | bin(a.y);
+    octant << 29 | morton << 4 | dir
+}
+
+impl RaySets {
+    /// Builds the sets (deterministic: fixed seed).
+    #[must_use]
+    pub fn new(scene: &Scene, cam: &CameraRays) -> Self {
+        let n = SIDE * SIDE;
+        let camera: Vec<RayQuery> = (0..n)
+            .map(|i| {
+                let (x, y) = tile_pixel(i);
+                let (o, d) = cam.ray(x as f32 + 0.5, y as f32 + 0.5);
+                RayQuery::new(o, d, f32::INFINITY)
+            })
+            .collect();
+        let (mut shadow, mut diffuse, mut hits) = (vec![], vec![], vec![]);
+        for (i, r) in camera.iter().enumerate() {
+            let Some(h) = scene.intersect(r.origin, r.direction, f32::INFINITY) else { continue };
+            let sp = scene.surface(&h);
+            let ng = if sp.frame.ng.dot(r.direction) > 0.0 { -sp.frame.ng } else { sp.frame.ng };
+            hits.push((sp.p, ng));
+            let s = Sampler::new(1, Domain::Camera, i as u64);
+            // As the renderer does, only toward lights above the surface.
+            let light = light_point(scene, [s.get(0, 0), s.get(0, 1), s.get(0, 2)]);
+            if let Some(target) = light.filter(|&q| (q - sp.p).dot(ng) > 0.0) {
+                let o = offset_ray_origin(sp.p, sp.p_error, ng, target - sp.p);
+                shadow.push(RayQuery::new(o, target - o, 1.0 - 1e-4));
+            }
+            let d = Frame::new(ng).to_world(cosine_hemisphere([s.get(0, 3), s.get(0, 4)]));
+            diffuse.push(RayQuery::new(offset_ray_origin(sp.p, sp.p_error, ng, d), d, f32::INFINITY));
+        }
+        diffuse.sort_by_key(|r| coherence_key(r.origin, r.direction, scene.bounds));
+        RaySets { camera, shadow, diffuse, hits }
+    }
+}
+
+/// A point on a light picked with three uniform numbers: area lights by power, then uniform on
+/// the triangle; point and spot lights at their position; None for a scene lit only by
+/// directional light.
+fn light_point(scene: &Scene, u: [f32; 3]) -> Option<Vec3> {
+    let idx = scene.light_power.sample(u[0]);
+    match scene.lights.get(idx)? {
+        Light::Area { tri, .. } => {
+            let t = scene.triangle(*tri);
+            let (b1, b2) = crate::sampling::uniform_triangle([u[1], u[2]]);
+            Some(t.p[0] * (1.0 - b1 - b2) + t.p[1] * b1 + t.p[2] * b2)
+        }
+        Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
+        Light::Directional { .. } => None,
+    }
+}
+
+/// Median of the samples.
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Times `a` and `b` alternately `reps` times each; returns their median seconds.
+pub fn time_pair(reps: usize, mut a: impl FnMut(), mut b: impl FnMut()) -> (f64, f64) {
+    let (mut ta, mut tb) = (vec![], vec![]);
+    for _ in 0..reps.max(1) {
+        let t = Instant::now();
+        a();
+        ta.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        b();
+        tb.push(t.elapsed().as_secs_f64());
+    }
+    (median(ta), median(tb))
+}
+
+/// Chunk of rays per thread task.
+const CHUNK: usize = 4096;
+
+/// Closest hits with packets on `threads` threads (chunks in fixed order).
+fn packets_closest(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
+    map_chunks(
+        rays.len(),
+        CHUNK,
+        threads,
+        |r| {
+            let mut out: Vec<Option<Hit>> = vec![None; r.len()];
+            closest_packets(scene.bvh(), scene.columns(), &rays[r], &mut out);
+            out.iter().filter(|h| h.is_some()).count()
+        },
+        |_| {},
+    )
+    .into_iter()
+    .sum()
+}
+
+fn packets_any(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
+    map_chunks(
+        rays.len(),
+        CHUNK,
+        threads,
+        |r| {
+            let mut out = vec![false; r.len()];
+            occluded_packets(scene.bvh(), scene.columns(), &rays[r], &mut out);
+            out.iter().filter(|&&b| b).count()
+        },
+        |_| {},
+    )
+    .into_iter()
+    .sum()
+}
+
+fn twin_closest(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
+    map_chunks(
+        rays.len(),
+        CHUNK,
+        threads,
+        |r| rays[r].iter().filter(|q| scene.intersect(q.origin, q.direction, q.t_max).is_some()).count(),
+        |_| {},
+    )
+    .into_iter()
+    .sum()
+}
+
+fn twin_any(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
+    map_chunks(
+        rays.len(),
+        CHUNK,
+        threads,
+        |r| rays[r].iter().filter(|q| scene.occluded(q.origin, q.direction, q.t_max)).count(),
+        |_| {},
+    )
+    .into_iter()
+    .sum()
+}
+
+fn single_closest(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
+    map_chunks(
+        rays.len(),
+        CHUNK,
+        threads,
+        |r| {
+            rays[r]
+                .iter()
+                .filter(|q| scene.bvh().closest_obvhs(scene.columns(), q.origin, q.direction, q.t_max).is_some())
+                .count()
+        },
+        |_| {},
+    )
+    .into_iter()
+    .sum()
+}
+
+fn single_any(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
+    map_chunks(
+        rays.len(),
+        CHUNK,
+        threads,
+        |r| {
+            rays[r]
+                .iter()
+                .filter(|q| scene.bvh().occluded_obvhs(scene.columns(), q.origin, q.direction, q.t_max))
+                .count()
+        },
+        |_| {},
+    )
+    .into_iter()
+    .sum()
+}
+
+/// Packet against obvhs single-ray traversal on every set and query. Also checks that both
+/// report the same number of hits (they differ only in ties between equally distant triangles,
+/// which do not change whether a ray hits).
+pub fn traversal(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usize) -> Vec<TraversalRow> {
+    let mut rows = vec![];
+    for (label, rays) in [("camera", &sets.camera), ("shadow", &sets.shadow), ("diffuse", &sets.diffuse)] {
+        if rays.is_empty() {
+            continue;
+        }
+        for query in ["closest", "any"] {
+            let (mut hp, mut hs) = (0, 0);
+            let (tp, ts) = if query == "closest" {
+                time_pair(
+                    reps,
+                    || hp = packets_closest(scene, rays, threads),
+                    || hs = single_closest(scene, rays, threads),
+                )
+            } else {
+                time_pair(reps, || hp = packets_any(scene, rays, threads), || hs = single_any(scene, rays, threads))
+            };
+            assert_eq!(hp, hs, "{name} {label} {query}: packet and single-ray hit counts differ");
+            let mut ht = 0;
+            let (tt, _) = if query == "closest" {
+                time_pair(reps, || ht = twin_closest(scene, rays, threads), || {})
+            } else {
+                time_pair(reps, || ht = twin_any(scene, rays, threads), || {})
+            };
+            assert_eq!(ht, hs, "{name} {label} {query}: scalar twin and obvhs hit counts differ");
+            let m = rays.len() as f64 * 1e-6;
+            rows.push(TraversalRow {
+                scene: name.to_string(),
+                rays: label,
+                query,
+                count: rays.len(),
+                packet_mrays: m / tp,
+                single_mrays: m / ts,
+                ratio: ts / tp,
+                twin_mrays: m / tt,
+            });
+        }
+    }
+    rows
+}
+
+/// One density-estimate measurement.
+#[derive(Clone, Debug, Serialize)]
+pub struct DensityRow {
+    /// Scene name.
+    pub scene: String,
+    /// knn (k nearest under a maximum radius) or radius (every photon within a fixed radius).
+    pub lookup: &'static str,
+    /// Queries in the set.
+    pub count: usize,
+    /// Photons in the map.
+    pub photons: usize,
+    /// SIMD estimates per second (median).
+    pub simd_per_s: f64,
+    /// Scalar estimates per second (median).
+    pub scalar_per_s: f64,
+    /// simd / scalar.
+    pub ratio: f64,
+}
+
+/// Everything `photonwave bench --json` prints.
+#[derive(Debug, Serialize)]
+pub struct Report {
+    /// `-C target-cpu` the crate was compiled for.
+    pub target_cpu: String,
+    /// The full RUSTFLAGS of the build.
+    pub rustflags: String,
+    /// SIMD target features enabled at compile time.
+    pub features: Vec<&'static str>,
+    /// Worker threads every kernel ran on.
+    pub threads: usize,
+    /// Traversal rows.
+    pub traversal: Vec<TraversalRow>,
+    /// Density rows.
+    pub density: Vec<DensityRow>,
+}
+
+impl Report {
+    /// An empty report for this build.
+    #[must_use]
+    pub fn new(threads: usize) -> Self {
+        let (target_cpu, rustflags, features) = build_flags();
+        Report { target_cpu, rustflags, features, threads, traversal: vec![], density: vec![] }
+    }
+    /// Adds one scene's rows.
+    pub fn add(&mut self, rows: (Vec<TraversalRow>, Vec<DensityRow>)) {
+        self.traversal.extend(rows.0);
+        self.density.extend(rows.1);
+    }
+}
+
+/// All measurements on one scene.
+#[must_use]
+pub fn run_scene(
+    name: &str,
+    scene: &Scene,
+    cam: &CameraRays,
+    threads: usize,
+    reps: usize,
+) -> (Vec<TraversalRow>, Vec<DensityRow>) {
+    let sets = RaySets::new(scene, cam);
+    let t = traversal(name, scene, &sets, threads, reps);
+    let d = density(name, scene, &sets, threads, reps);
+    (t, d)
+}
+
+/// The rows as a plain-text table.
+#[must_use]
+pub fn table(traversal: &[TraversalRow], density: &[DensityRow]) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    for r in traversal {
+        let _ = writeln!(
+            s,
+            "  traversal {:<8} {:<8} {:>8} rays  packet {:>7.2} Mrays/s  obvhs single {:>7.2} Mrays/s  ×{:.2}  (scalar twin {:.2})",
+            r.rays, r.query, r.count, r.packet_mrays, r.single_mrays, r.ratio, r.twin_mrays
+        );
+    }
+    for r in density {
+        let _ = writeln!(
+            s,
+            "  density   {:<8} {:>8} queries over {} photons  simd {:>9.0}/s  scalar {:>9.0}/s  ×{:.2}",
+            r.lookup, r.count, r.photons, r.simd_per_s, r.scalar_per_s, r.ratio
+        );
+    }
+    s
+}
+
+/// SIMD against scalar density estimates (filled in by the density kernels).
+fn density(_name: &str, _scene: &Scene, _sets: &RaySets, _threads: usize, _reps: usize) -> Vec<DensityRow> {
+    vec![]
+}
+
+/// Closest-hit throughput (Mrays/s, median) of packet traversal on each ray set for each
+/// hand-over threshold in `thins` (lanes at or below which a node goes to single-ray traversal).
+#[must_use]
+pub fn thin_sweep(scene: &Scene, sets: &RaySets, thins: &[u32], reps: usize) -> Vec<(&'static str, u32, f64)> {
+    use crate::geometry::packet::closest_packets_thin;
+    let mut rows = vec![];
+    for (label, rays) in [("camera", &sets.camera), ("shadow", &sets.shadow), ("diffuse", &sets.diffuse)] {
+        let mut out = vec![None; rays.len()];
+        let mut times: Vec<Vec<f64>> = vec![vec![]; thins.len()];
+        // Interleaved: every threshold once per round.
+        for _ in 0..reps.max(1) {
+            for (k, &thin) in thins.iter().enumerate() {
+                let t = Instant::now();
+                closest_packets_thin(scene.bvh(), scene.columns(), rays, &mut out, thin);
+                times[k].push(t.elapsed().as_secs_f64());
+            }
+        }
+        for (k, &thin) in thins.iter().enumerate() {
+            rows.push((label, thin, rays.len() as f64 * 1e-6 / median(times[k].clone())));
+        }
+    }
+    rows
+}

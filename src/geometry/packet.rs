@@ -1,0 +1,411 @@
+//! Packet traversal: 8 rays at a time (`wide::f32x8`) through the obvhs BVH2, masks rather than
+//! branches. A node's two child boxes are tested against all 8 rays at once; a child is visited
+//! while any lane enters it before its current closest hit. Leaves test each triangle against
+//! all 8 rays with an 8-wide form of the watertight test that is bit-identical to the scalar one
+//! (see [`intersect8`]). When a node is reached by at most `thin` active lanes ([`THIN_LANES`]
+//! by default), those lanes finish its subtree by single-ray traversal: testing 8 lanes to serve
+//! one or two costs more than it saves.
+//!
+//! Decisions match [`super::traverse`] (same conservative box test, same triangle test, ties to
+//! the lower triangle index), so hits are identical lane by lane; tests/packet.rs checks it.
+
+use super::bvh::{Bvh, Hit, TriangleColumns};
+use super::offset::gamma;
+use super::traverse::{closest_from, inverse_direction, occluded_from, Best, RayQuery, Stack, FAR_GROWTH, NO_TRI};
+use super::triangle::{dominant_axis, intersect_triangle, is_degenerate, permute};
+use glam::Vec3;
+use obvhs::bvh2::node::Bvh2Node;
+use wide::f32x8;
+
+/// Lanes per packet.
+pub const LANES: usize = 8;
+
+/// A node reached by this many active lanes or fewer is finished by single-ray traversal.
+/// Measured with `photonwave bench --thin-sweep` (BENCHMARKS.md): on every scene and ray set,
+/// handing over at 1–4 lanes was slower than staying in the packet (the 8-wide box and triangle
+/// tests cost about what one scalar test does), so by default packets never hand over.
+pub const THIN_LANES: u32 = 0;
+
+/// Eight rays in SIMD columns.
+struct Packet {
+    ox: f32x8,
+    oy: f32x8,
+    oz: f32x8,
+    ix: f32x8,
+    iy: f32x8,
+    iz: f32x8,
+    /// Per-lane axis permutation of the watertight test (z = the direction's largest axis):
+    /// lanes where that axis is z, and where it is x.
+    kz2: f32x8,
+    kz0: f32x8,
+    /// Shear constants −d'x/d'z, −d'y/d'z, 1/d'z of the permuted direction.
+    sx: f32x8,
+    sy: f32x8,
+    sz: f32x8,
+    o: [Vec3; LANES],
+    d: [Vec3; LANES],
+    inv: [Vec3; LANES],
+    /// Lanes holding a valid ray.
+    valid: u32,
+}
+
+impl Packet {
+    fn load(rays: &[RayQuery]) -> Self {
+        let mut o = [Vec3::ZERO; LANES];
+        let mut d = [Vec3::X; LANES];
+        let mut inv = [Vec3::ONE; LANES];
+        let mut valid = 0u32;
+        for (l, r) in rays.iter().enumerate().take(LANES) {
+            if r.is_valid() {
+                o[l] = r.origin;
+                d[l] = r.direction;
+                inv[l] = inverse_direction(r.direction);
+                valid |= 1 << l;
+            }
+        }
+        let col = |f: &dyn Fn(usize) -> f32| f32x8::from(std::array::from_fn::<f32, LANES, _>(f));
+        let mask = |f: &dyn Fn(usize) -> bool| col(&|l| if f(l) { f32::from_bits(u32::MAX) } else { 0.0 });
+        // The same axis choice and shear as the scalar watertight test.
+        let axis: [usize; LANES] = std::array::from_fn(|l| dominant_axis(d[l]));
+        let shear: [[f32; 3]; LANES] = std::array::from_fn(|l| {
+            let p = permute(d[l], axis[l]);
+            [-p.x / p.z, -p.y / p.z, 1.0 / p.z]
+        });
+        Packet {
+            ox: col(&|l| o[l].x),
+            oy: col(&|l| o[l].y),
+            oz: col(&|l| o[l].z),
+            ix: col(&|l| inv[l].x),
+            iy: col(&|l| inv[l].y),
+            iz: col(&|l| inv[l].z),
+            kz2: mask(&|l| axis[l] == 2),
+            kz0: mask(&|l| axis[l] == 0),
+            sx: col(&|l| shear[l][0]),
+            sy: col(&|l| shear[l][1]),
+            sz: col(&|l| shear[l][2]),
+            o,
+            d,
+            inv,
+            valid,
+        }
+    }
+
+    /// Entry distances into `node`'s box per lane, NaN where a lane misses or enters beyond its
+    /// `t_max` (so that every ordered comparison with it is false, even against t_max = ∞): the
+    /// 8-wide form of [`box_entry`], the same operations in the same order.
+    #[inline(always)]
+    fn entry(&self, node: &Bvh2Node, t_max: f32x8) -> f32x8 {
+        let b = &node.aabb;
+        let slab = |lo: f32, hi: f32, o: f32x8, inv: f32x8| {
+            let t0 = (f32x8::splat(lo) - o) * inv;
+            let t1 = (f32x8::splat(hi) - o) * inv;
+            (t0.min(t1), t0.max(t1))
+        };
+        let (nx, fx) = slab(b.min.x, b.max.x, self.ox, self.ix);
+        let (ny, fy) = slab(b.min.y, b.max.y, self.oy, self.iy);
+        let (nz, fz) = slab(b.min.z, b.max.z, self.oz, self.iz);
+        let near = nx.max(ny).max(nz).max(f32x8::ZERO);
+        let far = fx.min(fy).min(fz) * f32x8::splat(FAR_GROWTH);
+        let hit = near.simd_le(far) & near.simd_le(t_max);
+        hit.select(near, f32x8::splat(f32::NAN))
+    }
+}
+
+/// Bit mask of lanes where `m` is set.
+#[inline(always)]
+fn bits(m: f32x8) -> u32 {
+    m.to_bitmask()
+}
+
+/// The watertight ray/triangle test of [`intersect_triangle`] for 8 rays against one triangle:
+/// the same operations in the same order (no fused multiply-adds on either side), so every lane's
+/// decision, t and barycentrics are bit-identical to the scalar test. Returns (hit lanes,
+/// lanes to decide with the scalar test, t, b0, b1, b2). The scalar test recomputes edge
+/// functions that round to exactly zero in f64; lanes where that happens are handed back.
+#[inline(always)]
+#[allow(clippy::many_single_char_names)]
+fn intersect8(p: &Packet, lanes: u32, v: [Vec3; 3], t_max: f32x8) -> (u32, u32, f32x8, [f32x8; 3]) {
+    // Vertices relative to the origins, permuted per lane, sheared.
+    let perm = |q: Vec3| {
+        let x = f32x8::splat(q.x) - p.ox;
+        let y = f32x8::splat(q.y) - p.oy;
+        let z = f32x8::splat(q.z) - p.oz;
+        let px = p.kz2.select(x, p.kz0.select(y, z));
+        let py = p.kz2.select(y, p.kz0.select(z, x));
+        let pz = p.kz2.select(z, p.kz0.select(x, y));
+        (px + p.sx * pz, py + p.sy * pz, pz)
+    };
+    let (x0, y0, z0) = perm(v[0]);
+    let (x1, y1, z1) = perm(v[1]);
+    let (x2, y2, z2) = perm(v[2]);
+    let e0 = x1 * y2 - y1 * x2;
+    let e1 = x2 * y0 - y2 * x0;
+    let e2 = x0 * y1 - y0 * x1;
+    let zero = f32x8::ZERO;
+    let any_zero = e0.simd_eq(zero) | e1.simd_eq(zero) | e2.simd_eq(zero);
+    let fallback = bits(any_zero) & lanes;
+    let neg = e0.simd_lt(zero) | e1.simd_lt(zero) | e2.simd_lt(zero);
+    let pos = e0.simd_gt(zero) | e1.simd_gt(zero) | e2.simd_gt(zero);
+    let det = e0 + e1 + e2;
+    let (z0, z1, z2) = (z0 * p.sz, z1 * p.sz, z2 * p.sz);
+    let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
+    let bound = t_max * det;
+    let det_neg = det.simd_lt(zero) & (t_scaled.simd_ge(zero) | t_scaled.simd_lt(bound));
+    let det_pos = det.simd_gt(zero) & (t_scaled.simd_le(zero) | t_scaled.simd_gt(bound));
+    let inv_det = f32x8::ONE / det;
+    let t = t_scaled * inv_det;
+    // pbrt-v4's bound on t's error; t must exceed it.
+    let max_zt = z0.abs().max(z1.abs()).max(z2.abs());
+    let delta_z = f32x8::splat(gamma(3)) * max_zt;
+    let max_xt = x0.abs().max(x1.abs()).max(x2.abs());
+    let max_yt = y0.abs().max(y1.abs()).max(y2.abs());
+    let delta_x = f32x8::splat(gamma(5)) * (max_xt + max_zt);
+    let delta_y = f32x8::splat(gamma(5)) * (max_yt + max_zt);
+    let delta_e = f32x8::splat(2.0) * (f32x8::splat(gamma(2)) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+    let delta_t = f32x8::splat(3.0)
+        * (f32x8::splat(gamma(3)) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
+        * inv_det.abs();
+    let ok = !(neg & pos)
+        & det.simd_ne(zero)
+        & det.is_finite()
+        & !det_neg
+        & !det_pos
+        & t.simd_lt(t_max)
+        & t.simd_gt(delta_t);
+    let hit = bits(ok) & lanes & !fallback;
+    (hit, fallback, t, [e0 * inv_det, e1 * inv_det, e2 * inv_det])
+}
+
+/// Closest hits of 8 rays (fewer at the end of a slice).
+fn closest8(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery], thin: u32, out: &mut [Option<Hit>]) {
+    let nodes = bvh.nodes();
+    let p = Packet::load(rays);
+    let mut best: [Best; LANES] = std::array::from_fn(|l| Best::new(rays.get(l).map_or(0.0, |r| r.t_max)));
+    let mut t_best = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].t));
+    let active = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| {
+        if p.valid >> l & 1 == 1 {
+            f32::from_bits(u32::MAX)
+        } else {
+            0.0
+        }
+    }));
+    let mut single = Stack::new();
+    let mut stack: Stack<(u32, Entry)> = Stack::new();
+    if !nodes.is_empty() && p.valid != 0 {
+        let t0 = p.entry(&nodes[0], t_best);
+        stack.push((0, Entry(active.select(t0, f32x8::splat(f32::NAN)))));
+    }
+    while let Some((n, Entry(tn))) = stack.pop() {
+        let mut mask = bits(tn.simd_le(t_best));
+        if mask == 0 {
+            continue;
+        }
+        let node = &nodes[n as usize];
+        if mask.count_ones() <= thin {
+            let tn = tn.to_array();
+            while mask != 0 {
+                let l = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                closest_from(bvh, tris, n, tn[l], p.o[l], p.d[l], p.inv[l], &mut best[l], &mut single);
+            }
+            t_best = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].t));
+            continue;
+        }
+        if node.prim_count > 0 {
+            for id in node.first_index..node.first_index + node.prim_count {
+                let i = id as usize;
+                let v = [tris.p0[i], tris.p1[i], tris.p2[i]];
+                if is_degenerate(v[0], v[1], v[2]) {
+                    continue;
+                }
+                // Strictly below t_max while a lane has no hit; afterwards up to and including its
+                // best t (a tie may go to a lower index).
+                let limit = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| {
+                    if best[l].tri == NO_TRI {
+                        best[l].t
+                    } else {
+                        best[l].t.next_up()
+                    }
+                }));
+                let (mut hit, mut fallback, t, b) = intersect8(&p, mask, v, limit);
+                let (t, b) = (t.to_array(), b.map(f32x8::to_array));
+                while hit != 0 {
+                    let l = hit.trailing_zeros() as usize;
+                    hit &= hit - 1;
+                    if t[l] < best[l].t || id < best[l].tri {
+                        best[l] = Best { t: t[l], tri: id, b: [b[0][l], b[1][l], b[2][l]] };
+                    }
+                }
+                while fallback != 0 {
+                    let l = fallback.trailing_zeros() as usize;
+                    fallback &= fallback - 1;
+                    best[l].test(tris, p.o[l], p.d[l], id);
+                }
+            }
+            t_best = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].t));
+            continue;
+        }
+        let (l, r) = (node.first_index, node.first_index + 1);
+        let tl = p.entry(&nodes[l as usize], t_best);
+        let tr = p.entry(&nodes[r as usize], t_best);
+        let ml = bits(tl.simd_le(t_best)) & mask;
+        let mr = bits(tr.simd_le(t_best)) & mask;
+        // Visit first the child most of the lanes enter first.
+        let left_first = (bits(tl.simd_le(tr)) & ml & mr).count_ones() * 2 >= (ml & mr).count_ones();
+        let (first, second) = if left_first { ((l, tl, ml), (r, tr, mr)) } else { ((r, tr, mr), (l, tl, ml)) };
+        if second.2 != 0 {
+            stack.push((second.0, Entry(second.1)));
+        }
+        if first.2 != 0 {
+            stack.push((first.0, Entry(first.1)));
+        }
+    }
+    for (l, o) in out.iter_mut().enumerate() {
+        *o = best[l].hit();
+    }
+}
+
+/// Any-hit tests of 8 rays.
+fn occluded8(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery], thin: u32, out: &mut [bool]) {
+    let nodes = bvh.nodes();
+    let p = Packet::load(rays);
+    let t_max = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| rays.get(l).map_or(0.0, |r| r.t_max)));
+    let t_arr = t_max.to_array();
+    let mut blocked = 0u32;
+    let mut single = Stack::new();
+    let mut stack: Stack<(u32, u32)> = Stack::new();
+    if !nodes.is_empty() && p.valid != 0 {
+        let root = bits(p.entry(&nodes[0], t_max).simd_le(t_max)) & p.valid;
+        stack.push((0, root));
+    }
+    while let Some((n, m)) = stack.pop() {
+        let mut mask = m & !blocked;
+        if mask == 0 {
+            continue;
+        }
+        let node = &nodes[n as usize];
+        if mask.count_ones() <= thin {
+            while mask != 0 {
+                let l = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if occluded_from(bvh, tris, n, p.o[l], p.d[l], p.inv[l], t_arr[l], &mut single) {
+                    blocked |= 1 << l;
+                }
+            }
+            continue;
+        }
+        if node.prim_count > 0 {
+            for id in node.first_index..node.first_index + node.prim_count {
+                let i = id as usize;
+                let v = [tris.p0[i], tris.p1[i], tris.p2[i]];
+                let lanes = mask & !blocked;
+                if lanes == 0 || is_degenerate(v[0], v[1], v[2]) {
+                    continue;
+                }
+                let (hit, mut fallback, _, _) = intersect8(&p, lanes, v, t_max);
+                blocked |= hit;
+                while fallback != 0 {
+                    let l = fallback.trailing_zeros() as usize;
+                    fallback &= fallback - 1;
+                    if intersect_triangle(p.o[l], p.d[l], t_arr[l], v[0], v[1], v[2]).is_some() {
+                        blocked |= 1 << l;
+                    }
+                }
+            }
+            continue;
+        }
+        let (l, r) = (node.first_index, node.first_index + 1);
+        let tl = p.entry(&nodes[l as usize], t_max);
+        let tr = p.entry(&nodes[r as usize], t_max);
+        let ml = bits(tl.simd_le(t_max)) & mask;
+        let mr = bits(tr.simd_le(t_max)) & mask;
+        // Nearer child first, as most lanes see it: an occluder near the origin ends lanes early.
+        let left_first = (bits(tl.simd_le(tr)) & ml & mr).count_ones() * 2 >= (ml & mr).count_ones();
+        let (first, second) = if left_first { ((l, ml), (r, mr)) } else { ((r, mr), (l, ml)) };
+        if second.1 != 0 {
+            stack.push(second);
+        }
+        if first.1 != 0 {
+            stack.push(first);
+        }
+    }
+    for (l, o) in out.iter_mut().enumerate() {
+        *o = blocked >> l & 1 == 1;
+    }
+}
+
+/// A stack entry's per-lane entry distances.
+#[derive(Clone, Copy)]
+struct Entry(f32x8);
+impl Default for Entry {
+    fn default() -> Self {
+        Entry(f32x8::ZERO)
+    }
+}
+
+/// Closest hits of `rays` into `out`, 8 at a time. Same signature and results as
+/// [`super::traverse::closest_rays`].
+pub fn closest_packets(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [Option<Hit>]) {
+    closest_packets_thin(bvh, tris, rays, out, THIN_LANES);
+}
+
+/// [`closest_packets`] handing lanes to single-ray traversal at `thin` active lanes or fewer
+/// (0: never; 8: always, i.e. single-ray traversal with a packet root test).
+pub fn closest_packets_thin(
+    bvh: &Bvh,
+    tris: TriangleColumns<'_>,
+    rays: &[RayQuery],
+    out: &mut [Option<Hit>],
+    thin: u32,
+) {
+    for (r, o) in rays.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        closest8(bvh, tris, r, thin, o);
+    }
+}
+
+/// Any-hit tests of `rays` into `out`, 8 at a time. Same signature and results as
+/// [`super::traverse::occluded_rays`].
+pub fn occluded_packets(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [bool]) {
+    occluded_packets_thin(bvh, tris, rays, out, THIN_LANES);
+}
+
+/// [`occluded_packets`] with its own hand-over threshold (see [`closest_packets_thin`]).
+pub fn occluded_packets_thin(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [bool], thin: u32) {
+    for (r, o) in rays.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        occluded8(bvh, tris, r, thin, o);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::traverse::box_entry;
+    use super::*;
+
+    #[test]
+    fn packet_entry_matches_scalar_box_entry() {
+        let node = Bvh2Node {
+            aabb: obvhs::aabb::Aabb::new(glam::Vec3A::new(-1.0, 0.0, -1.0), glam::Vec3A::new(1.0, 0.0, 1.0)),
+            ..Default::default()
+        };
+        let rays: Vec<RayQuery> = (0..8)
+            .map(|i| {
+                let x = i as f32 * 0.4 - 1.6;
+                RayQuery::new(Vec3::new(x, 0.0, -3.0), Vec3::new(0.0, 0.0, 1.0), f32::INFINITY)
+            })
+            .collect();
+        let p = Packet::load(&rays);
+        let got = p.entry(&node, f32x8::splat(f32::INFINITY)).to_array();
+        let got = got.map(|t| if t.is_nan() { f32::INFINITY } else { t });
+        for (l, r) in rays.iter().enumerate() {
+            let want = box_entry(
+                node.aabb.min,
+                node.aabb.max,
+                r.origin.into(),
+                inverse_direction(r.direction).into(),
+                f32::INFINITY,
+            );
+            assert_eq!(got[l].to_bits(), want.to_bits(), "lane {l}");
+        }
+    }
+}

@@ -1,0 +1,297 @@
+//! Single-ray traversal of the obvhs BVH2: the scalar twin of the packet traversal in
+//! [`super::packet`], and what the packet hands its rays to when its active lanes thin out.
+//!
+//! Both traversals make the same decisions where it matters: the box test is conservative (far
+//! distances grown by 1 + 2γ₃, pbrt-v4 §6.1.2; zero direction components get a finite ±f32::MAX
+//! inverse so no 0·∞ NaN can arise), every triangle is tested with the same watertight routine,
+//! and a tie in t between two triangles goes to the lower triangle index. The closest hit is
+//! therefore the same whatever order the leaves are visited in.
+
+use super::bvh::{Bvh, Hit, TriangleColumns};
+use super::offset::gamma;
+use super::triangle::intersect_triangle;
+use glam::{Vec3, Vec3A};
+
+/// No triangle.
+pub const NO_TRI: u32 = u32::MAX;
+
+/// Far-distance growth that makes the slab test conservative.
+pub const FAR_GROWTH: f32 = 1.0 + 2.0 * gamma(3);
+
+/// One ray query: origin, direction, and the open interval (0, `t_max`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayQuery {
+    /// Origin.
+    pub origin: Vec3,
+    /// Direction (need not be unit length).
+    pub direction: Vec3,
+    /// Hits must have t < t_max.
+    pub t_max: f32,
+}
+
+impl RayQuery {
+    /// A query over (0, t_max).
+    #[must_use]
+    pub fn new(origin: Vec3, direction: Vec3, t_max: f32) -> Self {
+        RayQuery { origin, direction, t_max }
+    }
+    /// True if the ray can be traced at all: finite origin, finite non-zero direction, t_max > 0.
+    #[inline]
+    #[must_use]
+    pub fn is_valid(&self) -> bool {
+        self.origin.is_finite()
+            && self.direction.is_finite()
+            && self.direction != Vec3::ZERO
+            && self.t_max > 0.0
+            && !self.t_max.is_nan()
+    }
+}
+
+/// 1/d, with ±f32::MAX where that overflows (d = ±0 or subnormal): finite, so (b − o)·inv is
+/// never 0·∞.
+#[inline]
+#[must_use]
+pub fn safe_inverse(d: f32) -> f32 {
+    let i = 1.0 / d;
+    if i.is_finite() {
+        i
+    } else {
+        f32::MAX.copysign(d)
+    }
+}
+
+/// Best hit so far of one ray: t and triangle ([`NO_TRI`] while none).
+#[derive(Clone, Copy, Debug)]
+pub struct Best {
+    /// Distance of the best hit, or the query's t_max.
+    pub t: f32,
+    /// Its triangle.
+    pub tri: u32,
+    /// Its barycentrics.
+    pub b: [f32; 3],
+}
+
+impl Best {
+    /// Nothing hit yet below `t_max`.
+    #[must_use]
+    pub fn new(t_max: f32) -> Self {
+        Best { t: t_max, tri: NO_TRI, b: [0.0; 3] }
+    }
+    /// The hit, if any.
+    #[must_use]
+    pub fn hit(&self) -> Option<Hit> {
+        (self.tri != NO_TRI).then_some(Hit { tri: self.tri, t: self.t, b: self.b })
+    }
+    /// Tests triangle `id` and keeps it if it is closer, or equally close with a lower index.
+    #[inline]
+    pub fn test(&mut self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, id: u32) {
+        let i = id as usize;
+        // Strictly below t_max while nothing is hit; afterwards ties may replace (lower index).
+        let limit = if self.tri == NO_TRI { self.t } else { self.t.next_up() };
+        if let Some(h) = intersect_triangle(o, d, limit, tris.p0[i], tris.p1[i], tris.p2[i]) {
+            if h.t < self.t || id < self.tri {
+                *self = Best { t: h.t, tri: id, b: h.b };
+            }
+        }
+    }
+}
+
+/// Entry distance (≥ 0) of the ray into the box, or +∞ when it misses or enters beyond `t_max`
+/// (entry exactly at `t_max` counts: a tie may still win).
+#[inline]
+#[must_use]
+pub fn box_entry(min: Vec3A, max: Vec3A, o: Vec3A, inv: Vec3A, t_max: f32) -> f32 {
+    let t0 = (min - o) * inv;
+    let t1 = (max - o) * inv;
+    let near = t0.min(t1).max_element().max(0.0);
+    let far = t0.max(t1).min_element() * FAR_GROWTH;
+    if near <= far && near <= t_max {
+        near
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// A traversal stack: inline up to 96 entries, spilling to the heap beyond (deep trees only).
+pub struct Stack<T: Copy + Default> {
+    inline: [T; 96],
+    len: usize,
+    spill: Vec<T>,
+}
+
+impl<T: Copy + Default> Stack<T> {
+    /// An empty stack.
+    #[must_use]
+    pub fn new() -> Self {
+        Stack { inline: [T::default(); 96], len: 0, spill: Vec::new() }
+    }
+    /// Pushes `v`.
+    #[inline]
+    pub fn push(&mut self, v: T) {
+        if self.len < self.inline.len() {
+            self.inline[self.len] = v;
+            self.len += 1;
+        } else {
+            self.spill.push(v);
+        }
+    }
+    /// Pops the top.
+    #[inline]
+    pub fn pop(&mut self) -> Option<T> {
+        if let Some(v) = self.spill.pop() {
+            return Some(v);
+        }
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        Some(self.inline[self.len])
+    }
+}
+
+impl<T: Copy + Default> Default for Stack<T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Closest-hit traversal of one ray from node `start` (entry distance `start_t`), updating
+/// `best`. Used for whole rays and for lanes a packet hands over.
+#[allow(clippy::too_many_arguments)]
+pub fn closest_from(
+    bvh: &Bvh,
+    tris: TriangleColumns<'_>,
+    start: u32,
+    start_t: f32,
+    o: Vec3,
+    d: Vec3,
+    inv: Vec3,
+    best: &mut Best,
+    stack: &mut Stack<(u32, f32)>,
+) {
+    let nodes = bvh.nodes();
+    let (oa, inva) = (Vec3A::from(o), Vec3A::from(inv));
+    stack.push((start, start_t));
+    while let Some((n, tn)) = stack.pop() {
+        if tn > best.t {
+            continue;
+        }
+        let node = &nodes[n as usize];
+        if node.prim_count > 0 {
+            for id in node.first_index..node.first_index + node.prim_count {
+                best.test(tris, o, d, id);
+            }
+            continue;
+        }
+        let (l, r) = (node.first_index, node.first_index + 1);
+        let bl = &nodes[l as usize].aabb;
+        let br = &nodes[r as usize].aabb;
+        let tl = box_entry(bl.min, bl.max, oa, inva, best.t);
+        let tr = box_entry(br.min, br.max, oa, inva, best.t);
+        let ((near, tnear), (far, tfar)) = if tl <= tr { ((l, tl), (r, tr)) } else { ((r, tr), (l, tl)) };
+        if tfar.is_finite() {
+            stack.push((far, tfar));
+        }
+        if tnear.is_finite() {
+            stack.push((near, tnear));
+        }
+    }
+}
+
+/// Any-hit traversal of one ray from node `start`: true at the first triangle hit in (0, t_max).
+#[allow(clippy::too_many_arguments)]
+pub fn occluded_from(
+    bvh: &Bvh,
+    tris: TriangleColumns<'_>,
+    start: u32,
+    o: Vec3,
+    d: Vec3,
+    inv: Vec3,
+    t_max: f32,
+    stack: &mut Stack<u32>,
+) -> bool {
+    let nodes = bvh.nodes();
+    let (oa, inva) = (Vec3A::from(o), Vec3A::from(inv));
+    stack.push(start);
+    while let Some(n) = stack.pop() {
+        let node = &nodes[n as usize];
+        if node.prim_count > 0 {
+            for id in node.first_index..node.first_index + node.prim_count {
+                let i = id as usize;
+                if intersect_triangle(o, d, t_max, tris.p0[i], tris.p1[i], tris.p2[i]).is_some() {
+                    while stack.pop().is_some() {}
+                    return true;
+                }
+            }
+            continue;
+        }
+        // Nearer child first: occluders near the origin end the search early.
+        let (l, r) = (node.first_index, node.first_index + 1);
+        let bl = &nodes[l as usize].aabb;
+        let br = &nodes[r as usize].aabb;
+        let tl = box_entry(bl.min, bl.max, oa, inva, t_max);
+        let tr = box_entry(br.min, br.max, oa, inva, t_max);
+        let ((near, tnear), (far, tfar)) = if tl <= tr { ((l, tl), (r, tr)) } else { ((r, tr), (l, tl)) };
+        if tfar.is_finite() {
+            stack.push(far);
+        }
+        if tnear.is_finite() {
+            stack.push(near);
+        }
+    }
+    false
+}
+
+/// Inverse direction with finite components.
+#[inline]
+#[must_use]
+pub fn inverse_direction(d: Vec3) -> Vec3 {
+    Vec3::new(safe_inverse(d.x), safe_inverse(d.y), safe_inverse(d.z))
+}
+
+/// Closest hit of one ray.
+#[must_use]
+pub fn closest(bvh: &Bvh, tris: TriangleColumns<'_>, ray: &RayQuery) -> Option<Hit> {
+    if bvh.nodes().is_empty() || !ray.is_valid() {
+        return None;
+    }
+    let inv = inverse_direction(ray.direction);
+    let root = &bvh.nodes()[0].aabb;
+    let t0 = box_entry(root.min, root.max, ray.origin.into(), inv.into(), ray.t_max);
+    if !t0.is_finite() {
+        return None;
+    }
+    let mut best = Best::new(ray.t_max);
+    let mut stack = Stack::new();
+    closest_from(bvh, tris, 0, t0, ray.origin, ray.direction, inv, &mut best, &mut stack);
+    best.hit()
+}
+
+/// True if anything is hit in (0, t_max).
+#[must_use]
+pub fn occluded(bvh: &Bvh, tris: TriangleColumns<'_>, ray: &RayQuery) -> bool {
+    if bvh.nodes().is_empty() || !ray.is_valid() {
+        return false;
+    }
+    let inv = inverse_direction(ray.direction);
+    let root = &bvh.nodes()[0].aabb;
+    if !box_entry(root.min, root.max, ray.origin.into(), inv.into(), ray.t_max).is_finite() {
+        return false;
+    }
+    occluded_from(bvh, tris, 0, ray.origin, ray.direction, inv, ray.t_max, &mut Stack::new())
+}
+
+/// Scalar twin of [`super::packet::closest_packets`]: closest hits of `rays` into `out`, one ray
+/// at a time.
+pub fn closest_rays(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [Option<Hit>]) {
+    for (r, o) in rays.iter().zip(out.iter_mut()) {
+        *o = closest(bvh, tris, r);
+    }
+}
+
+/// Scalar twin of [`super::packet::occluded_packets`].
+pub fn occluded_rays(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [bool]) {
+    for (r, o) in rays.iter().zip(out.iter_mut()) {
+        *o = occluded(bvh, tris, r);
+    }
+}

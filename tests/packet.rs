@@ -1,0 +1,171 @@
+//! Packet traversal against its scalar twin, lane by lane: random rays on the bundled scenes and
+//! the edge cases where slab tests and triangle tests usually disagree.
+
+mod common;
+
+use common::*;
+use glam::Vec3;
+use photonwave::geometry::bvh::TriangleColumns;
+use photonwave::geometry::packet::{closest_packets, occluded_packets};
+use photonwave::geometry::traverse::{closest_rays, occluded_rays};
+use photonwave::geometry::{Bvh, Hit, RayQuery};
+use photonwave::rng::{Domain, Sampler};
+use photonwave::sampling::uniform_sphere;
+
+/// Runs both twins on `rays` and asserts identical results lane by lane; returns the hits.
+fn agree(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery]) -> Vec<Option<Hit>> {
+    let mut a = vec![None; rays.len()];
+    let mut b = vec![None; rays.len()];
+    closest_rays(bvh, tris, rays, &mut a);
+    closest_packets(bvh, tris, rays, &mut b);
+    for (i, (x, y)) in a.iter().zip(&b).enumerate() {
+        assert_eq!(x, y, "closest hit differs for ray {i}: {:?}", rays[i]);
+    }
+    let mut oa = vec![false; rays.len()];
+    let mut ob = vec![false; rays.len()];
+    occluded_rays(bvh, tris, rays, &mut oa);
+    occluded_packets(bvh, tris, rays, &mut ob);
+    for (i, (x, y)) in oa.iter().zip(&ob).enumerate() {
+        assert_eq!(x, y, "any hit differs for ray {i}: {:?}", rays[i]);
+        // Any hit and closest hit agree on whether something is in (0, t_max).
+        assert_eq!(*x, a[i].is_some(), "any vs closest for ray {i}");
+    }
+    a
+}
+
+fn random_rays(scene: &photonwave::scene::Scene, n: u64, seed: u64) -> Vec<RayQuery> {
+    let c = scene.centre();
+    let r = scene.radius();
+    (0..n)
+        .map(|i| {
+            let s = Sampler::new(seed, Domain::Camera, i);
+            let o = c + uniform_sphere([s.get(0, 0), s.get(0, 1)]) * r * s.get(0, 2) * 1.5;
+            let d = uniform_sphere([s.get(0, 3), s.get(0, 4)]);
+            let t_max = if i % 3 == 0 { f32::INFINITY } else { r * s.get(0, 5) * 2.0 };
+            RayQuery::new(o, d, t_max)
+        })
+        .collect()
+}
+
+#[test]
+fn packets_match_scalar_on_random_rays() {
+    for name in ["cornell-box.toml", "cornell-spheres.toml", "furnace.toml"] {
+        let loaded = load(name);
+        let s = &loaded.scene;
+        let rays = random_rays(s, 4000, 7);
+        let hits = agree(s.bvh(), s.columns(), &rays);
+        assert!(hits.iter().filter(|h| h.is_some()).count() > 1000, "{name}: too few hits to mean anything");
+    }
+}
+
+#[test]
+fn packets_match_scalar_on_coherent_camera_rays() {
+    let loaded = load("cornell-spheres.toml");
+    let s = &loaded.scene;
+    let cam = loaded.camera.unwrap().prepare(64, 64).unwrap();
+    let rays: Vec<RayQuery> = (0..64 * 64)
+        .map(|i| {
+            let (o, d) = cam.ray((i % 64) as f32 + 0.5, (i / 64) as f32 + 0.5);
+            RayQuery::new(o, d, f32::INFINITY)
+        })
+        .collect();
+    let hits = agree(s.bvh(), s.columns(), &rays);
+    for (h, r) in hits.iter().zip(&rays) {
+        let o = s.bvh().closest_obvhs(s.columns(), r.origin, r.direction, r.t_max);
+        assert_eq!(h.map(|h| h.tri), o.map(|h| h.tri), "{r:?} vs obvhs");
+    }
+    // The box is open toward the camera; the corner pixels see past its front edges.
+    assert!(hits.iter().filter(|h| h.is_some()).count() > 64 * 60, "most camera rays hit the box");
+}
+
+#[test]
+fn packets_match_scalar_on_edges_vertices_and_slab_planes() {
+    let loaded = load("cornell-box.toml");
+    let s = &loaded.scene;
+    let c = s.centre();
+    let mut rays = vec![];
+    for t in 0..s.triangle_count() {
+        let (p0, p1, p2) = (s.p0[t], s.p1[t], s.p2[t]);
+        // Exactly at vertices and edge midpoints, from the centre and from outside along axes.
+        for target in [p0, p1, p2, (p0 + p1) * 0.5, (p1 + p2) * 0.5, (p2 + p0) * 0.5] {
+            rays.push(RayQuery::new(c, target - c, f32::INFINITY));
+            // Axis-aligned rays whose other two direction components are exactly zero and whose
+            // origin lies on the slab planes of the boxes that hold the target.
+            for axis in 0..3 {
+                let mut o = target;
+                o[axis] = c[axis];
+                let mut d = Vec3::ZERO;
+                d[axis] = if target[axis] >= c[axis] { 1.0 } else { -1.0 };
+                rays.push(RayQuery::new(o, d, f32::INFINITY));
+            }
+        }
+        // Grazing: in the triangle's plane, along an edge.
+        rays.push(RayQuery::new(p0 - (p1 - p0), p1 - p0, f32::INFINITY));
+        // Hit distance exactly t_max (must not count: the interval is open).
+        let h = s.intersect(c, (p0 + p1 + p2) / 3.0 - c, f32::INFINITY);
+        if let Some(h) = h {
+            rays.push(RayQuery::new(c, (p0 + p1 + p2) / 3.0 - c, h.t));
+        }
+    }
+    // Invalid input: NaN, ±inf, zero direction, zero and negative t_max.
+    let bad = [
+        RayQuery::new(Vec3::splat(f32::NAN), Vec3::X, f32::INFINITY),
+        RayQuery::new(c, Vec3::new(f32::NAN, 0.0, 1.0), f32::INFINITY),
+        RayQuery::new(c, Vec3::new(f32::INFINITY, 0.0, 0.0), f32::INFINITY),
+        RayQuery::new(Vec3::splat(f32::NEG_INFINITY), Vec3::X, f32::INFINITY),
+        RayQuery::new(c, Vec3::ZERO, f32::INFINITY),
+        RayQuery::new(c, Vec3::X, 0.0),
+        RayQuery::new(c, Vec3::X, -1.0),
+        RayQuery::new(c, Vec3::X, f32::NAN),
+    ];
+    rays.extend(bad);
+    let hits = agree(s.bvh(), s.columns(), &rays);
+    for h in &hits[hits.len() - bad.len()..] {
+        assert!(h.is_none(), "invalid rays hit nothing");
+    }
+    // Vertex- and edge-aimed rays from inside the closed box never slip through.
+    let from_centre = hits.iter().zip(&rays).filter(|(_, r)| r.origin == c && r.t_max.is_infinite() && r.is_valid());
+    for (h, r) in from_centre {
+        assert!(h.is_some(), "ray {r:?} slipped through an edge or vertex");
+    }
+}
+
+#[test]
+fn packets_match_scalar_on_a_flat_mesh_with_slivers_and_degenerate_triangles() {
+    // A unit grid in z = 0 (boxes flat in z), plus zero-area and sliver triangles.
+    let n = 16;
+    let (mut p0, mut p1, mut p2) = (vec![], vec![], vec![]);
+    for i in 0..n {
+        for j in 0..n {
+            let q = |a: usize, b: usize| Vec3::new(a as f32 / n as f32, b as f32 / n as f32, 0.0);
+            p0.extend([q(i, j), q(i, j)]);
+            p1.extend([q(i + 1, j), q(i + 1, j + 1)]);
+            p2.extend([q(i + 1, j + 1), q(i, j + 1)]);
+        }
+    }
+    p0.extend([Vec3::new(0.5, 0.5, 0.5), Vec3::new(0.0, 0.0, 0.25)]);
+    p1.extend([Vec3::new(0.5, 0.5, 0.5), Vec3::new(1.0, 1.0, 0.25)]);
+    p2.extend([Vec3::new(0.6, 0.5, 0.5), Vec3::new(1.0, 1.0 + 1e-6, 0.25)]);
+    let (bvh, order) = Bvh::build(&p0, &p1, &p2);
+    let pick = |v: &Vec<Vec3>| order.iter().map(|&i| v[i as usize]).collect::<Vec<_>>();
+    let (q0, q1, q2) = (pick(&p0), pick(&p1), pick(&p2));
+    let cols = TriangleColumns { p0: &q0, p1: &q1, p2: &q2 };
+    let mut rays = vec![];
+    for i in 0..=4 * n {
+        for j in 0..=4 * n {
+            // Straight down onto grid lines and vertices (x, y multiples of 1/4n), direction
+            // components exactly zero, origins on the boxes' x/y slab planes.
+            let (x, y) = (i as f32 / (4 * n) as f32, j as f32 / (4 * n) as f32);
+            rays.push(RayQuery::new(Vec3::new(x, y, 1.0), Vec3::new(0.0, 0.0, -1.0), f32::INFINITY));
+            // Grazing: nearly in the plane.
+            rays.push(RayQuery::new(Vec3::new(x, -0.5, 1e-7), Vec3::new(0.0, 1.0, -1e-7), f32::INFINITY));
+        }
+    }
+    let hits = agree(&bvh, cols, &rays);
+    for (h, r) in hits.iter().zip(&rays).step_by(2) {
+        let o = bvh.closest_obvhs(cols, r.origin, r.direction, r.t_max);
+        assert_eq!(h.is_some(), o.is_some(), "{r:?} vs obvhs");
+    }
+    let down = hits.iter().step_by(2).filter(|h| h.is_some()).count();
+    assert_eq!(down, (4 * n + 1) * (4 * n + 1), "every ray straight down onto the closed grid hits");
+}
