@@ -93,27 +93,6 @@ fn tile_pixel(i: u32) -> (u32, u32) {
     ((tile % tiles_x) * 8 + within % 8, (tile / tiles_x) * 8 + within / 8)
 }
 
-/// The coherence key of a ray: direction octant in the top 3 bits, then the Morton code of its
-/// origin's cell in a 64³ grid over `bounds`, then the direction within the octant quantised
-/// to 4 × 4 bins — so that a run of 8 rays in key order starts close together and points alike.
-#[must_use]
-pub fn coherence_key(o: Vec3, d: Vec3, bounds: (Vec3, Vec3)) -> u32 {
-    let octant = u32::from(d.x < 0.0) | u32::from(d.y < 0.0) << 1 | u32::from(d.z < 0.0) << 2;
-    let ext = (bounds.1 - bounds.0).max(Vec3::splat(f32::MIN_POSITIVE));
-    let cell = ((o - bounds.0) / ext * 64.0).clamp(Vec3::ZERO, Vec3::splat(63.0));
-    let spread = |v: f32| {
-        let mut x = v as u32 & 63;
-        x = (x | x << 8) & 0x0000_f00f;
-        x = (x | x << 4) & 0x0000_30c3;
-        (x | x << 2) & 0x0000_9249
-    };
-    let morton = spread(cell.x) | spread(cell.y) << 1 | spread(cell.z) << 2;
-    let a = d.abs() / d.abs().element_sum().max(f32::MIN_POSITIVE);
-    let bin = |v: f32| ((v * 4.0) as u32).min(3);
-    let dir = bin(a.x) << 2 | bin(a.y);
-    octant << 29 | morton << 4 | dir
-}
-
 impl RaySets {
     /// Builds the sets (deterministic: fixed seed).
     #[must_use]
@@ -142,7 +121,7 @@ impl RaySets {
             let d = Frame::new(ng).to_world(cosine_hemisphere([s.get(0, 3), s.get(0, 4)]));
             diffuse.push(RayQuery::new(offset_ray_origin(sp.p, sp.p_error, ng, d), d, f32::INFINITY));
         }
-        diffuse.sort_by_key(|r| coherence_key(r.origin, r.direction, scene.bounds));
+        diffuse.sort_by_key(|r| crate::kernels::coherence_key(r.origin, r.direction, scene.bounds));
         RaySets { camera, shadow, diffuse, hits }
     }
 }
@@ -408,9 +387,96 @@ pub fn table(traversal: &[TraversalRow], density: &[DensityRow]) -> String {
     s
 }
 
-/// SIMD against scalar density estimates (filled in by the density kernels).
-fn density(_name: &str, _scene: &Scene, _sets: &RaySets, _threads: usize, _reps: usize) -> Vec<DensityRow> {
-    vec![]
+/// Photons in the bench's global map.
+pub const BENCH_PHOTONS: u32 = 200_000;
+
+/// Queries per density row.
+const QUERIES: usize = 65_536;
+
+/// SIMD against scalar density estimates on the scene's global photon map (default settings,
+/// [`BENCH_PHOTONS`] photons), at the camera hits (in tile order, as the camera pass asks),
+/// Lambertian reflectance. `knn`: the k = 64 nearest under the default maximum radius;
+/// `radius`: every photon within a fixed radius, the median radius the k-NN lookups found.
+fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usize) -> Vec<DensityRow> {
+    use crate::kernels::KernelSet;
+    use crate::photon_map::{Filter, Lookup, Reflectance};
+    use crate::reference::build_maps;
+    use crate::settings::Settings;
+    if sets.hits.is_empty() {
+        return vec![];
+    }
+    let settings = Settings { photons: BENCH_PHOTONS, threads: threads as u32, ..Default::default() };
+    let (maps, _, _) = build_maps(scene, &settings);
+    let map = &maps.global;
+    if map.is_empty() {
+        return vec![];
+    }
+    let step = sets.hits.len().div_ceil(QUERIES).max(1);
+    let queries: Vec<(Vec3, Vec3)> = sets.hits.iter().step_by(step).copied().collect();
+    let r_max = settings.global_radius * scene.diagonal();
+    let lookup = |p: Vec3, n: Vec3, k: usize, r: f32| Lookup {
+        p,
+        k,
+        r_max: r,
+        kernel: settings.kernel,
+        filter: Filter { n, flags_mask: 0 },
+    };
+    let f = |n: Vec3| Reflectance::Hemisphere { value: Vec3::splat(0.5 / std::f32::consts::PI), ng: n };
+    let knn = |set: KernelSet| {
+        map_chunks(
+            queries.len(),
+            CHUNK,
+            threads,
+            |r| {
+                let mut scratch = Vec::new();
+                queries[r]
+                    .iter()
+                    .map(|&(p, n)| map.estimate(set, &lookup(p, n, settings.k as usize, r_max), f(n), &mut scratch))
+                    .collect::<Vec<_>>()
+            },
+            |_| {},
+        )
+        .concat()
+    };
+    let radius_lookup = |set: KernelSet, r: f32| {
+        map_chunks(
+            queries.len(),
+            CHUNK,
+            threads,
+            |range| {
+                queries[range]
+                    .iter()
+                    .map(|&(p, n)| map.estimate_radius(set, &lookup(p, n, 0, r), f(n)).radiance.x)
+                    .sum::<f32>()
+            },
+            |_| {},
+        )
+        .into_iter()
+        .sum::<f32>()
+    };
+    let mut radii: Vec<f64> = knn(KernelSet::Scalar).iter().map(|e| f64::from(e.radius)).collect();
+    let r_fixed = if radii.is_empty() { r_max } else { median(std::mem::take(&mut radii)) as f32 };
+    let (ts, tk) = time_pair(reps, || drop(knn(KernelSet::Simd)), || drop(knn(KernelSet::Scalar)));
+    let (rs, rk) = time_pair(
+        reps,
+        || {
+            std::hint::black_box(radius_lookup(KernelSet::Simd, r_fixed));
+        },
+        || {
+            std::hint::black_box(radius_lookup(KernelSet::Scalar, r_fixed));
+        },
+    );
+    let n = queries.len() as f64;
+    let row = |lookup, simd: f64, scalar: f64| DensityRow {
+        scene: name.to_string(),
+        lookup,
+        count: queries.len(),
+        photons: map.len(),
+        simd_per_s: n / simd,
+        scalar_per_s: n / scalar,
+        ratio: scalar / simd,
+    };
+    vec![row("knn", ts, tk), row("radius", rs, rk)]
 }
 
 /// Closest-hit throughput (Mrays/s, median) of packet traversal on each ray set for each

@@ -8,6 +8,7 @@
 
 use crate::geometry::bvh::{Bvh, Hit, TriangleColumns};
 use crate::geometry::{packet, traverse, RayQuery};
+use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 /// Which implementation of the SIMD kernels runs.
@@ -35,6 +36,88 @@ impl KernelSet {
         match self {
             KernelSet::Simd => packet::occluded_packets(bvh, tris, rays, out),
             KernelSet::Scalar => traverse::occluded_rays(bvh, tris, rays, out),
+        }
+    }
+}
+
+/// The coherence key of a ray: direction octant in the top 3 bits, then the Morton code of its
+/// origin's cell in a 64³ grid over `bounds`, then the direction within the octant quantised
+/// to 4 × 4 bins — so that a run of 8 rays in key order starts close together and points alike.
+#[must_use]
+pub fn coherence_key(o: Vec3, d: Vec3, bounds: (Vec3, Vec3)) -> u32 {
+    let octant = u32::from(d.x < 0.0) | u32::from(d.y < 0.0) << 1 | u32::from(d.z < 0.0) << 2;
+    let ext = (bounds.1 - bounds.0).max(Vec3::splat(f32::MIN_POSITIVE));
+    let cell = ((o - bounds.0) / ext * 64.0).clamp(Vec3::ZERO, Vec3::splat(63.0));
+    let spread = |v: f32| {
+        let mut x = v as u32 & 63;
+        x = (x | x << 8) & 0x0000_f00f;
+        x = (x | x << 4) & 0x0000_30c3;
+        (x | x << 2) & 0x0000_9249
+    };
+    let morton = spread(cell.x) | spread(cell.y) << 1 | spread(cell.z) << 2;
+    let a = d.abs() / d.abs().element_sum().max(f32::MIN_POSITIVE);
+    let bin = |v: f32| ((v * 4.0) as u32).min(3);
+    let dir = bin(a.x) << 2 | bin(a.y);
+    octant << 29 | morton << 4 | dir
+}
+
+/// Traces `rays` in coherence-key order (packets of 8 that start close together and point
+/// alike) and returns the results in the input order. The SIMD kernels' results do not depend on
+/// the order (each lane's hit is the scalar twin's), so sorting changes speed only.
+fn in_coherent_order<T: Copy + Default>(
+    rays: &[RayQuery],
+    bounds: (Vec3, Vec3),
+    trace: impl FnOnce(&[RayQuery], &mut [T]),
+) -> Vec<T> {
+    let mut order: Vec<(u32, u32)> =
+        rays.iter().enumerate().map(|(i, r)| (coherence_key(r.origin, r.direction, bounds), i as u32)).collect();
+    order.sort_unstable();
+    let sorted: Vec<RayQuery> = order.iter().map(|&(_, i)| rays[i as usize]).collect();
+    let mut traced = vec![T::default(); rays.len()];
+    trace(&sorted, &mut traced);
+    let mut out = vec![T::default(); rays.len()];
+    for (&(_, i), t) in order.iter().zip(traced) {
+        out[i as usize] = t;
+    }
+    out
+}
+
+impl KernelSet {
+    /// Closest hits of `rays` (in input order); the SIMD set traces them sorted for coherence.
+    #[must_use]
+    pub fn closest_coherent(
+        self,
+        bvh: &Bvh,
+        tris: TriangleColumns<'_>,
+        rays: &[RayQuery],
+        bounds: (Vec3, Vec3),
+    ) -> Vec<Option<Hit>> {
+        match self {
+            KernelSet::Simd => in_coherent_order(rays, bounds, |r, o| packet::closest_packets(bvh, tris, r, o)),
+            KernelSet::Scalar => {
+                let mut out = vec![None; rays.len()];
+                traverse::closest_rays(bvh, tris, rays, &mut out);
+                out
+            }
+        }
+    }
+
+    /// Any-hit tests of `rays` (in input order); the SIMD set traces them sorted for coherence.
+    #[must_use]
+    pub fn occluded_coherent(
+        self,
+        bvh: &Bvh,
+        tris: TriangleColumns<'_>,
+        rays: &[RayQuery],
+        bounds: (Vec3, Vec3),
+    ) -> Vec<bool> {
+        match self {
+            KernelSet::Simd => in_coherent_order(rays, bounds, |r, o| packet::occluded_packets(bvh, tris, r, o)),
+            KernelSet::Scalar => {
+                let mut out = vec![false; rays.len()];
+                traverse::occluded_rays(bvh, tris, rays, &mut out);
+                out
+            }
         }
     }
 }

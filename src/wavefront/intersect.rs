@@ -1,10 +1,12 @@
 //! Intersect: closest hits for every lane of the photon or path queue, and any-hit tests for
-//! the shadow queue. Reads rays; writes hit columns (and, for shadow rays, the unblocked
+//! the shadow queue, with the configured kernels (8-wide packets by default, each chunk traced
+//! in coherence-key order). Reads rays; writes hit columns (and, for shadow rays, the unblocked
 //! contributions into the wave's terms, in lane order).
 
 use super::queues::PathKind;
 use super::queues::{HitColumns, RayColumns};
 use super::{add_term, par_columns, par_lanes, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
+use crate::geometry::RayQuery;
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
@@ -19,7 +21,10 @@ fn closest_hits(shared: &Shared, rays: &RayColumns, hits: &mut HitColumns) {
         shared.threads,
         |r, part: &mut HitColumns| {
             part.reserve(r.len());
-            part.extend(r.map(|i| scene.intersect(rays.origin(i), rays.direction(i), f32::INFINITY)))
+            let queries: Vec<RayQuery> =
+                r.map(|i| RayQuery::new(rays.origin(i), rays.direction(i), f32::INFINITY)).collect();
+            let hits = shared.settings.kernels.closest_coherent(scene.bvh(), scene.columns(), &queries, scene.bounds);
+            part.extend(hits.into_iter())
         },
         |part| hits.append(part),
     );
@@ -57,7 +62,9 @@ pub fn trace_shadow_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
     let q = &w.shadows;
     let n = q.len();
     let blocked = par_lanes(n, CHUNK, shared.threads, |r| {
-        r.map(|i| scene.occluded(q.rays.origin(i), q.rays.direction(i), q.t_max[i])).collect()
+        let queries: Vec<RayQuery> =
+            r.map(|i| RayQuery::new(q.rays.origin(i), q.rays.direction(i), q.t_max[i])).collect();
+        shared.settings.kernels.occluded_coherent(scene.bvh(), scene.columns(), &queries, scene.bounds)
     });
     for (i, b) in blocked.into_iter().enumerate() {
         if !b {

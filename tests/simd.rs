@@ -1,0 +1,201 @@
+//! The 8-wide photon lookups against their scalar twins, lookup by lookup, and whole renders
+//! with the SIMD kernels against renders with the scalar twins.
+
+mod common;
+
+use common::*;
+use glam::Vec3;
+use photonwave::kernels::KernelSet;
+use photonwave::photon_map::{flags, Filter, Lookup, Photon, PhotonMap, Reflectance};
+use photonwave::rng::{Domain, Sampler};
+use photonwave::sampling::uniform_sphere;
+use photonwave::settings::{Kernel, Settings};
+
+/// Photons on three faces of a corner (floor, wall, ceiling-facing), with random powers,
+/// directions and flags, plus photons placed on exact lattice points.
+fn corner_photons(n: u64) -> Vec<Photon> {
+    let mut v: Vec<Photon> = (0..n)
+        .map(|i| {
+            let s = Sampler::new(3, Domain::GlobalPhoton, i);
+            let (a, b) = (s.get(0, 0), s.get(0, 1));
+            let (position, normal) = match i % 3 {
+                0 => (Vec3::new(a, 0.0, b), Vec3::Y),
+                1 => (Vec3::new(a, b, 0.0), Vec3::Z),
+                _ => (Vec3::new(0.0, a, b), Vec3::X),
+            };
+            let mut wi = uniform_sphere([s.get(0, 2), s.get(0, 3)]);
+            if wi.dot(normal) < 0.0 {
+                wi = -wi;
+            }
+            let power = Vec3::new(s.get(0, 4), s.get(0, 5), s.get(0, 6)) * 1e-3;
+            Photon { position, power, wi, normal, flags: (i % 4) as u8 & (flags::DIRECT | flags::CAUSTIC) }
+        })
+        .collect();
+    // A lattice: many photons at exactly equal distances from lattice-aligned queries.
+    for i in 0..20 {
+        for j in 0..20 {
+            let position = Vec3::new(0.5 + i as f32 * 0.01, 0.0, 0.5 + j as f32 * 0.01);
+            v.push(Photon { position, power: Vec3::splat(1e-3), wi: Vec3::Y, normal: Vec3::Y, flags: 0 });
+        }
+    }
+    v
+}
+
+fn queries() -> Vec<(Vec3, Vec3)> {
+    let mut q: Vec<(Vec3, Vec3)> = (0..2000u64)
+        .map(|i| {
+            let s = Sampler::new(4, Domain::Camera, i);
+            let (a, b) = (s.get(0, 0), s.get(0, 1));
+            match i % 3 {
+                0 => (Vec3::new(a, 0.0, b), Vec3::Y),
+                1 => (Vec3::new(a, b, 0.0), Vec3::Z),
+                _ => (Vec3::new(0.0, a, b), Vec3::X),
+            }
+        })
+        .collect();
+    // On the lattice, in the corner edge, and outside everything.
+    q.extend([
+        (Vec3::new(0.55, 0.0, 0.55), Vec3::Y),
+        (Vec3::new(0.6, 0.0, 0.6), Vec3::Y),
+        (Vec3::ZERO, Vec3::Y),
+        (Vec3::new(0.5, 0.0, 0.0), Vec3::Z),
+        (Vec3::splat(10.0), Vec3::Y),
+    ]);
+    q
+}
+
+fn sorted(mut v: Vec<(f32, u32)>) -> Vec<(f32, u32)> {
+    v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    v
+}
+
+/// |a − b| ≤ 1e-5·max(|a|, |b|) per channel: sums of the same terms in another order.
+fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).abs().cmple(a.abs().max(b.abs()) * 1e-5 + Vec3::splat(1e-30)).all()
+}
+
+#[test]
+fn simd_lookups_find_the_same_photons_as_the_scalar_twins() {
+    let map = PhotonMap::build(corner_photons(30_000));
+    let (mut a, mut b) = (vec![], vec![]);
+    let glossy = |wi: Vec3| Vec3::splat(wi.y.max(0.0).powi(8));
+    for (qi, (p, n)) in queries().into_iter().enumerate() {
+        for (k, r_max, flags_mask) in [(1, 0.05, 0), (16, 0.02, 0), (64, 0.1, flags::DIRECT), (200, 0.01, 0)] {
+            for kernel in [Kernel::Box, Kernel::Cone, Kernel::Epanechnikov] {
+                let q = Lookup { p, k, r_max, kernel, filter: Filter { n, flags_mask } };
+                map.nearest(KernelSet::Simd, &q, &mut a);
+                map.nearest(KernelSet::Scalar, &q, &mut b);
+                assert_eq!(sorted(a.clone()), sorted(b.clone()), "query {qi} {q:?}: different photons");
+                let lambert = Reflectance::Hemisphere { value: Vec3::splat(0.3), ng: n };
+                for f in [Reflectance::Constant(Vec3::ONE), lambert, Reflectance::PerPhoton(&glossy)] {
+                    let es = map.estimate(KernelSet::Simd, &q, f, &mut a);
+                    let ek = map.estimate(KernelSet::Scalar, &q, f, &mut b);
+                    assert_eq!(es.count, ek.count, "query {qi}");
+                    assert_eq!(es.radius, ek.radius, "query {qi}");
+                    assert!(close(es.radiance, ek.radiance), "query {qi}: {:?} vs {:?}", es.radiance, ek.radiance);
+                    let rs = map.estimate_radius(KernelSet::Simd, &q, f);
+                    let rk = map.estimate_radius(KernelSet::Scalar, &q, f);
+                    assert_eq!(rs.count, rk.count, "query {qi}: radius lookup counts");
+                    assert!(close(rs.radiance, rk.radiance), "query {qi}: {:?} vs {:?}", rs.radiance, rk.radiance);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn lookups_honour_the_radius_and_the_filters_exactly() {
+    // Photons at exactly the search radius are outside (the interval is open), on both twins;
+    // photons on the perpendicular wall or with a masked flag are never found.
+    let r = 0.25f32;
+    let mut photons = vec![];
+    for (i, d) in [Vec3::X, Vec3::Z, -Vec3::X, -Vec3::Z].into_iter().enumerate() {
+        photons.push(Photon { position: d * r, power: Vec3::ONE, wi: Vec3::Y, normal: Vec3::Y, flags: 0 });
+        photons.push(Photon { position: d * r * 0.5, power: Vec3::ONE, wi: Vec3::Y, normal: Vec3::Y, flags: 0 });
+        // A wall photon right at the query, and a masked one.
+        photons.push(Photon { position: d * 0.01, power: Vec3::ONE, wi: Vec3::X, normal: Vec3::X, flags: 0 });
+        let flags = if i % 2 == 0 { flags::CAUSTIC } else { flags::DIRECT };
+        photons.push(Photon { position: d * 0.02, power: Vec3::ONE, wi: Vec3::Y, normal: Vec3::Y, flags });
+    }
+    let map = PhotonMap::build(photons);
+    for set in [KernelSet::Simd, KernelSet::Scalar] {
+        let q = Lookup {
+            p: Vec3::ZERO,
+            k: 100,
+            r_max: r,
+            kernel: Kernel::Box,
+            filter: Filter { n: Vec3::Y, flags_mask: flags::DIRECT | flags::CAUSTIC },
+        };
+        let mut out = vec![];
+        map.nearest(set, &q, &mut out);
+        assert_eq!(out.len(), 4, "{set:?}: only the four at half the radius");
+        let e = map.estimate_radius(set, &q, Reflectance::Constant(Vec3::ONE));
+        assert_eq!(e.count, 4, "{set:?}");
+        // Box kernel: 4 photons of unit power over πr².
+        let want = 4.0 / (std::f32::consts::PI * r * r);
+        assert!((e.radiance.x - want).abs() < 1e-5 * want, "{set:?}: {} vs {want}", e.radiance.x);
+        // Non-finite queries find nothing and stay finite.
+        for p in [Vec3::splat(f32::NAN), Vec3::splat(f32::INFINITY), Vec3::new(f32::NEG_INFINITY, 0.0, 0.0)] {
+            let q = Lookup { p, ..q };
+            map.nearest(set, &q, &mut out);
+            assert!(out.is_empty(), "{set:?}: {p:?} found photons");
+            let e = map.estimate(set, &q, Reflectance::Constant(Vec3::ONE), &mut out);
+            assert!(e.radiance.is_finite() && e.count == 0, "{set:?}: {p:?}");
+        }
+    }
+}
+
+#[test]
+fn photon_packing_stays_within_its_stated_error_bounds() {
+    // 20 bytes a photon: power per channel within 2⁻⁸ of the largest channel, incoming direction
+    // within 1°, normal within 4° (photon_map.rs module notes).
+    assert_eq!(PhotonMap::bytes_per_photon(), 20);
+    let photons: Vec<Photon> = (0..5000u64)
+        .map(|i| {
+            let s = Sampler::new(5, Domain::GlobalPhoton, i);
+            let wi = uniform_sphere([s.get(0, 0), s.get(0, 1)]);
+            let normal = uniform_sphere([s.get(0, 2), s.get(0, 3)]);
+            let scale = 10f32.powf(s.get(0, 4) * 12.0 - 6.0);
+            let power = Vec3::new(s.get(0, 5), s.get(0, 6), s.get(0, 7)) * scale;
+            Photon { position: Vec3::new(i as f32, 0.0, 0.0), power, wi, normal, flags: (i % 4) as u8 }
+        })
+        .collect();
+    let map = PhotonMap::build(photons.clone());
+    for i in 0..map.len() {
+        let got = map.photon(i);
+        let want = photons[got.position.x as usize];
+        let max = want.power.max_element();
+        assert!(
+            (got.power - want.power).abs().max_element() <= max / 256.0,
+            "{i}: {:?} vs {:?}",
+            got.power,
+            want.power
+        );
+        assert!(got.wi.dot(want.wi) >= 1f32.to_radians().cos(), "{i}: wi {:?} vs {:?}", got.wi, want.wi);
+        assert!(got.normal.dot(want.normal) >= 4f32.to_radians().cos(), "{i}: n {:?} vs {:?}", got.normal, want.normal);
+        assert_eq!(got.flags, want.flags);
+    }
+}
+
+#[test]
+fn renders_with_simd_kernels_match_renders_with_scalar_twins() {
+    // Traversal is bit-identical and lookups find the same photons; only the order in which
+    // photon contributions are summed differs. Tolerance 1e-5 relative per pixel and channel.
+    for scene in ["cornell-box.toml", "cornell-spheres.toml"] {
+        let loaded = load(scene);
+        let base = Settings {
+            width: 24,
+            height: 24,
+            spp: 2,
+            photons: 20_000,
+            caustic_photons: 10_000,
+            gather_rays: 4,
+            ..Default::default()
+        };
+        let simd = render(&loaded, &Settings { kernels: KernelSet::Simd, ..base.clone() });
+        let scalar = render(&loaded, &Settings { kernels: KernelSet::Scalar, ..base });
+        for (a, b) in simd.beauty().iter().zip(scalar.beauty()) {
+            assert!(close(*a, b), "{scene}: {a:?} vs {b:?}");
+        }
+    }
+}
