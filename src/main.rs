@@ -106,6 +106,10 @@ struct RenderArgs {
     /// Density-estimation kernel: box, cone, epanechnikov [cone].
     #[arg(long)]
     kernel: Option<Kernel>,
+    /// BVH traversal and photon lookups: `simd` (8-wide packets) or `scalar` (their scalar twins,
+    /// for checking) [simd].
+    #[arg(long)]
+    kernels: Option<photonwave::kernels::KernelSet>,
     /// Final-gather rays per camera sample [16].
     #[arg(long)]
     gather_rays: Option<u32>,
@@ -190,7 +194,7 @@ fn render(args: RenderArgs) -> Result<()> {
     macro_rules! set {
         ($($f:ident),*) => { $( if let Some(v) = args.$f { settings.$f = v; } )* };
     }
-    set!(width, height, spp, photons, caustic_photons, gather_rays, max_depth, seed, threads, kernel);
+    set!(width, height, spp, photons, caustic_photons, gather_rays, max_depth, seed, threads, kernel, kernels);
     if let Some(k) = args.k {
         settings.k = k;
         settings.caustic_k = k;

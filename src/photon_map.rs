@@ -470,6 +470,13 @@ impl PhotonMap {
         // (O(k)) and r² shrinks to the k-th distance. Amortised O(1) per candidate, no heap.
         let by_distance = |a: &(f32, u32), b: &(f32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
         let offer = |out: &mut Vec<(f32, u32)>, r2: &mut f32, d2: f32, i: usize| {
+            if k == 1 {
+                // The nearest alone (precomputed-irradiance lookups): keep the best so far.
+                out.clear();
+                out.push((d2, i as u32));
+                *r2 = d2;
+                return;
+            }
             out.push((d2, i as u32));
             if out.len() == 2 * k {
                 out.select_nth_unstable_by(k - 1, by_distance);

@@ -81,6 +81,8 @@ pub struct RenderStats {
     pub spp: u32,
     /// Worker threads.
     pub threads: usize,
+    /// Traversal and lookup kernels: simd or scalar.
+    pub kernels: String,
     /// Seed.
     pub seed: u64,
     /// The effects plan: each part with whether it ran and why.
@@ -124,6 +126,7 @@ impl RenderStats {
             height: settings.height,
             spp: settings.spp,
             threads,
+            kernels: format!("{:?}", settings.kernels).to_lowercase(),
             seed: settings.seed,
             ..Default::default()
         }
@@ -141,10 +144,11 @@ impl RenderStats {
             }
         };
         format!(
-            "summary ({} engine, {} threads)\n{}{}  rays: {} total ({} camera, {} shadow, {} gather, {} photon)\n  \
+            "summary ({} engine, {} kernels, {} threads)\n{}{}  rays: {} total ({} camera, {} shadow, {} gather, {} photon)\n  \
              time: load {:.2} s, global photons {:.2} s, caustic photons {:.2} s, maps {:.2} s, camera {:.2} s, total {:.2} s\n  \
              non-finite samples dropped: {} camera, {} photon\n",
             self.engine,
+            self.kernels,
             self.threads,
             map("global", &self.global_map),
             map("caustic", &self.caustic_map),

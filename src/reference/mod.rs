@@ -48,11 +48,17 @@ impl PhotonMaps {
         caustic: Vec<Photon>,
         threads: usize,
     ) -> Self {
-        let mut maps = PhotonMaps {
-            global: PhotonMap::build(global),
-            caustic: PhotonMap::build(caustic),
-            irradiance: PhotonMap::default(),
+        // The two trees are independent: built side by side when there is a second thread.
+        let (global, caustic) = if threads > 1 {
+            std::thread::scope(|s| {
+                let c = s.spawn(|| PhotonMap::build(caustic));
+                let g = PhotonMap::build(global);
+                (g, c.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            })
+        } else {
+            (PhotonMap::build(global), PhotonMap::build(caustic))
         };
+        let mut maps = PhotonMaps { global, caustic, irradiance: PhotonMap::default() };
         if Effects::plan(scene, settings).final_gather.on && settings.precompute_irradiance && !maps.global.is_empty() {
             maps.irradiance = precompute_irradiance(&maps.global, scene, settings, threads);
         }
