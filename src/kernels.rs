@@ -101,23 +101,4 @@ impl KernelSet {
             }
         }
     }
-
-    /// Any-hit tests of `rays` (in input order); the SIMD set traces them sorted for coherence.
-    #[must_use]
-    pub fn occluded_coherent(
-        self,
-        bvh: &Bvh,
-        tris: TriangleColumns<'_>,
-        rays: &[RayQuery],
-        bounds: (Vec3, Vec3),
-    ) -> Vec<bool> {
-        match self {
-            KernelSet::Simd => in_coherent_order(rays, bounds, |r, o| packet::occluded_packets(bvh, tris, r, o)),
-            KernelSet::Scalar => {
-                let mut out = vec![false; rays.len()];
-                traverse::occluded_rays(bvh, tris, rays, &mut out);
-                out
-            }
-        }
-    }
 }

@@ -43,6 +43,15 @@ struct BenchArgs {
     /// Timed repetitions of each kernel (alternating with its baseline; medians reported).
     #[arg(long, default_value_t = 5)]
     reps: u32,
+    /// Camera position X,Y,Z for scenes without a camera [fitted to the scene bounds].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    eye: Option<Vec3>,
+    /// Camera target X,Y,Z for scenes without a camera.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    target: Option<Vec3>,
+    /// Vertical field of view in degrees for scenes without a camera [40].
+    #[arg(long)]
+    fov: Option<f32>,
     /// Also time packet closest-hit traversal at each single-ray hand-over threshold (0–4 lanes).
     #[arg(long)]
     thin_sweep: bool,
@@ -294,7 +303,16 @@ fn bench(args: BenchArgs) -> Result<()> {
             load_scene(std::path::Path::new(name))?
         };
         let label = std::path::Path::new(name).file_stem().map_or(name.clone(), |s| s.to_string_lossy().into_owned());
-        let camera = loaded.camera.unwrap_or_else(|| fitted_camera(&loaded.scene, 40.0));
+        let camera = loaded.camera.unwrap_or_else(|| {
+            let mut c = fitted_camera(&loaded.scene, args.fov.unwrap_or(40.0));
+            if let Some(e) = args.eye {
+                c.eye = e;
+            }
+            if let Some(t) = args.target {
+                c.target = t;
+            }
+            c
+        });
         let cam = camera.prepare(bench::SIDE, bench::SIDE)?;
         if !args.json {
             eprintln!("{label}: {} triangles", loaded.scene.triangle_count());

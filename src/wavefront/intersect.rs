@@ -1,6 +1,6 @@
 //! Intersect: closest hits for every lane of the photon or path queue, and any-hit tests for
-//! the shadow queue, with the configured kernels (8-wide packets by default, each chunk traced
-//! in coherence-key order). Reads rays; writes hit columns (and, for shadow rays, the unblocked
+//! the shadow queue, with the configured kernels (8-wide packets by default; path and photon
+//! chunks traced in coherence-key order). Reads rays; writes hit columns (and, for shadow rays, the unblocked
 //! contributions into the wave's terms, in lane order).
 
 use super::queues::PathKind;
@@ -64,7 +64,11 @@ pub fn trace_shadow_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
     let blocked = par_lanes(n, CHUNK, shared.threads, |r| {
         let queries: Vec<RayQuery> =
             r.map(|i| RayQuery::new(q.rays.origin(i), q.rays.direction(i), q.t_max[i])).collect();
-        shared.settings.kernels.occluded_coherent(scene.bvh(), scene.columns(), &queries, scene.bounds)
+        // Shadow rays are queued in camera-lane order, from neighbouring hits toward the same
+        // lights: already coherent, and sorting them cost more than it saved (BENCHMARKS.md).
+        let mut blocked = vec![false; queries.len()];
+        shared.settings.kernels.occluded(scene.bvh(), scene.columns(), &queries, &mut blocked);
+        blocked
     });
     for (i, b) in blocked.into_iter().enumerate() {
         if !b {
