@@ -468,7 +468,9 @@ impl PhotonMap {
         let k = q.k;
         // Candidates gather unsorted in `out`; when 2k have gathered, the k nearest are selected
         // (O(k)) and r² shrinks to the k-th distance. Amortised O(1) per candidate, no heap.
-        let by_distance = |a: &(f32, u32), b: &(f32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+        // Order by (distance², index) as one integer: distances are non-negative (never −0 or
+        // NaN here), so their bit patterns order as the values do.
+        let by_distance = |c: &(f32, u32)| u64::from(c.0.to_bits()) << 32 | u64::from(c.1);
         let offer = |out: &mut Vec<(f32, u32)>, r2: &mut f32, d2: f32, i: usize| {
             if k == 1 {
                 // The nearest alone (precomputed-irradiance lookups): keep the best so far.
@@ -479,7 +481,7 @@ impl PhotonMap {
             }
             out.push((d2, i as u32));
             if out.len() == 2 * k {
-                out.select_nth_unstable_by(k - 1, by_distance);
+                out.select_nth_unstable_by_key(k - 1, by_distance);
                 out.truncate(k);
                 *r2 = out[k - 1].0;
             }
@@ -511,7 +513,7 @@ impl PhotonMap {
             }
         });
         if out.len() > k {
-            out.select_nth_unstable_by(k - 1, by_distance);
+            out.select_nth_unstable_by_key(k - 1, by_distance);
             out.truncate(k);
         }
     }
