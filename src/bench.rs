@@ -479,25 +479,37 @@ fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usiz
     vec![row("knn", ts, tk), row("radius", rs, rk)]
 }
 
-/// Closest-hit throughput (Mrays/s, median) of packet traversal on each ray set for each
+/// Throughput (Mrays/s, median) of packet traversal on each ray set and query for each
 /// hand-over threshold in `thins` (lanes at or below which a node goes to single-ray traversal).
 #[must_use]
-pub fn thin_sweep(scene: &Scene, sets: &RaySets, thins: &[u32], reps: usize) -> Vec<(&'static str, u32, f64)> {
-    use crate::geometry::packet::closest_packets_thin;
+pub fn thin_sweep(
+    scene: &Scene,
+    sets: &RaySets,
+    thins: &[u32],
+    reps: usize,
+) -> Vec<(&'static str, &'static str, u32, f64)> {
+    use crate::geometry::packet::{closest_packets_thin, occluded_packets_thin};
     let mut rows = vec![];
     for (label, rays) in [("camera", &sets.camera), ("shadow", &sets.shadow), ("diffuse", &sets.diffuse)] {
-        let mut out = vec![None; rays.len()];
-        let mut times: Vec<Vec<f64>> = vec![vec![]; thins.len()];
-        // Interleaved: every threshold once per round.
-        for _ in 0..reps.max(1) {
-            for (k, &thin) in thins.iter().enumerate() {
-                let t = Instant::now();
-                closest_packets_thin(scene.bvh(), scene.columns(), rays, &mut out, thin);
-                times[k].push(t.elapsed().as_secs_f64());
+        for query in ["closest", "any"] {
+            let mut hits = vec![None; rays.len()];
+            let mut blocked = vec![false; rays.len()];
+            let mut times: Vec<Vec<f64>> = vec![vec![]; thins.len()];
+            // Interleaved: every threshold once per round.
+            for _ in 0..reps.max(1) {
+                for (k, &thin) in thins.iter().enumerate() {
+                    let t = Instant::now();
+                    if query == "closest" {
+                        closest_packets_thin(scene.bvh(), scene.columns(), rays, &mut hits, thin);
+                    } else {
+                        occluded_packets_thin(scene.bvh(), scene.columns(), rays, &mut blocked, thin);
+                    }
+                    times[k].push(t.elapsed().as_secs_f64());
+                }
             }
-        }
-        for (k, &thin) in thins.iter().enumerate() {
-            rows.push((label, thin, rays.len() as f64 * 1e-6 / median(times[k].clone())));
+            for (k, &thin) in thins.iter().enumerate() {
+                rows.push((label, query, thin, rays.len() as f64 * 1e-6 / median(times[k].clone())));
+            }
         }
     }
     rows

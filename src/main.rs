@@ -52,7 +52,7 @@ struct BenchArgs {
     /// Vertical field of view in degrees for scenes without a camera [40].
     #[arg(long)]
     fov: Option<f32>,
-    /// Also time packet closest-hit traversal at each single-ray hand-over threshold (0–4 lanes).
+    /// Also time packet traversal at each single-ray hand-over threshold (0–4 lanes).
     #[arg(long)]
     thin_sweep: bool,
     /// Sphere rings of `generated:sphere` (2·rings·2·rings triangles) [512].
@@ -319,8 +319,10 @@ fn bench(args: BenchArgs) -> Result<()> {
         }
         if args.thin_sweep {
             let sets = bench::RaySets::new(&loaded.scene, &cam);
-            for (rays, thin, mrays) in bench::thin_sweep(&loaded.scene, &sets, &[0, 1, 2, 3, 4], args.reps as usize) {
-                eprintln!("  hand-over at ≤{thin} lanes: {rays:<8} closest {mrays:>7.2} Mrays/s");
+            for (rays, query, thin, mrays) in
+                bench::thin_sweep(&loaded.scene, &sets, &[0, 1, 2, 3, 4], args.reps as usize)
+            {
+                eprintln!("  hand-over at ≤{thin} lanes: {rays:<8} {query:<8} {mrays:>7.2} Mrays/s");
             }
         }
         let rows = bench::run_scene(&label, &loaded.scene, &cam, threads, args.reps as usize);

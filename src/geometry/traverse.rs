@@ -135,6 +135,12 @@ impl<T: Copy + Default> Stack<T> {
             self.spill.push(v);
         }
     }
+    /// Empties the stack.
+    #[inline]
+    pub fn clear(&mut self) {
+        self.len = 0;
+        self.spill.clear();
+    }
     /// Pops the top.
     #[inline]
     pub fn pop(&mut self) -> Option<T> {
@@ -176,24 +182,31 @@ pub fn closest_from(
         if tn > best.t {
             continue;
         }
-        let node = &nodes[n as usize];
-        if node.prim_count > 0 {
-            for id in node.first_index..node.first_index + node.prim_count {
-                best.test(tris, o, d, id);
+        // Descend without a push while one child remains (one push per fork, as obvhs does).
+        let mut cur = n;
+        loop {
+            let node = &nodes[cur as usize];
+            if node.prim_count > 0 {
+                for id in node.first_index..node.first_index + node.prim_count {
+                    best.test(tris, o, d, id);
+                }
+                break;
             }
-            continue;
-        }
-        let (l, r) = (node.first_index, node.first_index + 1);
-        let bl = &nodes[l as usize].aabb;
-        let br = &nodes[r as usize].aabb;
-        let tl = box_entry(bl.min, bl.max, oa, inva, best.t);
-        let tr = box_entry(br.min, br.max, oa, inva, best.t);
-        let ((near, tnear), (far, tfar)) = if tl <= tr { ((l, tl), (r, tr)) } else { ((r, tr), (l, tl)) };
-        if tfar.is_finite() {
-            stack.push((far, tfar));
-        }
-        if tnear.is_finite() {
-            stack.push((near, tnear));
+            let (l, r) = (node.first_index, node.first_index + 1);
+            let bl = &nodes[l as usize].aabb;
+            let br = &nodes[r as usize].aabb;
+            let tl = box_entry(bl.min, bl.max, oa, inva, best.t);
+            let tr = box_entry(br.min, br.max, oa, inva, best.t);
+            let ((near, tnear), (far, tfar)) = if tl <= tr { ((l, tl), (r, tr)) } else { ((r, tr), (l, tl)) };
+            match (tnear.is_finite(), tfar.is_finite()) {
+                (true, true) => {
+                    stack.push((far, tfar));
+                    cur = near;
+                }
+                (true, false) => cur = near,
+                (false, true) => cur = far,
+                (false, false) => break,
+            }
         }
     }
 }
@@ -214,29 +227,35 @@ pub fn occluded_from(
     let (oa, inva) = (Vec3A::from(o), Vec3A::from(inv));
     stack.push(start);
     while let Some(n) = stack.pop() {
-        let node = &nodes[n as usize];
-        if node.prim_count > 0 {
-            for id in node.first_index..node.first_index + node.prim_count {
-                let i = id as usize;
-                if intersect_triangle(o, d, t_max, tris.p0[i], tris.p1[i], tris.p2[i]).is_some() {
-                    while stack.pop().is_some() {}
-                    return true;
+        let mut cur = n;
+        loop {
+            let node = &nodes[cur as usize];
+            if node.prim_count > 0 {
+                for id in node.first_index..node.first_index + node.prim_count {
+                    let i = id as usize;
+                    if intersect_triangle(o, d, t_max, tris.p0[i], tris.p1[i], tris.p2[i]).is_some() {
+                        stack.clear();
+                        return true;
+                    }
                 }
+                break;
             }
-            continue;
-        }
-        // Nearer child first: occluders near the origin end the search early.
-        let (l, r) = (node.first_index, node.first_index + 1);
-        let bl = &nodes[l as usize].aabb;
-        let br = &nodes[r as usize].aabb;
-        let tl = box_entry(bl.min, bl.max, oa, inva, t_max);
-        let tr = box_entry(br.min, br.max, oa, inva, t_max);
-        let ((near, tnear), (far, tfar)) = if tl <= tr { ((l, tl), (r, tr)) } else { ((r, tr), (l, tl)) };
-        if tfar.is_finite() {
-            stack.push(far);
-        }
-        if tnear.is_finite() {
-            stack.push(near);
+            // Nearer child first: occluders near the origin end the search early.
+            let (l, r) = (node.first_index, node.first_index + 1);
+            let bl = &nodes[l as usize].aabb;
+            let br = &nodes[r as usize].aabb;
+            let tl = box_entry(bl.min, bl.max, oa, inva, t_max);
+            let tr = box_entry(br.min, br.max, oa, inva, t_max);
+            let ((near, tnear), (far, tfar)) = if tl <= tr { ((l, tl), (r, tr)) } else { ((r, tr), (l, tl)) };
+            match (tnear.is_finite(), tfar.is_finite()) {
+                (true, true) => {
+                    stack.push(far);
+                    cur = near;
+                }
+                (true, false) => cur = near,
+                (false, true) => cur = far,
+                (false, false) => break,
+            }
         }
     }
     false
@@ -249,9 +268,14 @@ pub fn inverse_direction(d: Vec3) -> Vec3 {
     Vec3::new(safe_inverse(d.x), safe_inverse(d.y), safe_inverse(d.z))
 }
 
-/// Closest hit of one ray.
+/// Closest hit of one ray, with a caller's stack.
 #[must_use]
-pub fn closest(bvh: &Bvh, tris: TriangleColumns<'_>, ray: &RayQuery) -> Option<Hit> {
+pub fn closest_with(
+    bvh: &Bvh,
+    tris: TriangleColumns<'_>,
+    ray: &RayQuery,
+    stack: &mut Stack<(u32, f32)>,
+) -> Option<Hit> {
     if bvh.nodes().is_empty() || !ray.is_valid() {
         return None;
     }
@@ -262,14 +286,13 @@ pub fn closest(bvh: &Bvh, tris: TriangleColumns<'_>, ray: &RayQuery) -> Option<H
         return None;
     }
     let mut best = Best::new(ray.t_max);
-    let mut stack = Stack::new();
-    closest_from(bvh, tris, 0, t0, ray.origin, ray.direction, inv, &mut best, &mut stack);
+    closest_from(bvh, tris, 0, t0, ray.origin, ray.direction, inv, &mut best, stack);
     best.hit()
 }
 
-/// True if anything is hit in (0, t_max).
+/// True if anything is hit in (0, t_max), with a caller's stack.
 #[must_use]
-pub fn occluded(bvh: &Bvh, tris: TriangleColumns<'_>, ray: &RayQuery) -> bool {
+pub fn occluded_with(bvh: &Bvh, tris: TriangleColumns<'_>, ray: &RayQuery, stack: &mut Stack<u32>) -> bool {
     if bvh.nodes().is_empty() || !ray.is_valid() {
         return false;
     }
@@ -278,20 +301,47 @@ pub fn occluded(bvh: &Bvh, tris: TriangleColumns<'_>, ray: &RayQuery) -> bool {
     if !box_entry(root.min, root.max, ray.origin.into(), inv.into(), ray.t_max).is_finite() {
         return false;
     }
-    occluded_from(bvh, tris, 0, ray.origin, ray.direction, inv, ray.t_max, &mut Stack::new())
+    occluded_from(bvh, tris, 0, ray.origin, ray.direction, inv, ray.t_max, stack)
+}
+
+thread_local! {
+    /// Per-thread stacks for one-off queries: initialising a fresh 96-entry stack per ray cost
+    /// more than some traversals (BENCHMARKS.md).
+    static STACKS: std::cell::RefCell<(Stack<(u32, f32)>, Stack<u32>)> =
+        std::cell::RefCell::new((Stack::new(), Stack::new()));
+}
+
+/// Closest hit of one ray.
+#[must_use]
+pub fn closest(bvh: &Bvh, tris: TriangleColumns<'_>, ray: &RayQuery) -> Option<Hit> {
+    STACKS.with(|s| match s.try_borrow_mut() {
+        Ok(mut s) => closest_with(bvh, tris, ray, &mut s.0),
+        Err(_) => closest_with(bvh, tris, ray, &mut Stack::new()),
+    })
+}
+
+/// True if anything is hit in (0, t_max).
+#[must_use]
+pub fn occluded(bvh: &Bvh, tris: TriangleColumns<'_>, ray: &RayQuery) -> bool {
+    STACKS.with(|s| match s.try_borrow_mut() {
+        Ok(mut s) => occluded_with(bvh, tris, ray, &mut s.1),
+        Err(_) => occluded_with(bvh, tris, ray, &mut Stack::new()),
+    })
 }
 
 /// Scalar twin of [`super::packet::closest_packets`]: closest hits of `rays` into `out`, one ray
 /// at a time.
 pub fn closest_rays(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [Option<Hit>]) {
+    let mut stack = Stack::new();
     for (r, o) in rays.iter().zip(out.iter_mut()) {
-        *o = closest(bvh, tris, r);
+        *o = closest_with(bvh, tris, r, &mut stack);
     }
 }
 
 /// Scalar twin of [`super::packet::occluded_packets`].
 pub fn occluded_rays(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [bool]) {
+    let mut stack = Stack::new();
     for (r, o) in rays.iter().zip(out.iter_mut()) {
-        *o = occluded(bvh, tris, r);
+        *o = occluded_with(bvh, tris, r, &mut stack);
     }
 }
