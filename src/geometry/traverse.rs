@@ -304,10 +304,13 @@ pub fn occluded_with(bvh: &Bvh, tris: TriangleColumns<'_>, ray: &RayQuery, stack
     occluded_from(bvh, tris, 0, ray.origin, ray.direction, inv, ray.t_max, stack)
 }
 
+/// The closest-hit and any-hit stacks of single-ray traversal.
+type SingleStacks = (Stack<(u32, f32)>, Stack<u32>);
+
 thread_local! {
     /// Per-thread stacks for one-off queries: initialising a fresh 96-entry stack per ray cost
     /// more than some traversals (BENCHMARKS.md).
-    static STACKS: std::cell::RefCell<(Stack<(u32, f32)>, Stack<u32>)> =
+    static STACKS: std::cell::RefCell<SingleStacks> =
         std::cell::RefCell::new((Stack::new(), Stack::new()));
 }
 
