@@ -11,8 +11,8 @@
 
 use super::bvh::{Bvh, Hit, TriangleColumns};
 use super::offset::gamma;
-use super::traverse::{closest_from, inverse_direction, occluded_from, Best, RayQuery, Stack, FAR_GROWTH, NO_TRI};
-use super::triangle::{dominant_axis, intersect_triangle, is_degenerate, permute};
+use super::traverse::{closest_from, occluded_from, Best, RayQuery, Stack, FAR_GROWTH, NO_TRI};
+use super::triangle::{intersect_triangle, is_degenerate};
 use glam::Vec3;
 use obvhs::bvh2::node::Bvh2Node;
 use wide::f32x8;
@@ -50,42 +50,58 @@ struct Packet {
 }
 
 impl Packet {
+    /// Loads up to 8 rays. Inverse directions, the watertight test's axis choice and its shear
+    /// are computed 8-wide with the scalar code's operations (IEEE division, the same
+    /// comparisons), so every lane's values equal the scalar ones bit for bit.
     fn load(rays: &[RayQuery]) -> Self {
         let mut o = [Vec3::ZERO; LANES];
         let mut d = [Vec3::X; LANES];
-        let mut inv = [Vec3::ONE; LANES];
         let mut valid = 0u32;
         for (l, r) in rays.iter().enumerate().take(LANES) {
             if r.is_valid() {
                 o[l] = r.origin;
                 d[l] = r.direction;
-                inv[l] = inverse_direction(r.direction);
                 valid |= 1 << l;
             }
         }
         let col = |f: &dyn Fn(usize) -> f32| f32x8::from(std::array::from_fn::<f32, LANES, _>(f));
-        let mask = |f: &dyn Fn(usize) -> bool| col(&|l| if f(l) { f32::from_bits(u32::MAX) } else { 0.0 });
-        // The same axis choice and shear as the scalar watertight test.
-        let axis: [usize; LANES] = std::array::from_fn(|l| dominant_axis(d[l]));
-        let shear: [[f32; 3]; LANES] = std::array::from_fn(|l| {
-            let p = permute(d[l], axis[l]);
-            [-p.x / p.z, -p.y / p.z, 1.0 / p.z]
-        });
+        let (ox, oy, oz) = (col(&|l| o[l].x), col(&|l| o[l].y), col(&|l| o[l].z));
+        let (dx, dy, dz) = (col(&|l| d[l].x), col(&|l| d[l].y), col(&|l| d[l].z));
+        // traverse::safe_inverse: 1/d, or ±f32::MAX (the sign of d) where that is not finite.
+        let safe_inverse = |v: f32x8| {
+            let i = f32x8::ONE / v;
+            let max = f32x8::splat(f32::MAX) | (v & f32x8::splat(-0.0));
+            i.is_finite().select(i, max)
+        };
+        let (ix, iy, iz) = (safe_inverse(dx), safe_inverse(dy), safe_inverse(dz));
+        // triangle::dominant_axis: x if |x| > |y| and |x| > |z|; y if not the former and
+        // |y| > |z|; z otherwise.
+        let (ax, ay, az) = (dx.abs(), dy.abs(), dz.abs());
+        let x_gt_y = ax.simd_gt(ay);
+        let kz0 = x_gt_y & ax.simd_gt(az);
+        let kz1 = !x_gt_y & ay.simd_gt(az);
+        let kz2 = !(kz0 | kz1);
+        // triangle::permute, then the shear −d'x/d'z, −d'y/d'z, 1/d'z.
+        let px = kz2.select(dx, kz0.select(dy, dz));
+        let py = kz2.select(dy, kz0.select(dz, dx));
+        let pz = kz2.select(dz, kz0.select(dx, dy));
+        let (sx, sy, sz) = (-px / pz, -py / pz, f32x8::ONE / pz);
+        let (ixa, iya, iza) = (ix.to_array(), iy.to_array(), iz.to_array());
         Packet {
-            ox: col(&|l| o[l].x),
-            oy: col(&|l| o[l].y),
-            oz: col(&|l| o[l].z),
-            ix: col(&|l| inv[l].x),
-            iy: col(&|l| inv[l].y),
-            iz: col(&|l| inv[l].z),
-            kz2: mask(&|l| axis[l] == 2),
-            kz0: mask(&|l| axis[l] == 0),
-            sx: col(&|l| shear[l][0]),
-            sy: col(&|l| shear[l][1]),
-            sz: col(&|l| shear[l][2]),
+            ox,
+            oy,
+            oz,
+            ix,
+            iy,
+            iz,
+            kz2,
+            kz0,
+            sx,
+            sy,
+            sz,
             o,
             d,
-            inv,
+            inv: std::array::from_fn(|l| Vec3::new(ixa[l], iya[l], iza[l])),
             valid,
         }
     }
@@ -177,6 +193,18 @@ fn intersect8(p: &Packet, lanes: u32, v: [Vec3; 3], t_max: f32x8) -> (u32, u32, 
     (hit, fallback, t, [e0 * inv_det, e1 * inv_det, e2 * inv_det])
 }
 
+/// Per lane, the largest t a triangle hit may have to matter: strictly below t_max while the
+/// lane has no hit; afterwards up to and including its best t (a tie may go to a lower index).
+fn limits(best: &[Best; LANES]) -> f32x8 {
+    f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| {
+        if best[l].tri == NO_TRI {
+            best[l].t
+        } else {
+            best[l].t.next_up()
+        }
+    }))
+}
+
 /// Closest hits of 8 rays (fewer at the end of a slice).
 fn closest8(
     bvh: &Bvh,
@@ -191,6 +219,7 @@ fn closest8(
     let p = Packet::load(rays);
     let mut best: [Best; LANES] = std::array::from_fn(|l| Best::new(rays.get(l).map_or(0.0, |r| r.t_max)));
     let mut t_best = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].t));
+    let mut limit = limits(&best);
     let active = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| {
         if p.valid >> l & 1 == 1 {
             f32::from_bits(u32::MAX)
@@ -216,6 +245,7 @@ fn closest8(
                 closest_from(bvh, tris, n, tn[l], p.o[l], p.d[l], p.inv[l], &mut best[l], single);
             }
             t_best = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].t));
+            limit = limits(&best);
             continue;
         }
         if node.prim_count > 0 {
@@ -225,16 +255,10 @@ fn closest8(
                 if is_degenerate(v[0], v[1], v[2]) {
                     continue;
                 }
-                // Strictly below t_max while a lane has no hit; afterwards up to and including its
-                // best t (a tie may go to a lower index).
-                let limit = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| {
-                    if best[l].tri == NO_TRI {
-                        best[l].t
-                    } else {
-                        best[l].t.next_up()
-                    }
-                }));
                 let (mut hit, mut fallback, t, b) = intersect8(&p, mask, v, limit);
+                if hit | fallback == 0 {
+                    continue;
+                }
                 let (t, b) = (t.to_array(), b.map(f32x8::to_array));
                 while hit != 0 {
                     let l = hit.trailing_zeros() as usize;
@@ -248,6 +272,7 @@ fn closest8(
                     fallback &= fallback - 1;
                     best[l].test(tris, p.o[l], p.d[l], id);
                 }
+                limit = limits(&best);
             }
             t_best = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].t));
             continue;
@@ -403,7 +428,7 @@ pub fn occluded_packets_thin(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQu
 
 #[cfg(test)]
 mod tests {
-    use super::super::traverse::box_entry;
+    use super::super::traverse::{box_entry, inverse_direction};
     use super::*;
 
     #[test]
