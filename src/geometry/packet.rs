@@ -115,13 +115,15 @@ impl Packet {
         let slab = |lo: f32, hi: f32, o: f32x8, inv: f32x8| {
             let t0 = (f32x8::splat(lo) - o) * inv;
             let t1 = (f32x8::splat(hi) - o) * inv;
-            (t0.min(t1), t0.max(t1))
+            (t0.fast_min(t1), t0.fast_max(t1))
         };
         let (nx, fx) = slab(b.min.x, b.max.x, self.ox, self.ix);
         let (ny, fy) = slab(b.min.y, b.max.y, self.oy, self.iy);
         let (nz, fz) = slab(b.min.z, b.max.z, self.oz, self.iz);
-        let near = nx.max(ny).max(nz).max(f32x8::ZERO);
-        let far = fx.min(fy).min(fz) * f32x8::splat(FAR_GROWTH);
+        // No NaN can arise (finite origins, boxes and inverse directions), so the min/max need
+        // no NaN handling: the same values as the scalar test's.
+        let near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
+        let far = fx.fast_min(fy).fast_min(fz) * f32x8::splat(FAR_GROWTH);
         let hit = near.simd_le(far) & near.simd_le(t_max);
         hit.select(near, f32x8::splat(f32::NAN))
     }
@@ -205,6 +207,44 @@ fn limits(best: &[Best; LANES]) -> f32x8 {
     }))
 }
 
+/// Tests the triangles of leaf `node` against the lanes of `lanes`, keeping each lane's closest
+/// hit (ties to the lower index), and refreshes the lanes' `limit`s.
+#[inline]
+fn closest_leaf(
+    p: &Packet,
+    tris: TriangleColumns<'_>,
+    node: &Bvh2Node,
+    lanes: u32,
+    best: &mut [Best; LANES],
+    limit: &mut f32x8,
+) {
+    for id in node.first_index..node.first_index + node.prim_count {
+        let i = id as usize;
+        let v = [tris.p0[i], tris.p1[i], tris.p2[i]];
+        if is_degenerate(v[0], v[1], v[2]) {
+            continue;
+        }
+        let (mut hit, mut fallback, t, b) = intersect8(p, lanes, v, *limit);
+        if hit | fallback == 0 {
+            continue;
+        }
+        let (t, b) = (t.to_array(), b.map(f32x8::to_array));
+        while hit != 0 {
+            let l = hit.trailing_zeros() as usize;
+            hit &= hit - 1;
+            if t[l] < best[l].t || id < best[l].tri {
+                best[l] = Best { t: t[l], tri: id, b: [b[0][l], b[1][l], b[2][l]] };
+            }
+        }
+        while fallback != 0 {
+            let l = fallback.trailing_zeros() as usize;
+            fallback &= fallback - 1;
+            best[l].test(tris, p.o[l], p.d[l], id);
+        }
+        *limit = limits(best);
+    }
+}
+
 /// Closest hits of 8 rays (fewer at the end of a slice).
 fn closest8(
     bvh: &Bvh,
@@ -249,31 +289,7 @@ fn closest8(
             continue;
         }
         if node.prim_count > 0 {
-            for id in node.first_index..node.first_index + node.prim_count {
-                let i = id as usize;
-                let v = [tris.p0[i], tris.p1[i], tris.p2[i]];
-                if is_degenerate(v[0], v[1], v[2]) {
-                    continue;
-                }
-                let (mut hit, mut fallback, t, b) = intersect8(&p, mask, v, limit);
-                if hit | fallback == 0 {
-                    continue;
-                }
-                let (t, b) = (t.to_array(), b.map(f32x8::to_array));
-                while hit != 0 {
-                    let l = hit.trailing_zeros() as usize;
-                    hit &= hit - 1;
-                    if t[l] < best[l].t || id < best[l].tri {
-                        best[l] = Best { t: t[l], tri: id, b: [b[0][l], b[1][l], b[2][l]] };
-                    }
-                }
-                while fallback != 0 {
-                    let l = fallback.trailing_zeros() as usize;
-                    fallback &= fallback - 1;
-                    best[l].test(tris, p.o[l], p.d[l], id);
-                }
-                limit = limits(&best);
-            }
+            closest_leaf(&p, tris, node, mask, &mut best, &mut limit);
             t_best = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].t));
             continue;
         }
@@ -295,6 +311,40 @@ fn closest8(
     for (l, o) in out.iter_mut().enumerate() {
         *o = best[l].hit();
     }
+}
+
+/// Lanes of `lanes` blocked by a triangle of leaf `node` within (0, t_max).
+#[inline]
+fn any_leaf(
+    p: &Packet,
+    tris: TriangleColumns<'_>,
+    node: &Bvh2Node,
+    lanes: u32,
+    t_max: f32x8,
+    t_arr: &[f32; LANES],
+) -> u32 {
+    let mut blocked = 0u32;
+    for id in node.first_index..node.first_index + node.prim_count {
+        let i = id as usize;
+        let v = [tris.p0[i], tris.p1[i], tris.p2[i]];
+        let open = lanes & !blocked;
+        if open == 0 {
+            break;
+        }
+        if is_degenerate(v[0], v[1], v[2]) {
+            continue;
+        }
+        let (hit, mut fallback, _, _) = intersect8(p, open, v, t_max);
+        blocked |= hit;
+        while fallback != 0 {
+            let l = fallback.trailing_zeros() as usize;
+            fallback &= fallback - 1;
+            if intersect_triangle(p.o[l], p.d[l], t_arr[l], v[0], v[1], v[2]).is_some() {
+                blocked |= 1 << l;
+            }
+        }
+    }
+    blocked
 }
 
 /// Any-hit tests of 8 rays.
@@ -333,23 +383,7 @@ fn occluded8(
             continue;
         }
         if node.prim_count > 0 {
-            for id in node.first_index..node.first_index + node.prim_count {
-                let i = id as usize;
-                let v = [tris.p0[i], tris.p1[i], tris.p2[i]];
-                let lanes = mask & !blocked;
-                if lanes == 0 || is_degenerate(v[0], v[1], v[2]) {
-                    continue;
-                }
-                let (hit, mut fallback, _, _) = intersect8(&p, lanes, v, t_max);
-                blocked |= hit;
-                while fallback != 0 {
-                    let l = fallback.trailing_zeros() as usize;
-                    fallback &= fallback - 1;
-                    if intersect_triangle(p.o[l], p.d[l], t_arr[l], v[0], v[1], v[2]).is_some() {
-                        blocked |= 1 << l;
-                    }
-                }
-            }
+            blocked |= any_leaf(&p, tris, node, mask & !blocked, t_max, &t_arr);
             if blocked & p.valid == p.valid {
                 stack.clear();
                 break;
@@ -363,7 +397,20 @@ fn occluded8(
         let mr = bits(tr.simd_le(t_max)) & mask;
         // Nearer child first, as most lanes see it: an occluder near the origin ends lanes early.
         let left_first = (bits(tl.simd_le(tr)) & ml & mr).count_ones() * 2 >= (ml & mr).count_ones();
-        let (first, second) = if left_first { ((l, ml), (r, mr)) } else { ((r, mr), (l, ml)) };
+        let (mut first, mut second) = if left_first { ((l, ml), (r, mr)) } else { ((r, mr), (l, ml)) };
+        // Leaf children are tested at once, before any inner child is entered: a leaf is cheap
+        // and may end lanes (what makes obvhs's single-ray any-hit fast).
+        for c in [&mut first, &mut second] {
+            let child = &nodes[c.0 as usize];
+            if c.1 != 0 && child.prim_count > 0 {
+                blocked |= any_leaf(&p, tris, child, c.1 & !blocked, t_max, &t_arr);
+                c.1 = 0;
+            }
+        }
+        if blocked & p.valid == p.valid {
+            stack.clear();
+            break;
+        }
         if second.1 != 0 {
             stack.push(second);
         }

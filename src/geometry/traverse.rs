@@ -247,7 +247,23 @@ pub fn occluded_from(
             let tl = box_entry(bl.min, bl.max, oa, inva, t_max);
             let tr = box_entry(br.min, br.max, oa, inva, t_max);
             let ((near, tnear), (far, tfar)) = if tl <= tr { ((l, tl), (r, tr)) } else { ((r, tr), (l, tl)) };
-            match (tnear.is_finite(), tfar.is_finite()) {
+            // Leaf children are tested at once, nearer first, before any inner child is entered:
+            // a leaf is cheap and may end the search.
+            let mut go = [(near, tnear.is_finite()), (far, tfar.is_finite())];
+            for g in &mut go {
+                let child = &nodes[g.0 as usize];
+                if g.1 && child.prim_count > 0 {
+                    for id in child.first_index..child.first_index + child.prim_count {
+                        let i = id as usize;
+                        if intersect_triangle(o, d, t_max, tris.p0[i], tris.p1[i], tris.p2[i]).is_some() {
+                            stack.clear();
+                            return true;
+                        }
+                    }
+                    g.1 = false;
+                }
+            }
+            match (go[0].1, go[1].1) {
                 (true, true) => {
                     stack.push(far);
                     cur = near;
