@@ -212,6 +212,7 @@ pub fn closest_from(
 }
 
 /// Any-hit traversal of one ray from node `start`: true at the first triangle hit in (0, t_max).
+/// Leaf children are tested as soon as their parent is reached (as obvhs's loop does).
 #[allow(clippy::too_many_arguments)]
 pub fn occluded_from(
     bvh: &Bvh,
