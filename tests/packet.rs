@@ -169,3 +169,40 @@ fn packets_match_scalar_on_a_flat_mesh_with_slivers_and_degenerate_triangles() {
     let down = hits.iter().step_by(2).filter(|h| h.is_some()).count();
     assert_eq!(down, (4 * n + 1) * (4 * n + 1), "every ray straight down onto the closed grid hits");
 }
+
+#[test]
+fn packets_match_scalar_on_rays_along_box_edges_and_faces() {
+    // Rays that run exactly along the edges of BVH node boxes and inside their faces — where a
+    // slab test's near and far distances coincide or a direction component is zero.
+    for name in ["cornell-box.toml", "cornell-spheres.toml"] {
+        let loaded = load(name);
+        let s = &loaded.scene;
+        let mut rays = vec![];
+        for (k, node) in s.bvh().nodes().iter().enumerate() {
+            let (lo, hi) = (Vec3::from(node.aabb.min), Vec3::from(node.aabb.max));
+            let ext = hi - lo;
+            for axis in 0..3 {
+                // Along an edge: start before the box on the edge line.
+                let mut o = lo;
+                o[axis] -= ext[axis].max(1e-3);
+                let mut d = Vec3::ZERO;
+                d[axis] = 1.0;
+                rays.push(RayQuery::new(o, d, f32::INFINITY));
+                // Inside a face, diagonally across it (two non-zero components, one zero).
+                let mut o2 = lo;
+                let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+                o2[a] -= ext[a].max(1e-3);
+                o2[b] -= ext[b].max(1e-3);
+                let mut d2 = Vec3::ZERO;
+                d2[a] = ext[a].max(1e-3) * 2.0 + ext[a];
+                d2[b] = ext[b].max(1e-3) * 2.0 + ext[b];
+                rays.push(RayQuery::new(o2, d2, if k % 2 == 0 { f32::INFINITY } else { 1.0 }));
+            }
+            // Through opposite corners.
+            rays.push(RayQuery::new(lo - ext, ext, f32::INFINITY));
+        }
+        let hits = agree(s.bvh(), s.columns(), &rays);
+        let n = hits.iter().filter(|h| h.is_some()).count();
+        assert!(n > rays.len() / 10, "{name}: only {n} of {} edge rays hit anything", rays.len());
+    }
+}
