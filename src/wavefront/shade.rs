@@ -115,11 +115,13 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
     let t = Instant::now();
     let scene = &*shared.scene;
     let n = shared.settings.gather_rays;
-    let w = &*work;
+    // Chunks append straight to the next queue (disjoint fields of the work resource).
+    let CameraWork { paths, classified, next, .. } = &mut *work;
+    let w = &*paths;
     let lanes: Vec<u32> =
-        w.classified.diffuse.iter().copied().filter(|&l| w.paths.kind[l as usize] == PathKind::Camera).collect();
-    let mut spawned = PathQueue::default();
-    spawned.reserve(lanes.len() * n as usize);
+        classified.diffuse.iter().copied().filter(|&l| w.kind[l as usize] == PathKind::Camera).collect();
+    let before = next.len();
+    next.reserve(lanes.len() * n as usize);
     par_columns(
         lanes.len(),
         CHUNK,
@@ -128,17 +130,17 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
             out.reserve(r.len() * n as usize);
             for j in r {
                 let i = lanes[j] as usize;
-                let Some(hit) = w.paths.hits.get(i) else { continue };
+                let Some(hit) = w.hits.get(i) else { continue };
                 let sp = scene.surface(&hit);
                 let kd = scene.materials[sp.material as usize].bsdf.diffuse();
                 if kd == glam::Vec3::ZERO {
                     continue;
                 }
-                let wo = -w.paths.rays.direction(i);
+                let wo = -w.rays.direction(i);
                 let (ng, ns) = sp.frame.oriented(wo);
                 let frame = Frame::new(ns);
-                let gs = Sampler::from_key(w.paths.key[i]).fork(TAG_GATHER + w.paths.depth[i] as u64);
-                let weight = w.paths.beta[i] * kd / n as f32;
+                let gs = Sampler::from_key(w.key[i]).fork(TAG_GATHER + w.depth[i] as u64);
+                let weight = w.beta[i] * kd / n as f32;
                 for g in 0..n {
                     let wi = frame.to_world(cosine_hemisphere([gs.get(g, 0), gs.get(g, 1)]));
                     if wi.dot(ng) <= 0.0 {
@@ -147,22 +149,21 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
                     out.push(Segment {
                         o: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, wi),
                         d: wi,
-                        sample: w.paths.sample[i],
+                        sample: w.sample[i],
                         kind: PathKind::Gather,
                         key: gs.fork(g as u64).key(),
                         base: 0,
                         depth: 0,
                         beta: weight,
-                        slot: camera_slot(w.paths.through_specular[i], slot::INDIRECT),
+                        slot: camera_slot(w.through_specular[i], slot::INDIRECT),
                         through_specular: false,
                     });
                 }
             }
         },
-        |part| spawned.append(part),
+        |part| next.append(part),
     );
-    let count = spawned.len();
-    work.next.append(&mut spawned);
+    let count = next.len() - before;
     stats.record("spawn_gather_rays", count, t);
 }
 
