@@ -184,3 +184,31 @@ fn the_cli_renders_and_writes_stats() {
     assert!(stats["rays"]["camera"].as_u64().unwrap() >= 256);
     assert!(std::fs::metadata(&png).unwrap().len() > 0);
 }
+
+#[test]
+fn the_bench_command_checks_its_input_and_prints_one_json_object() {
+    let (code, e) = cli(&["bench", "/no/such/scene.toml"]);
+    assert!(code != 0 && e.contains("/no/such/scene.toml"), "{e}");
+    let (code, e) = cli(&["bench", "--reps", "0"]);
+    assert!(code != 0 && e.contains("--reps"), "{e}");
+    let (code, e) = cli(&["bench", "--rings", "1"]);
+    assert!(code != 0 && e.contains("--rings"), "{e}");
+    // A small generated sphere, one repetition: the report's shape, not its speed.
+    let out = Command::new(env!("CARGO_BIN_EXE_photonwave"))
+        .args(["bench", "generated:sphere", "--rings", "8", "--reps", "1", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
+    assert!(v["target_cpu"].is_string() && v["threads"] == 1, "{v}");
+    let traversal = v["traversal"].as_array().unwrap();
+    assert_eq!(traversal.len(), 6, "three ray sets × closest/any");
+    for row in traversal {
+        assert!(row["count"].as_u64().unwrap() > 0 && row["ratio"].as_f64().unwrap() > 0.0, "{row}");
+    }
+    let density = v["density"].as_array().unwrap();
+    assert_eq!(density.len(), 2, "knn and radius");
+    for row in density {
+        assert!(row["photons"].as_u64().unwrap() > 0 && row["ratio"].as_f64().unwrap() > 0.0, "{row}");
+    }
+}
