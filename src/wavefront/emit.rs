@@ -1,8 +1,8 @@
 //! Emit: new lanes. Reads the scene and settings; writes the photon queue (a batch of paths
 //! starting at lights) or the path queue (a wave of camera rays) and the wave's empty terms.
 
-use super::queues::{PathKind, Segment};
-use super::{par_lanes, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
+use super::queues::{PathKind, PhotonQueue, Segment};
+use super::{par_columns, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
 use crate::film::Terms;
 use crate::reference::camera::camera_sample;
 use crate::reference::photons::{start_photon, BATCH};
@@ -18,17 +18,28 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
     let domain = work.domain.unwrap_or(Domain::GlobalPhoton);
     let first = work.first_path;
     let n = work.batches.max(1) * BATCH;
-    let starts = par_lanes(n, CHUNK, shared.threads, |r| {
-        r.map(|i| start_photon(scene, settings, domain, first + i as u64)).collect()
-    });
     let w = &mut *work;
     w.queue.clear();
-    for (i, s) in starts.into_iter().enumerate() {
-        match s {
-            Some(p) => w.queue.push(p.origin, p.dir, first + i as u64, 0, p.power, true),
-            None => w.non_finite += 1,
-        }
-    }
+    let (queue, mut non_finite) = (&mut w.queue, 0);
+    // Each chunk fills its own queue; chunks are appended in lane order.
+    par_columns(
+        n,
+        CHUNK,
+        shared.threads,
+        |r, part: &mut (PhotonQueue, u64)| {
+            for i in r {
+                match start_photon(scene, settings, domain, first + i as u64) {
+                    Some(p) => part.0.push(p.origin, p.dir, first + i as u64, 0, p.power, true),
+                    None => part.1 += 1,
+                }
+            }
+        },
+        |part| {
+            queue.append(&mut part.0);
+            non_finite += part.1;
+        },
+    );
+    w.non_finite += non_finite;
     stats.record("emit_photons", n, t);
 }
 

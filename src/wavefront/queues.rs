@@ -215,6 +215,14 @@ impl PhotonQueue {
         self.power.clear();
         self.specular_only.clear();
     }
+    /// Moves `other`'s lanes (rays and their columns, not hits) to the end.
+    pub fn append(&mut self, other: &mut PhotonQueue) {
+        self.rays.append(&mut other.rays);
+        self.path.append(&mut other.path);
+        self.bounce.append(&mut other.bounce);
+        self.power.append(&mut other.power);
+        self.specular_only.append(&mut other.specular_only);
+    }
 }
 
 /// What a camera-pass path segment is for.
