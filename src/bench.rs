@@ -69,6 +69,12 @@ pub struct TraversalRow {
     pub ratio: f64,
     /// The packet kernel's scalar twin (our single-ray traversal), million rays per second.
     pub twin_mrays: f64,
+    /// obvhs's CWBVH (8-wide nodes) single-ray traversal over the same boxes, million rays per
+    /// second: the other tree obvhs offers.
+    pub cwbvh_mrays: f64,
+    /// Rays the BVH2 traversals (packet, twin, obvhs) report hit and obvhs's CWBVH traversal
+    /// does not (negative: the other way round).
+    pub cwbvh_lost_hits: i64,
 }
 
 /// Image side of the bench camera.
@@ -260,6 +266,7 @@ fn single_any(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
 /// report the same number of hits (they differ only in ties between equally distant triangles,
 /// which do not change whether a ray hits).
 pub fn traversal(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usize) -> Vec<TraversalRow> {
+    let cw = crate::geometry::bvh::CwBaseline::build(scene.columns());
     let mut rows = vec![];
     for (label, rays) in [("camera", &sets.camera), ("shadow", &sets.shadow), ("diffuse", &sets.diffuse)] {
         if rays.is_empty() {
@@ -284,6 +291,31 @@ pub fn traversal(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps
                 time_pair(reps, || ht = twin_any(scene, rays, threads), || {})
             };
             assert_eq!(ht, hs, "{name} {label} {query}: scalar twin and obvhs hit counts differ");
+            let cw_count = |any: bool| {
+                map_chunks(
+                    rays.len(),
+                    CHUNK,
+                    threads,
+                    |r| {
+                        rays[r]
+                            .iter()
+                            .filter(|q| {
+                                if any {
+                                    cw.occluded(scene.columns(), q.origin, q.direction, q.t_max)
+                                } else {
+                                    cw.closest(scene.columns(), q.origin, q.direction, q.t_max)
+                                }
+                            })
+                            .count()
+                    },
+                    |_| {},
+                )
+                .into_iter()
+                .sum::<usize>()
+            };
+            let mut hc = 0;
+            let (tc, _) = time_pair(reps, || hc = cw_count(query == "any"), || {});
+            // Not asserted: obvhs's CWBVH traversal loses a few hits (recorded, see BENCHMARKS.md).
             let m = rays.len() as f64 * 1e-6;
             rows.push(TraversalRow {
                 scene: name.to_string(),
@@ -294,6 +326,8 @@ pub fn traversal(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps
                 single_mrays: m / ts,
                 ratio: ts / tp,
                 twin_mrays: m / tt,
+                cwbvh_mrays: m / tc,
+                cwbvh_lost_hits: hs as i64 - hc as i64,
             });
         }
     }
@@ -373,8 +407,8 @@ pub fn table(traversal: &[TraversalRow], density: &[DensityRow]) -> String {
     for r in traversal {
         let _ = writeln!(
             s,
-            "  traversal {:<8} {:<8} {:>8} rays  packet {:>7.2} Mrays/s  obvhs single {:>7.2} Mrays/s  ×{:.2}  (scalar twin {:.2})",
-            r.rays, r.query, r.count, r.packet_mrays, r.single_mrays, r.ratio, r.twin_mrays
+            "  traversal {:<8} {:<8} {:>8} rays  packet {:>7.2} Mrays/s  obvhs single {:>7.2} Mrays/s  ×{:.2}  (scalar twin {:.2}, obvhs CWBVH {:.2}, {} hits lost)",
+            r.rays, r.query, r.count, r.packet_mrays, r.single_mrays, r.ratio, r.twin_mrays, r.cwbvh_mrays, r.cwbvh_lost_hits
         );
     }
     for r in density {

@@ -37,22 +37,7 @@ impl Bvh {
     /// per-triangle columns by it so that leaf indices address them directly.
     #[must_use]
     pub fn build(p0: &[Vec3], p1: &[Vec3], p2: &[Vec3]) -> (Bvh, Vec<u32>) {
-        let mut lo = Vec3::splat(f32::INFINITY);
-        let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        for p in p0.iter().chain(p1).chain(p2) {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
-        let diag = if p0.is_empty() { 1.0 } else { (hi - lo).length().max(f32::MIN_POSITIVE) };
-        let boxes: Vec<Aabb> = (0..p0.len())
-            .map(|i| {
-                let mn = p0[i].min(p1[i]).min(p2[i]);
-                let mx = p0[i].max(p1[i]).max(p2[i]);
-                // Padding relative to both the scene and the box's own magnitude.
-                let pad = Vec3::splat(diag * BOX_PAD) + mn.abs().max(mx.abs()) * 4.0 * f32::EPSILON;
-                Aabb::new(Vec3A::from(mn - pad), Vec3A::from(mx + pad))
-            })
-            .collect();
+        let boxes = padded_boxes(p0, p1, p2);
         let mut build_time = std::time::Duration::ZERO;
         let bvh = obvhs::bvh2::builder::build_bvh2(&boxes, BvhBuildParams::medium_build(), &mut build_time);
         let order = bvh.primitive_indices.clone();
@@ -132,6 +117,73 @@ impl Bvh {
             intersect_triangle(o, d, r.tmax, tris.p0[id], tris.p1[id], tris.p2[id]).map_or(f32::INFINITY, |h| h.t)
         });
         tests
+    }
+}
+
+/// Triangle boxes padded as [`Bvh::build`] pads them (module notes): by [`BOX_PAD`] of the
+/// scene diagonal plus a few ulps of their own magnitude.
+#[must_use]
+pub fn padded_boxes(p0: &[Vec3], p1: &[Vec3], p2: &[Vec3]) -> Vec<Aabb> {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for p in p0.iter().chain(p1).chain(p2) {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let diag = if p0.is_empty() { 1.0 } else { (hi - lo).length().max(f32::MIN_POSITIVE) };
+    (0..p0.len())
+        .map(|i| {
+            let mn = p0[i].min(p1[i]).min(p2[i]);
+            let mx = p0[i].max(p1[i]).max(p2[i]);
+            // Padding relative to both the scene and the box's own magnitude.
+            let pad = Vec3::splat(diag * BOX_PAD) + mn.abs().max(mx.abs()) * 4.0 * f32::EPSILON;
+            Aabb::new(Vec3A::from(mn - pad), Vec3A::from(mx + pad))
+        })
+        .collect()
+}
+
+/// obvhs's CWBVH (8-wide compressed nodes) over the same padded boxes, traversed by obvhs's own
+/// single-ray code: a second baseline for the packet traversal (`photonwave bench`).
+pub struct CwBaseline {
+    bvh: obvhs::cwbvh::CwBvh,
+}
+
+impl CwBaseline {
+    /// Builds over BVH-ordered columns (so primitive indices address them directly).
+    #[must_use]
+    pub fn build(tris: TriangleColumns<'_>) -> Self {
+        let boxes = padded_boxes(tris.p0, tris.p1, tris.p2);
+        let mut t = std::time::Duration::ZERO;
+        CwBaseline { bvh: obvhs::cwbvh::builder::build_cwbvh(&boxes, BvhBuildParams::medium_build(), &mut t) }
+    }
+
+    /// Closest hit (obvhs CWBVH traversal, same triangle test).
+    #[must_use]
+    pub fn closest(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> bool {
+        if self.bvh.nodes.is_empty() || !o.is_finite() || !d.is_finite() {
+            return false;
+        }
+        let ray = Ray::new(Vec3A::from(o), Vec3A::from(d), 0.0, t_max);
+        let mut rh = obvhs::ray::RayHit::none();
+        let idx = &self.bvh.primitive_indices;
+        self.bvh.ray_traverse(ray, &mut rh, |r, id| {
+            let i = idx[id] as usize;
+            intersect_triangle(o, d, r.tmax, tris.p0[i], tris.p1[i], tris.p2[i]).map_or(f32::INFINITY, |h| h.t)
+        })
+    }
+
+    /// Any hit (obvhs CWBVH traversal).
+    #[must_use]
+    pub fn occluded(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> bool {
+        if self.bvh.nodes.is_empty() || !o.is_finite() || !d.is_finite() {
+            return false;
+        }
+        let ray = Ray::new(Vec3A::from(o), Vec3A::from(d), 0.0, t_max);
+        let idx = &self.bvh.primitive_indices;
+        !self.bvh.ray_traverse_miss(ray, |_, id| {
+            let i = idx[id] as usize;
+            intersect_triangle(o, d, t_max, tris.p0[i], tris.p1[i], tris.p2[i]).map_or(f32::INFINITY, |h| h.t)
+        })
     }
 }
 
