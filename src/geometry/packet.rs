@@ -14,7 +14,7 @@
 
 use super::bvh::{Bvh, Hit, TriangleColumns};
 use super::offset::gamma;
-use super::traverse::{closest_from, occluded_from, Best, RayQuery, Stack, FAR_GROWTH, NO_TRI};
+use super::traverse::{closest_from, occluded_from, Best, RayQuery, Stack, FAR_GROWTH};
 use super::triangle::{intersect_triangle, is_degenerate};
 use glam::Vec3;
 use obvhs::bvh2::node::Bvh2Node;
@@ -198,16 +198,31 @@ fn intersect8(p: &Packet, lanes: u32, v: [Vec3; 3], t_max: f32x8) -> (u32, u32, 
     (hit, fallback, t, [e0 * inv_det, e1 * inv_det, e2 * inv_det])
 }
 
-/// Per lane, the largest t a triangle hit may have to matter: strictly below t_max while the
-/// lane has no hit; afterwards up to and including its best t (a tie may go to a lower index).
+/// [`Best::limit`] per lane.
 fn limits(best: &[Best; LANES]) -> f32x8 {
-    f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| {
-        if best[l].tri == NO_TRI {
-            best[l].t
-        } else {
-            best[l].t.next_up()
-        }
-    }))
+    f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].limit()))
+}
+
+/// The best t per lane (the pruning bound of boxes).
+fn best_ts(best: &[Best; LANES]) -> f32x8 {
+    f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].t))
+}
+
+/// The two children of inner `node` with each one's per-lane entry distances and the lanes of
+/// `mask` that enter it within `t`, the child most lanes enter first coming first.
+#[inline]
+fn ordered_children(p: &Packet, nodes: &[Bvh2Node], node: &Bvh2Node, t: f32x8, mask: u32) -> [(u32, f32x8, u32); 2] {
+    let (l, r) = (node.first_index, node.first_index + 1);
+    let tl = p.entry(&nodes[l as usize], t);
+    let tr = p.entry(&nodes[r as usize], t);
+    let ml = bits(tl.simd_le(t)) & mask;
+    let mr = bits(tr.simd_le(t)) & mask;
+    let left_first = (bits(tl.simd_le(tr)) & ml & mr).count_ones() * 2 >= (ml & mr).count_ones();
+    if left_first {
+        [(l, tl, ml), (r, tr, mr)]
+    } else {
+        [(r, tr, mr), (l, tl, ml)]
+    }
 }
 
 /// Tests the triangles of leaf `node` against the lanes of `lanes`, keeping each lane's closest
@@ -235,9 +250,7 @@ fn closest_leaf(
         while hit != 0 {
             let l = hit.trailing_zeros() as usize;
             hit &= hit - 1;
-            if t[l] < best[l].t || id < best[l].tri {
-                best[l] = Best { t: t[l], tri: id, b: [b[0][l], b[1][l], b[2][l]] };
-            }
+            best[l].offer(t[l], id, [b[0][l], b[1][l], b[2][l]]);
         }
         while fallback != 0 {
             let l = fallback.trailing_zeros() as usize;
@@ -261,7 +274,7 @@ fn closest8(
     let nodes = bvh.nodes();
     let p = Packet::load(rays);
     let mut best: [Best; LANES] = std::array::from_fn(|l| Best::new(rays.get(l).map_or(0.0, |r| r.t_max)));
-    let mut t_best = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].t));
+    let mut t_best = best_ts(&best);
     let mut limit = limits(&best);
     let active = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| {
         if p.valid >> l & 1 == 1 {
@@ -287,28 +300,21 @@ fn closest8(
                 mask &= mask - 1;
                 closest_from(bvh, tris, n, tn[l], p.o[l], p.d[l], p.inv[l], &mut best[l], single);
             }
-            t_best = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].t));
+            t_best = best_ts(&best);
             limit = limits(&best);
             continue;
         }
         if node.prim_count > 0 {
             closest_leaf(&p, tris, node, mask, &mut best, &mut limit);
-            t_best = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].t));
+            t_best = best_ts(&best);
             continue;
         }
-        let (l, r) = (node.first_index, node.first_index + 1);
-        let tl = p.entry(&nodes[l as usize], t_best);
-        let tr = p.entry(&nodes[r as usize], t_best);
-        let ml = bits(tl.simd_le(t_best)) & mask;
-        let mr = bits(tr.simd_le(t_best)) & mask;
-        // Visit first the child most of the lanes enter first.
-        let left_first = (bits(tl.simd_le(tr)) & ml & mr).count_ones() * 2 >= (ml & mr).count_ones();
-        let (first, second) = if left_first { ((l, tl, ml), (r, tr, mr)) } else { ((r, tr, mr), (l, tl, ml)) };
-        if second.2 != 0 {
-            stack.push((second.0, Entry(second.1)));
-        }
-        if first.2 != 0 {
-            stack.push((first.0, Entry(first.1)));
+        // The child most of the lanes enter first is visited first.
+        let [first, second] = ordered_children(&p, nodes, node, t_best, mask);
+        for (child, t, lanes) in [second, first] {
+            if lanes != 0 {
+                stack.push((child, Entry(t)));
+            }
         }
     }
     for (l, o) in out.iter_mut().enumerate() {
@@ -393,32 +399,26 @@ fn occluded8(
             }
             continue;
         }
-        let (l, r) = (node.first_index, node.first_index + 1);
-        let tl = p.entry(&nodes[l as usize], t_max);
-        let tr = p.entry(&nodes[r as usize], t_max);
-        let ml = bits(tl.simd_le(t_max)) & mask;
-        let mr = bits(tr.simd_le(t_max)) & mask;
         // Nearer child first, as most lanes see it: an occluder near the origin ends lanes early.
-        let left_first = (bits(tl.simd_le(tr)) & ml & mr).count_ones() * 2 >= (ml & mr).count_ones();
-        let (mut first, mut second) = if left_first { ((l, ml), (r, mr)) } else { ((r, mr), (l, ml)) };
+        let mut children = ordered_children(&p, nodes, node, t_max, mask);
         // Leaf children are tested at once, before any inner child is entered: a leaf is cheap
         // and may end lanes (what makes obvhs's single-ray any-hit fast).
-        for c in [&mut first, &mut second] {
-            let child = &nodes[c.0 as usize];
-            if c.1 != 0 && child.prim_count > 0 {
-                blocked |= any_leaf(&p, tris, child, c.1 & !blocked, t_max, &t_arr);
-                c.1 = 0;
+        for (child, _, lanes) in &mut children {
+            let c = &nodes[*child as usize];
+            if *lanes != 0 && c.prim_count > 0 {
+                blocked |= any_leaf(&p, tris, c, *lanes & !blocked, t_max, &t_arr);
+                *lanes = 0;
             }
         }
         if blocked & p.valid == p.valid {
             stack.clear();
             break;
         }
-        if second.1 != 0 {
-            stack.push(second);
-        }
-        if first.1 != 0 {
-            stack.push(first);
+        let [first, second] = children;
+        for (child, _, lanes) in [second, first] {
+            if lanes != 0 {
+                stack.push((child, lanes));
+            }
         }
     }
     for (l, o) in out.iter_mut().enumerate() {

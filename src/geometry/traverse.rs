@@ -39,11 +39,7 @@ impl RayQuery {
     #[inline]
     #[must_use]
     pub fn is_valid(&self) -> bool {
-        self.origin.is_finite()
-            && self.direction.is_finite()
-            && self.direction != Vec3::ZERO
-            && self.t_max > 0.0
-            && !self.t_max.is_nan()
+        self.origin.is_finite() && self.direction.is_finite() && self.direction != Vec3::ZERO && self.t_max > 0.0
     }
 }
 
@@ -82,16 +78,32 @@ impl Best {
     pub fn hit(&self) -> Option<Hit> {
         (self.tri != NO_TRI).then_some(Hit { tri: self.tri, t: self.t, b: self.b })
     }
-    /// Tests triangle `id` and keeps it if it is closer, or equally close with a lower index.
+    /// The largest t a triangle hit may have to matter (the triangle test's exclusive bound):
+    /// strictly below t_max while nothing is hit; afterwards up to and including the best t, so
+    /// that a tie may go to a lower index.
+    #[inline]
+    #[must_use]
+    pub fn limit(&self) -> f32 {
+        if self.tri == NO_TRI {
+            self.t
+        } else {
+            self.t.next_up()
+        }
+    }
+    /// Keeps a hit found below [`Best::limit`] if it is closer, or equally close with a lower
+    /// index: the rule that makes every traversal order give the same hit.
+    #[inline]
+    pub fn offer(&mut self, t: f32, id: u32, b: [f32; 3]) {
+        if t < self.t || id < self.tri {
+            *self = Best { t, tri: id, b };
+        }
+    }
+    /// Tests triangle `id` and keeps it by [`Best::offer`]'s rule.
     #[inline]
     pub fn test(&mut self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, id: u32) {
         let i = id as usize;
-        // Strictly below t_max while nothing is hit; afterwards ties may replace (lower index).
-        let limit = if self.tri == NO_TRI { self.t } else { self.t.next_up() };
-        if let Some(h) = intersect_triangle(o, d, limit, tris.p0[i], tris.p1[i], tris.p2[i]) {
-            if h.t < self.t || id < self.tri {
-                *self = Best { t: h.t, tri: id, b: h.b };
-            }
+        if let Some(h) = intersect_triangle(o, d, self.limit(), tris.p0[i], tris.p1[i], tris.p2[i]) {
+            self.offer(h.t, id, h.b);
         }
     }
 }
