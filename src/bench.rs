@@ -14,7 +14,7 @@
 //! others t = ∞ — any hit then answers "is anything there").
 
 use crate::geometry::packet::{closest_packets, occluded_packets};
-use crate::geometry::{offset_ray_origin, Hit, RayQuery};
+use crate::geometry::{offset_ray_origin, RayQuery};
 use crate::reference::parallel::map_chunks;
 use crate::rng::{Domain, Sampler};
 use crate::sampling::{cosine_hemisphere, Frame};
@@ -171,95 +171,15 @@ pub fn time_pair(reps: usize, mut a: impl FnMut(), mut b: impl FnMut()) -> (f64,
 /// Chunk of rays per thread task.
 const CHUNK: usize = 4096;
 
-/// Closest hits with packets on `threads` threads (chunks in fixed order).
-fn packets_closest(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
-    map_chunks(
-        rays.len(),
-        CHUNK,
-        threads,
-        |r| {
-            let mut out: Vec<Option<Hit>> = vec![None; r.len()];
-            closest_packets(scene.bvh(), scene.columns(), &rays[r], &mut out);
-            out.iter().filter(|h| h.is_some()).count()
-        },
-        |_| {},
-    )
-    .into_iter()
-    .sum()
+/// A per-ray kernel as a chunk counter for [`count_hits`].
+fn per_ray(hit: impl Fn(&RayQuery) -> bool + Sync) -> impl Fn(&[RayQuery]) -> usize + Sync {
+    move |c| c.iter().filter(|q| hit(q)).count()
 }
 
-fn packets_any(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
-    map_chunks(
-        rays.len(),
-        CHUNK,
-        threads,
-        |r| {
-            let mut out = vec![false; r.len()];
-            occluded_packets(scene.bvh(), scene.columns(), &rays[r], &mut out);
-            out.iter().filter(|&&b| b).count()
-        },
-        |_| {},
-    )
-    .into_iter()
-    .sum()
-}
-
-fn twin_closest(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
-    map_chunks(
-        rays.len(),
-        CHUNK,
-        threads,
-        |r| rays[r].iter().filter(|q| scene.intersect(q.origin, q.direction, q.t_max).is_some()).count(),
-        |_| {},
-    )
-    .into_iter()
-    .sum()
-}
-
-fn twin_any(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
-    map_chunks(
-        rays.len(),
-        CHUNK,
-        threads,
-        |r| rays[r].iter().filter(|q| scene.occluded(q.origin, q.direction, q.t_max)).count(),
-        |_| {},
-    )
-    .into_iter()
-    .sum()
-}
-
-fn single_closest(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
-    map_chunks(
-        rays.len(),
-        CHUNK,
-        threads,
-        |r| {
-            rays[r]
-                .iter()
-                .filter(|q| scene.bvh().closest_obvhs(scene.columns(), q.origin, q.direction, q.t_max).is_some())
-                .count()
-        },
-        |_| {},
-    )
-    .into_iter()
-    .sum()
-}
-
-fn single_any(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
-    map_chunks(
-        rays.len(),
-        CHUNK,
-        threads,
-        |r| {
-            rays[r]
-                .iter()
-                .filter(|q| scene.bvh().occluded_obvhs(scene.columns(), q.origin, q.direction, q.t_max))
-                .count()
-        },
-        |_| {},
-    )
-    .into_iter()
-    .sum()
+/// Rays of `rays` that a kernel reports as hitting anything: `hits(chunk)` counts one chunk;
+/// chunks run on `threads` threads.
+fn count_hits(rays: &[RayQuery], threads: usize, hits: impl Fn(&[RayQuery]) -> usize + Sync) -> usize {
+    map_chunks(rays.len(), CHUNK, threads, |r| hits(&rays[r]), |_| {}).into_iter().sum()
 }
 
 /// Packet against obvhs single-ray traversal on every set and query. Also checks that both
@@ -267,54 +187,54 @@ fn single_any(scene: &Scene, rays: &[RayQuery], threads: usize) -> usize {
 /// which do not change whether a ray hits).
 pub fn traversal(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usize) -> Vec<TraversalRow> {
     let cw = crate::geometry::bvh::CwBaseline::build(scene.columns());
+    let (bvh, tris) = (scene.bvh(), scene.columns());
     let mut rows = vec![];
     for (label, rays) in [("camera", &sets.camera), ("shadow", &sets.shadow), ("diffuse", &sets.diffuse)] {
         if rays.is_empty() {
             continue;
         }
-        for query in ["closest", "any"] {
-            let (mut hp, mut hs) = (0, 0);
-            let (tp, ts) = if query == "closest" {
-                time_pair(
-                    reps,
-                    || hp = packets_closest(scene, rays, threads),
-                    || hs = single_closest(scene, rays, threads),
-                )
-            } else {
-                time_pair(reps, || hp = packets_any(scene, rays, threads), || hs = single_any(scene, rays, threads))
+        for any in [false, true] {
+            let query = if any { "any" } else { "closest" };
+            // Each kernel as "how many rays of this chunk hit".
+            let packet = |c: &[RayQuery]| {
+                if any {
+                    let mut out = vec![false; c.len()];
+                    occluded_packets(bvh, tris, c, &mut out);
+                    out.iter().filter(|&&b| b).count()
+                } else {
+                    let mut out = vec![None; c.len()];
+                    closest_packets(bvh, tris, c, &mut out);
+                    out.iter().filter(|h| h.is_some()).count()
+                }
             };
+            let obvhs = per_ray(|q: &RayQuery| {
+                if any {
+                    bvh.occluded_obvhs(tris, q.origin, q.direction, q.t_max)
+                } else {
+                    bvh.closest_obvhs(tris, q.origin, q.direction, q.t_max).is_some()
+                }
+            });
+            let twin = per_ray(|q: &RayQuery| {
+                if any {
+                    scene.occluded(q.origin, q.direction, q.t_max)
+                } else {
+                    scene.intersect(q.origin, q.direction, q.t_max).is_some()
+                }
+            });
+            let cwbvh = per_ray(|q: &RayQuery| {
+                if any {
+                    cw.occluded(tris, q.origin, q.direction, q.t_max)
+                } else {
+                    cw.closest(tris, q.origin, q.direction, q.t_max)
+                }
+            });
+            let (mut hp, mut hs, mut ht, mut hc) = (0, 0, 0, 0);
+            let (tp, ts) =
+                time_pair(reps, || hp = count_hits(rays, threads, packet), || hs = count_hits(rays, threads, &obvhs));
             assert_eq!(hp, hs, "{name} {label} {query}: packet and single-ray hit counts differ");
-            let mut ht = 0;
-            let (tt, _) = if query == "closest" {
-                time_pair(reps, || ht = twin_closest(scene, rays, threads), || {})
-            } else {
-                time_pair(reps, || ht = twin_any(scene, rays, threads), || {})
-            };
+            let (tt, tc) =
+                time_pair(reps, || ht = count_hits(rays, threads, &twin), || hc = count_hits(rays, threads, &cwbvh));
             assert_eq!(ht, hs, "{name} {label} {query}: scalar twin and obvhs hit counts differ");
-            let cw_count = |any: bool| {
-                map_chunks(
-                    rays.len(),
-                    CHUNK,
-                    threads,
-                    |r| {
-                        rays[r]
-                            .iter()
-                            .filter(|q| {
-                                if any {
-                                    cw.occluded(scene.columns(), q.origin, q.direction, q.t_max)
-                                } else {
-                                    cw.closest(scene.columns(), q.origin, q.direction, q.t_max)
-                                }
-                            })
-                            .count()
-                    },
-                    |_| {},
-                )
-                .into_iter()
-                .sum::<usize>()
-            };
-            let mut hc = 0;
-            let (tc, _) = time_pair(reps, || hc = cw_count(query == "any"), || {});
             // Not asserted: obvhs's CWBVH traversal loses a few hits (recorded, see BENCHMARKS.md).
             let m = rays.len() as f64 * 1e-6;
             rows.push(TraversalRow {
@@ -488,8 +408,8 @@ fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usiz
         .into_iter()
         .sum::<f32>()
     };
-    let mut radii: Vec<f64> = knn(KernelSet::Scalar).iter().map(|e| f64::from(e.radius)).collect();
-    let r_fixed = if radii.is_empty() { r_max } else { median(std::mem::take(&mut radii)) as f32 };
+    let radii: Vec<f64> = knn(KernelSet::Scalar).iter().map(|e| f64::from(e.radius)).collect();
+    let r_fixed = if radii.is_empty() { r_max } else { median(radii) as f32 };
     let (ts, tk) = time_pair(reps, || drop(knn(KernelSet::Simd)), || drop(knn(KernelSet::Scalar)));
     let (rs, rk) = time_pair(
         reps,
