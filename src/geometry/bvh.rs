@@ -94,12 +94,7 @@ impl Bvh {
             return false;
         }
         let ray = Ray::new(Vec3A::from(o), Vec3A::from(d), 0.0, t_max);
-        !self.bvh.ray_traverse_miss(ray, |_, id| {
-            match intersect_triangle(o, d, t_max, tris.p0[id], tris.p1[id], tris.p2[id]) {
-                Some(h) => h.t,
-                None => f32::INFINITY,
-            }
-        })
+        !self.bvh.ray_traverse_miss(ray, |_, id| hit_t(tris, o, d, t_max, id))
     }
 
     /// Number of triangle tests a closest-hit query makes (a measure of BVH quality that does not
@@ -114,10 +109,16 @@ impl Bvh {
         let ray = Ray::new(Vec3A::from(o), Vec3A::from(d), 0.0, f32::INFINITY);
         self.bvh.ray_traverse(ray, &mut rh, |r, id| {
             tests += 1;
-            intersect_triangle(o, d, r.tmax, tris.p0[id], tris.p1[id], tris.p2[id]).map_or(f32::INFINITY, |h| h.t)
+            hit_t(tris, o, d, r.tmax, id)
         });
         tests
     }
+}
+
+/// t of triangle `i`'s hit in (0, t_max), or +∞: what obvhs's traversal callbacks return.
+#[inline]
+fn hit_t(tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32, i: usize) -> f32 {
+    intersect_triangle(o, d, t_max, tris.p0[i], tris.p1[i], tris.p2[i]).map_or(f32::INFINITY, |h| h.t)
 }
 
 /// Triangle boxes padded as [`Bvh::build`] pads them (module notes): by [`BOX_PAD`] of the
@@ -166,10 +167,7 @@ impl CwBaseline {
         let ray = Ray::new(Vec3A::from(o), Vec3A::from(d), 0.0, t_max);
         let mut rh = obvhs::ray::RayHit::none();
         let idx = &self.bvh.primitive_indices;
-        self.bvh.ray_traverse(ray, &mut rh, |r, id| {
-            let i = idx[id] as usize;
-            intersect_triangle(o, d, r.tmax, tris.p0[i], tris.p1[i], tris.p2[i]).map_or(f32::INFINITY, |h| h.t)
-        })
+        self.bvh.ray_traverse(ray, &mut rh, |r, id| hit_t(tris, o, d, r.tmax, idx[id] as usize))
     }
 
     /// Any hit (obvhs CWBVH traversal).
@@ -180,10 +178,7 @@ impl CwBaseline {
         }
         let ray = Ray::new(Vec3A::from(o), Vec3A::from(d), 0.0, t_max);
         let idx = &self.bvh.primitive_indices;
-        !self.bvh.ray_traverse_miss(ray, |_, id| {
-            let i = idx[id] as usize;
-            intersect_triangle(o, d, t_max, tris.p0[i], tris.p1[i], tris.p2[i]).map_or(f32::INFINITY, |h| h.t)
-        })
+        !self.bvh.ray_traverse_miss(ray, |_, id| hit_t(tris, o, d, t_max, idx[id] as usize))
     }
 }
 
