@@ -11,7 +11,9 @@ use rayon_core::{ThreadPool, ThreadPoolBuilder};
 /// work ~3 000 times per render (every stage of every bounce), so fresh threads per call cost ~9 %
 /// of a two-thread render (BENCHMARKS.md). `None` if the OS refuses the threads.
 fn pool(threads: usize) -> Option<Arc<ThreadPool>> {
-    static POOLS: OnceLock<Mutex<Vec<(usize, Arc<ThreadPool>)>>> = OnceLock::new();
+    /// Pools built so far, by worker count.
+    type Pools = Mutex<Vec<(usize, Arc<ThreadPool>)>>;
+    static POOLS: OnceLock<Pools> = OnceLock::new();
     let mut pools = POOLS.get_or_init(Mutex::default).lock().unwrap_or_else(|e| e.into_inner());
     if let Some((_, p)) = pools.iter().find(|(t, _)| *t == threads) {
         return Some(Arc::clone(p));
