@@ -130,23 +130,71 @@ fn srgb8(v: f32) -> u8 {
     (s * 255.0 + 0.5) as u8
 }
 
-/// Reads the named layer (`""` for beauty) of an EXR written by [`Film::write_exr`] as RGB.
-pub fn read_exr_layer(path: &Path, layer: &str) -> Result<(u32, u32, Vec<Vec3>)> {
+/// An RGB image read from an EXR: its size and every layer that has R, G and B channels, the
+/// default (unnamed) layer first as `""`, then the term layers in [`TERM_NAMES`] order, then any
+/// others by name.
+pub struct ExrLayers {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// (layer name, pixels) — `""` is the beauty image in files written by [`Film::write_exr`].
+    pub layers: Vec<(String, Vec<Vec3>)>,
+}
+
+/// Reads every RGB layer of the first part of the EXR at `path`.
+pub fn read_exr(path: &Path) -> Result<ExrLayers> {
     use exr::prelude::*;
     let image = read_all_flat_layers_from_file(path).map_err(|e| PwError::io(path, e))?;
     let l = image.layer_data.first().ok_or_else(|| PwError::parse(path, 0, "EXR has no layer"))?;
     let (w, h) = (l.size.0, l.size.1);
-    let find = |c: &str| {
-        let name = if layer.is_empty() { c.to_string() } else { format!("{layer}.{c}") };
+    let channel = |name: &str| {
         l.channel_data
             .list
             .iter()
-            .find(|ch| ch.name.eq(name.as_str()))
+            .find(|ch| ch.name.eq(name))
             .map(|ch| ch.sample_data.values_as_f32().collect::<Vec<f32>>())
     };
-    let (r, g, b) = match (find("R"), find("G"), find("B")) {
-        (Some(r), Some(g), Some(b)) => (r, g, b),
-        _ => return Err(PwError::parse(path, 0, format!("EXR has no RGB channels for layer `{layer}`"))),
-    };
-    Ok((w as u32, h as u32, (0..w * h).map(|i| Vec3::new(r[i], g[i], b[i])).collect()))
+    // Layer names: the part of `layer.R` before the last dot, "" for a bare `R`.
+    let mut names: Vec<String> = l
+        .channel_data
+        .list
+        .iter()
+        .filter_map(|ch| {
+            let full = ch.name.to_string();
+            match full.rsplit_once('.') {
+                Some((layer, "R")) => Some(layer.to_string()),
+                None if full == "R" => Some(String::new()),
+                _ => None,
+            }
+        })
+        .collect();
+    // Beauty, then the terms in film order, then anything else by name.
+    names.sort_by_key(|n| {
+        (!n.is_empty(), TERM_NAMES.iter().position(|t| t == n).unwrap_or(TERM_NAMES.len()), n.clone())
+    });
+    names.dedup();
+    let mut layers = Vec::new();
+    for name in names {
+        let full = |c: &str| if name.is_empty() { c.to_string() } else { format!("{name}.{c}") };
+        if let (Some(r), Some(g), Some(b)) = (channel(&full("R")), channel(&full("G")), channel(&full("B"))) {
+            layers.push((name, (0..w * h).map(|i| Vec3::new(r[i], g[i], b[i])).collect()));
+        }
+    }
+    if layers.is_empty() {
+        return Err(PwError::parse(path, 0, "EXR has no layer with R, G and B channels"));
+    }
+    Ok(ExrLayers { width: w as u32, height: h as u32, layers })
+}
+
+/// Reads the named layer (`""` for beauty) of an EXR written by [`Film::write_exr`] as RGB.
+pub fn read_exr_layer(path: &Path, layer: &str) -> Result<(u32, u32, Vec<Vec3>)> {
+    let image = read_exr(path)?;
+    let pixels = image
+        .layers
+        .into_iter()
+        .find(|(n, _)| n == layer)
+        .map(|(_, p)| p)
+        .ok_or_else(|| PwError::parse(path, 0, format!("EXR has no RGB channels for layer `{layer}`")))?;
+    Ok((image.width, image.height, pixels))
 }

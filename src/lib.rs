@@ -11,6 +11,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod bench;
+pub mod compare;
 pub mod effects;
 pub mod error;
 pub mod film;

@@ -27,6 +27,20 @@ enum Command {
     /// Throughput of the SIMD kernels against their baselines on identical rays and queries:
     /// packet vs obvhs single-ray traversal, SIMD vs scalar density estimates.
     Bench(BenchArgs),
+    /// Error of an image against a reference (both EXRs written by `render`): RMSE, relMSE
+    /// ((a−b)²/(b²+0.01)) and mean ratio for the beauty image and each term layer in both.
+    Compare(CompareArgs),
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    /// The image to measure (.exr).
+    image: PathBuf,
+    /// The reference image (.exr), e.g. a long progressive render.
+    reference: PathBuf,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(clap::Args)]
@@ -337,11 +351,22 @@ fn bench(args: BenchArgs) -> Result<()> {
     Ok(())
 }
 
+fn compare(args: &CompareArgs) -> Result<()> {
+    let c = photonwave::compare::compare_files(&args.image, &args.reference)?;
+    if args.json {
+        println!("{}", serde_json::to_string(&c).map_err(|e| Error::output(std::path::Path::new("stdout"), e))?);
+    } else {
+        print!("{}", c.table());
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render(*args),
         Command::Bench(args) => bench(args),
+        Command::Compare(args) => compare(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

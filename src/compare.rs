@@ -1,0 +1,147 @@
+//! How far an image is from a reference: RMSE, relative MSE and the ratio of means, for the
+//! beauty image and for each Jensen term layer present in both files.
+
+use crate::error::{Error, Result};
+use crate::film::read_exr;
+use glam::Vec3;
+use serde::Serialize;
+use std::path::Path;
+
+/// The relMSE denominator's offset: (a − b)² / (b² + ε), so that black reference pixels do not
+/// dominate.
+pub const REL_EPSILON: f64 = 0.01;
+
+/// Error of one layer against its reference, over every pixel and channel.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LayerError {
+    /// Layer name: `beauty`, or a term (`direct`, `caustic`, …).
+    pub layer: String,
+    /// √(mean (a − b)²).
+    pub rmse: f64,
+    /// mean (a − b)² / (b² + [`REL_EPSILON`]).
+    pub rel_mse: f64,
+    /// mean(a) / mean(b); `None` when the reference's mean is 0.
+    pub mean_ratio: Option<f64>,
+    /// mean(a).
+    pub mean: f64,
+    /// mean(b), the reference's.
+    pub reference_mean: f64,
+}
+
+/// `a` against the reference `b` (same length, finite values).
+#[must_use]
+pub fn layer_error(layer: &str, a: &[Vec3], b: &[Vec3]) -> LayerError {
+    let (mut se, mut rel, mut sa, mut sb) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for (x, y) in a.iter().zip(b) {
+        for c in 0..3 {
+            let (x, y) = (f64::from(x[c]), f64::from(y[c]));
+            let d2 = (x - y) * (x - y);
+            se += d2;
+            rel += d2 / (y * y + REL_EPSILON);
+            sa += x;
+            sb += y;
+        }
+    }
+    let n = (3 * a.len().min(b.len())).max(1) as f64;
+    LayerError {
+        layer: layer.to_string(),
+        rmse: (se / n).sqrt(),
+        rel_mse: rel / n,
+        mean_ratio: (sb != 0.0).then(|| sa / sb),
+        mean: sa / n,
+        reference_mean: sb / n,
+    }
+}
+
+/// The comparison of two EXR files.
+#[derive(Clone, Debug, Serialize)]
+pub struct Comparison {
+    /// The image compared.
+    pub image: String,
+    /// The reference.
+    pub reference: String,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Beauty first, then each term layer present in both files.
+    pub layers: Vec<LayerError>,
+}
+
+/// Compares the EXR at `image` with the reference EXR at `reference`: both must have the same
+/// size and finite values; layers present in only one file are skipped.
+pub fn compare_files(image: &Path, reference: &Path) -> Result<Comparison> {
+    let a = read_exr(image)?;
+    let b = read_exr(reference)?;
+    if (a.width, a.height) != (b.width, b.height) {
+        return Err(Error::parse(
+            image,
+            0,
+            format!(
+                "is {}×{} but the reference {} is {}×{}",
+                a.width,
+                a.height,
+                reference.display(),
+                b.width,
+                b.height
+            ),
+        ));
+    }
+    for (path, img) in [(image, &a), (reference, &b)] {
+        for (name, pixels) in &img.layers {
+            let bad = pixels.iter().filter(|p| !p.is_finite()).count();
+            if bad > 0 {
+                let name = if name.is_empty() { "beauty" } else { name.as_str() };
+                return Err(Error::parse(
+                    path,
+                    0,
+                    format!("layer `{name}`: {bad} of {} pixels are NaN or infinite", pixels.len()),
+                ));
+            }
+        }
+    }
+    let mut layers = Vec::new();
+    for (name, pa) in &a.layers {
+        if let Some((_, pb)) = b.layers.iter().find(|(n, _)| n == name) {
+            layers.push(layer_error(if name.is_empty() { "beauty" } else { name }, pa, pb));
+        }
+    }
+    if layers.is_empty() {
+        return Err(Error::parse(image, 0, format!("shares no RGB layer with {}", reference.display())));
+    }
+    Ok(Comparison {
+        image: image.display().to_string(),
+        reference: reference.display().to_string(),
+        width: a.width,
+        height: a.height,
+        layers,
+    })
+}
+
+impl Comparison {
+    /// A text table, one row per layer.
+    #[must_use]
+    pub fn table(&self) -> String {
+        let mut s = format!(
+            "{} against {} ({}×{})\n{:<10} {:>12} {:>12} {:>10} {:>12} {:>12}\n",
+            self.image,
+            self.reference,
+            self.width,
+            self.height,
+            "layer",
+            "RMSE",
+            "relMSE",
+            "mean ratio",
+            "mean",
+            "ref mean"
+        );
+        for l in &self.layers {
+            let ratio = l.mean_ratio.map_or("-".to_string(), |r| format!("{r:.5}"));
+            s += &format!(
+                "{:<10} {:>12.4e} {:>12.4e} {:>10} {:>12.4e} {:>12.4e}\n",
+                l.layer, l.rmse, l.rel_mse, ratio, l.mean, l.reference_mean
+            );
+        }
+        s
+    }
+}
