@@ -19,6 +19,7 @@ pub mod geometry;
 pub mod kernels;
 pub mod material;
 pub mod photon_map;
+pub mod progressive;
 pub mod reference;
 pub mod rng;
 pub mod sampling;

@@ -74,6 +74,27 @@ struct BenchArgs {
     rings: u32,
 }
 
+fn parse_duration(s: &str) -> std::result::Result<std::time::Duration, String> {
+    let t = s.trim();
+    let (num, unit) = match t.find(|c: char| c.is_ascii_alphabetic()) {
+        Some(i) => t.split_at(i),
+        None => (t, "s"),
+    };
+    let scale = match unit {
+        "ms" => 1e-3,
+        "s" => 1.0,
+        "m" | "min" => 60.0,
+        "h" => 3600.0,
+        _ => return Err(format!("unknown unit `{unit}` in `{s}` (ms, s, m, h)")),
+    };
+    let v: f64 = num.trim().parse().map_err(|_| format!("`{s}` is not a duration such as 30s, 500ms or 2m"))?;
+    let secs = v * scale;
+    if !(secs > 0.0 && secs <= 1e7) {
+        return Err(format!("`{s}`: the budget must be positive and at most 10 000 000 s"));
+    }
+    Ok(std::time::Duration::from_secs_f64(secs))
+}
+
 fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
     let parts: Vec<&str> = s.split(',').collect();
     if parts.len() != 3 {
@@ -143,6 +164,17 @@ struct RenderArgs {
     /// caustic_map, global_map, final_gather, refraction, shadow_rays.
     #[arg(long)]
     force: Vec<String>,
+    /// Progressive passes: each traces fresh photons and estimates with fixed radii that shrink
+    /// pass by pass (α); the image is their mean [1 = one k-nearest-neighbour render].
+    #[arg(long)]
+    passes: Option<u32>,
+    /// Time budget, e.g. `30s`, `500ms`, `2m`: progressive passes until it is spent, ending
+    /// within 5 % of it (counted from the start, scene loading included).
+    #[arg(long, value_parser = parse_duration)]
+    time: Option<std::time::Duration>,
+    /// Radius reduction of progressive passes, r²ᵢ₊₁ = r²ᵢ·(i+α)/(i+1) [0.6667].
+    #[arg(long)]
+    alpha: Option<f32>,
     /// Longest photon path / specular chain [10].
     #[arg(long)]
     max_depth: Option<u32>,
@@ -190,7 +222,7 @@ impl Progress for Bars {
         }
         let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
         bar.set_style(
-            ProgressStyle::with_template("{prefix:>16} [{bar:40}] {pos}/{len} ({elapsed}, eta {eta})")
+            ProgressStyle::with_template("{prefix:>16} [{bar:40}] {pos}/{len} ({elapsed}, eta {eta}) {msg}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar())
                 .progress_chars("=> "),
         );
@@ -200,6 +232,11 @@ impl Progress for Bars {
     fn advance(&self, n: u64) {
         if let Some(b) = &*self.bar.lock().unwrap_or_else(|e| e.into_inner()) {
             b.inc(n);
+        }
+    }
+    fn message(&self, text: &str) {
+        if let Some(b) = &*self.bar.lock().unwrap_or_else(|e| e.into_inner()) {
+            b.set_message(text.to_string());
         }
     }
     fn finish(&self) {
@@ -221,6 +258,12 @@ fn render(args: RenderArgs) -> Result<()> {
     if let Some(k) = args.k {
         settings.k = k;
         settings.caustic_k = k;
+    }
+    if let Some(p) = args.passes {
+        settings.passes = p;
+    }
+    if let Some(a) = args.alpha {
+        settings.alpha = a;
     }
     settings.force.extend(args.force.iter().cloned());
     if args.no_final_gather {
@@ -257,10 +300,27 @@ fn render(args: RenderArgs) -> Result<()> {
     eprint!("{}", plan.describe());
     let quiet = args.quiet || !std::io::IsTerminal::is_terminal(&std::io::stderr());
     let bars = Bars { bar: Mutex::new(None), quiet };
-    let (film, mut stats) = match args.engine {
-        Engine::Wavefront => photonwave::wavefront::render(scene.clone(), &rays, &settings, &bars)?,
-        Engine::Reference => reference::render(&scene, &rays, &settings, &bars)?,
-        Engine::Path => reference::path::render_path_traced_with_stats(&scene, &rays, &settings, &bars)?,
+    let progressive = settings.passes > 1 || args.time.is_some();
+    let (film, mut stats) = if progressive {
+        if args.engine == Engine::Path {
+            return Err(Error::setting(
+                "--engine",
+                "progressive passes (--passes, --time) need a photon-mapping engine",
+            ));
+        }
+        let pass = photonwave::progressive::per_pass(
+            &settings,
+            args.spp.is_some(),
+            args.photons.is_some(),
+            args.caustic_photons.is_some(),
+        );
+        render_progressive(&scene, &rays, &pass, args.engine, args.time, t0, &bars)?
+    } else {
+        match args.engine {
+            Engine::Wavefront => photonwave::wavefront::render(scene.clone(), &rays, &settings, &bars)?,
+            Engine::Reference => reference::render(&scene, &rays, &settings, &bars)?,
+            Engine::Path => reference::path::render_path_traced_with_stats(&scene, &rays, &settings, &bars)?,
+        }
     };
     stats.scene = args.scene.display().to_string();
     stats.times.load_s = load_s;
@@ -279,6 +339,87 @@ fn render(args: RenderArgs) -> Result<()> {
         eprintln!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// Progressive passes until `settings.passes` or the time budget (from `t0`) is reached, with one
+/// progress bar over the passes.
+fn render_progressive(
+    scene: &std::sync::Arc<photonwave::scene::Scene>,
+    rays: &photonwave::scene::camera::CameraRays,
+    settings: &photonwave::settings::Settings,
+    engine: Engine,
+    budget: Option<std::time::Duration>,
+    t0: Instant,
+    bars: &Bars,
+) -> Result<(photonwave::film::Film, photonwave::stats::RenderStats)> {
+    use photonwave::progressive::Progressive;
+    let run = |s: &photonwave::settings::Settings| match engine {
+        Engine::Reference => reference::render(scene, rays, s, &reference::NoProgress),
+        _ => photonwave::wavefront::render(scene.clone(), rays, s, &reference::NoProgress),
+    };
+    eprintln!(
+        "progressive: {} each {} spp, {} global + {} caustic photons, α = {:.3}",
+        match budget {
+            Some(b) => format!("passes for {:.2} s,", b.as_secs_f64()),
+            None => format!("{} passes,", settings.passes),
+        },
+        settings.spp,
+        settings.photons,
+        settings.caustic_photons,
+        settings.alpha
+    );
+    let mut p = Progressive::new(scene, settings)?;
+    let total = budget.map_or(u64::from(settings.passes), |b| b.as_millis() as u64);
+    bars.start(if budget.is_some() { "ms of budget" } else { "passes" }, total);
+    let mut shown = 0u64;
+    loop {
+        let elapsed = t0.elapsed();
+        let go_on = match budget {
+            Some(b) => p.another_fits(elapsed, b),
+            None => p.passes() < settings.passes,
+        };
+        if !go_on {
+            break;
+        }
+        p.step(&run)?;
+        let elapsed = t0.elapsed();
+        let done = match budget {
+            Some(b) => {
+                bars.message(&format!(
+                    "pass {}, {:.1} s left",
+                    p.passes(),
+                    (b.as_secs_f64() - elapsed.as_secs_f64()).max(0.0)
+                ));
+                (elapsed.as_millis() as u64).min(total)
+            }
+            None => {
+                bars.message(&format!("pass {} of {}", p.passes(), settings.passes));
+                u64::from(p.passes())
+            }
+        };
+        bars.advance(done - shown.min(done));
+        shown = shown.max(done);
+    }
+    bars.finish();
+    let film = p.image();
+    let mut stats = p.stats.clone();
+    let mut prog = p.progress.clone();
+    prog.budget_s = budget.map(|b| b.as_secs_f64());
+    prog.elapsed_s = t0.elapsed().as_secs_f64();
+    if let (Some(b), Some(&first)) = (budget, prog.pass_seconds.first()) {
+        if first > 0.05 * b.as_secs_f64() {
+            eprintln!(
+                "warning: one pass takes {first:.2} s, more than 5 % of the {:.2} s budget; lower --spp or --photons per pass to end closer to it",
+                b.as_secs_f64()
+            );
+        }
+    }
+    stats.progressive = Some(prog);
+    stats.passes.push(format!("{} progressive passes", p.passes()));
+    stats.spp = settings.spp * p.passes();
+    stats.times.total_s = t0.elapsed().as_secs_f64();
+    stats.mean_rgb = film.mean().to_array();
+    Ok((film, stats))
 }
 
 fn bench(args: BenchArgs) -> Result<()> {

@@ -75,6 +75,26 @@ pub struct Settings {
     /// Parts of the effects plan to force on even where the scene does not need them (for
     /// comparison): any of `caustic_map`, `global_map`, `final_gather`, `refraction`, `shadow_rays`.
     pub force: Vec<String>,
+    /// Progressive passes (1 = a single k-nearest-neighbour render). With more, every pass
+    /// traces fresh photons and estimates with fixed radii that shrink pass by pass (Knaus &
+    /// Zwicker 2011), and the image is the mean of the passes.
+    pub passes: u32,
+    /// Radius reduction of progressive passes: r²ᵢ₊₁ = r²ᵢ·(i + α)/(i + 1). Smaller α shrinks
+    /// faster (less bias, more noise).
+    pub alpha: f32,
+    /// Set by the progressive driver for one pass: estimate every photon within these radii
+    /// (scene units) instead of the k nearest. Not a user setting.
+    #[serde(skip)]
+    pub fixed_radii: Option<FixedRadii>,
+}
+
+/// Fixed density-estimation radii of one progressive pass, in scene units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FixedRadii {
+    /// Global map (and the irradiance precomputed from it).
+    pub global: f32,
+    /// Caustic map.
+    pub caustic: f32,
 }
 
 impl Default for Settings {
@@ -99,6 +119,9 @@ impl Default for Settings {
             seed: 1,
             threads: 0,
             force: Vec::new(),
+            passes: 1,
+            alpha: 2.0 / 3.0,
+            fixed_radii: None,
         }
     }
 }
@@ -142,6 +165,17 @@ impl Settings {
         }
         if !(1..=1024).contains(&self.light_samples) {
             return err("light_samples", "must be between 1 and 1024");
+        }
+        if !(1..=10_000_000).contains(&self.passes) {
+            return err("passes", "must be between 1 and 10000000");
+        }
+        if !(self.alpha > 0.0 && self.alpha < 1.0) {
+            return err("alpha", "must be in (0, 1) (2/3 is the usual choice)");
+        }
+        if let Some(r) = self.fixed_radii {
+            if !(r.global > 0.0 && r.global.is_finite() && r.caustic > 0.0 && r.caustic.is_finite()) {
+                return err("fixed_radii", "progressive radii must be positive and finite");
+            }
         }
         if self.threads > 1024 {
             return err("threads", "at most 1024");

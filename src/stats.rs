@@ -107,6 +107,8 @@ pub struct RenderStats {
     pub stages: Option<crate::wavefront::StageStats>,
     /// Mean of the beauty image (RGB).
     pub mean_rgb: [f32; 3],
+    /// Progressive passes, radii and budget (progressive renders only).
+    pub progressive: Option<crate::progressive::ProgressiveStats>,
 }
 
 impl RenderStats {
@@ -165,7 +167,20 @@ impl RenderStats {
             t.total_s,
             self.non_finite_samples,
             self.non_finite_photons,
-        ) + &self.stage_summary()
+        ) + &self.progressive_summary()
+            + &self.stage_summary()
+    }
+
+    /// The progressive line: passes, radii, budget.
+    #[must_use]
+    pub fn progressive_summary(&self) -> String {
+        let Some(p) = &self.progressive else { return String::new() };
+        let budget =
+            p.budget_s.map_or(String::new(), |b| format!(", budget {b:.2} s, finished at {:.2} s", p.elapsed_s));
+        format!(
+            "  progressive: {} passes (α = {:.3}), radii global {:.4} → {:.4}, caustic {:.4} → {:.4}{budget}\n",
+            p.passes, p.alpha, p.initial_radii[0], p.final_radii[0], p.initial_radii[1], p.final_radii[1]
+        )
     }
 
     /// Per-system lines (wavefront engine): runs, lanes, time and lanes per second.

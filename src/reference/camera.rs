@@ -41,6 +41,8 @@ pub struct Context<'a> {
     pub global_radius: f32,
     /// Caustic-map radius in scene units.
     pub caustic_radius: f32,
+    /// Progressive pass: every photon within these radii, not the k nearest.
+    pub fixed: Option<crate::settings::FixedRadii>,
     /// What to simulate.
     pub effects: Effects,
 }
@@ -56,6 +58,7 @@ impl<'a> Context<'a> {
             settings,
             global_radius: settings.global_radius * d,
             caustic_radius: settings.caustic_radius * d,
+            fixed: settings.fixed_radii,
             effects: Effects::plan(scene, settings),
         }
     }
@@ -297,6 +300,7 @@ fn map_estimate(
     bsdf: &Bsdf,
     wo: Vec3,
     mask: u8,
+    fixed: Option<f32>,
     scratch: &mut Vec<(f32, u32)>,
 ) -> Vec3 {
     let (ng, _) = sp.frame.oriented(wo);
@@ -313,7 +317,10 @@ fn map_estimate(
         Bsdf::Lambert { kd } => Reflectance::Hemisphere { value: kd * std::f32::consts::FRAC_1_PI, ng },
         _ => Reflectance::PerPhoton(&eval),
     };
-    map.estimate(ctx.settings.kernels, &lookup, f, scratch).radiance
+    match fixed {
+        Some(r) => map.estimate_radius(ctx.settings.kernels, &Lookup { r_max: r, ..lookup }, f).radiance,
+        None => map.estimate(ctx.settings.kernels, &lookup, f, scratch).radiance,
+    }
 }
 
 /// Caustic-map radiance estimate at `sp` toward `wo`.
@@ -324,7 +331,8 @@ pub fn caustic_estimate(
     wo: Vec3,
     scratch: &mut Vec<(f32, u32)>,
 ) -> Vec3 {
-    map_estimate(ctx, &ctx.maps.caustic, ctx.settings.caustic_k, ctx.caustic_radius, sp, bsdf, wo, 0, scratch)
+    let fixed = ctx.fixed.map(|r| r.caustic);
+    map_estimate(ctx, &ctx.maps.caustic, ctx.settings.caustic_k, ctx.caustic_radius, sp, bsdf, wo, 0, fixed, scratch)
 }
 
 /// Global-map radiance estimate at `sp` toward `wo`, ignoring photons with any `mask` flag.
@@ -336,7 +344,8 @@ pub fn global_estimate(
     mask: u8,
     scratch: &mut Vec<(f32, u32)>,
 ) -> Vec3 {
-    map_estimate(ctx, &ctx.maps.global, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, scratch)
+    let fixed = ctx.fixed.map(|r| r.global);
+    map_estimate(ctx, &ctx.maps.global, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, fixed, scratch)
 }
 
 /// Final gather: `kd/N · Σ L(x, ωi)` over N cosine-weighted rays, L read from the global map at

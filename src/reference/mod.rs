@@ -89,7 +89,18 @@ fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings,
                         kernel: settings.kernel,
                         filter: Filter { n: src.normal, flags_mask: 0 },
                     };
-                    let e = global.estimate(settings.kernels, &lookup, Reflectance::Constant(Vec3::ONE), &mut scratch);
+                    let f = Reflectance::Constant(Vec3::ONE);
+                    let e = match settings.fixed_radii {
+                        Some(r) => {
+                            // Leave the photon itself out (see `PhotonMap::own_share`).
+                            let mut e =
+                                global.estimate_radius(settings.kernels, &Lookup { r_max: r.global, ..lookup }, f);
+                            e.radiance =
+                                (e.radiance - global.own_share(picks[j], r.global, settings.kernel)).max(Vec3::ZERO);
+                            e
+                        }
+                        None => global.estimate(settings.kernels, &lookup, f, &mut scratch),
+                    };
                     Photon { position: src.position, power: e.radiance, wi: src.normal, normal: src.normal, flags: 0 }
                 })
                 .collect::<Vec<_>>()
@@ -105,6 +116,8 @@ pub trait Progress: Sync {
     fn start(&self, phase: &str, total: u64);
     /// `n` more units are done.
     fn advance(&self, n: u64);
+    /// A status line beside the bar (passes, time left).
+    fn message(&self, _text: &str) {}
     /// The phase is over.
     fn finish(&self);
 }

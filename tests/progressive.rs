@@ -1,0 +1,162 @@
+//! Progressive photon mapping: the radius sequence, convergence at the predicted rate, seeds and
+//! threads, and time budgets.
+
+mod common;
+
+use common::load;
+use photonwave::film::Film;
+use photonwave::progressive::{radius2_scale, Progressive};
+use photonwave::reference::NoProgress;
+use photonwave::scene::camera::CameraRays;
+use photonwave::scene::Scene;
+use photonwave::settings::Settings;
+use std::sync::Arc;
+
+/// Small, fast passes of the glass-sphere box: caustics without final gather.
+fn small(seed: u64) -> Settings {
+    Settings {
+        width: 24,
+        height: 24,
+        spp: 1,
+        photons: 1000,
+        caustic_photons: 2000,
+        final_gather: false,
+        threads: 1,
+        seed,
+        ..Default::default()
+    }
+}
+
+/// The bundled glass-sphere box, shared, with its camera at the small settings' size.
+fn spheres() -> (Arc<Scene>, CameraRays) {
+    let loaded = load("cornell-spheres.toml");
+    let s = small(0);
+    let cam = loaded.camera.unwrap().prepare(s.width, s.height).unwrap();
+    (Arc::new(loaded.scene), cam)
+}
+
+/// Runs `passes` progressive passes with the wavefront engine, calling `at(n, image)` after each.
+fn progressive(
+    (scene, cam): &(Arc<Scene>, CameraRays),
+    settings: &Settings,
+    passes: u32,
+    mut at: impl FnMut(u32, Film),
+) {
+    let mut p = Progressive::new(scene, settings).unwrap();
+    let engine = |s: &Settings| photonwave::wavefront::render(scene.clone(), cam, s, &NoProgress);
+    for _ in 0..passes {
+        p.step(&engine).unwrap();
+        at(p.passes(), p.image());
+    }
+}
+
+fn caustic_rms_difference(a: &Film, b: &Film) -> f64 {
+    let se: f64 =
+        a.pixels.iter().zip(&b.pixels).map(|(x, y)| f64::from((x.caustic - y.caustic).length_squared())).sum();
+    (se / (3 * a.pixels.len()) as f64).sqrt()
+}
+
+/// Least-squares slope of log y against log x.
+fn log_slope(points: &[(f64, f64)]) -> f64 {
+    let n = points.len() as f64;
+    let (xs, ys): (Vec<f64>, Vec<f64>) = points.iter().map(|&(x, y)| (x.ln(), y.ln())).unzip();
+    let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
+    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = xs.iter().map(|x| (x - mx) * (x - mx)).sum();
+    sxy / sxx
+}
+
+#[test]
+fn radii_shrink_as_knaus_and_zwicker_prescribe() {
+    let alpha = 2.0 / 3.0;
+    assert_eq!(radius2_scale(1, alpha), 1.0);
+    assert!((radius2_scale(2, alpha) - (1.0 + 2.0 / 3.0) / 2.0).abs() < 1e-7);
+    // r²ᵢ ∝ i^(α−1) asymptotically: the ratio over a doubling of i tends to 2^(−1/3).
+    let ratio = radius2_scale(20_000, alpha) / radius2_scale(10_000, alpha);
+    assert!((ratio - 2f64.powf(alpha as f64 - 1.0)).abs() < 1e-4, "{ratio}");
+    for i in 1..100 {
+        assert!(radius2_scale(i + 1, alpha) < radius2_scale(i, alpha));
+    }
+}
+
+/// The caustic layer's error falls as passes grow, at the rate the radius sequence predicts.
+///
+/// Two independent runs (different seeds) differ by √2 × each one's noise, with the bias
+/// cancelled, so their RMS difference measures the variance part of the error without a
+/// converged reference. For a fixed photon count per pass the variance of pass i ∝ 1/r²ᵢ, so the
+/// mean of N passes has variance ∝ Σᵢ 1/r²ᵢ / N² — predicted slope −0.394 over N = 1…16 for
+/// α = 2/3 (−1/3 asymptotically; camera jitter at 1 spp, whose variance falls as 1/N, pulls the
+/// measured slope toward −1/2). Squared differences are pooled over 4 seed pairs. Tolerance:
+/// single pairs' slopes spread with a standard deviation of 0.27 (6 pairs measured, 24² pixels,
+/// dominated by a few bright caustic pixels), so the pooled slope's standard error is ≈ 0.14;
+/// ±0.3 is ≈ 2.2 of them, and a render that did not converge (slope ≥ 0) fails by ≥ 2.7.
+#[test]
+fn progressive_error_falls_at_the_predicted_rate() {
+    let shared = spheres();
+    let marks = [1u32, 2, 4, 8, 16];
+    let mut mse = [0.0f64; 5];
+    for pair in 0..4u64 {
+        let mut runs = [Vec::new(), Vec::new()];
+        for (k, run) in runs.iter_mut().enumerate() {
+            progressive(&shared, &small(100 + 2 * pair + k as u64), 16, |n, f| {
+                if marks.contains(&n) {
+                    run.push(f);
+                }
+            });
+        }
+        for (m, (a, b)) in mse.iter_mut().zip(runs[0].iter().zip(&runs[1])) {
+            *m += caustic_rms_difference(a, b).powi(2) / 4.0;
+        }
+    }
+    let points: Vec<(f64, f64)> = marks.iter().zip(&mse).map(|(&n, &m)| (f64::from(n), m.sqrt())).collect();
+    let alpha = small(0).alpha;
+    let predicted: Vec<(f64, f64)> = marks
+        .iter()
+        .map(|&n| {
+            (f64::from(n), ((1..=n).map(|i| 1.0 / radius2_scale(i, alpha)).sum::<f64>() / f64::from(n * n)).sqrt())
+        })
+        .collect();
+    let (measured, expected) = (log_slope(&points), log_slope(&predicted));
+    assert!((expected + 0.394).abs() < 0.005, "{expected}");
+    assert!(points[4].1 < 0.5 * points[0].1, "error did not fall: {points:?}");
+    println!("caustic RMS difference {points:?}: slope {measured:.3}, predicted {expected:.3}");
+    assert!((measured - expected).abs() < 0.3, "slope {measured:.3}, predicted {expected:.3}: {points:?}");
+}
+
+/// The same seed gives the same progressive image at 1 and 2 threads.
+#[test]
+fn same_seed_same_image_at_any_thread_count() {
+    let shared = spheres();
+    let mut images = Vec::new();
+    for threads in [1, 2] {
+        let mut last = None;
+        progressive(&shared, &Settings { threads, ..small(7) }, 3, |_, f| last = Some(f));
+        images.push(last.unwrap());
+    }
+    assert_eq!(images[0], images[1]);
+}
+
+/// `--time` ends within 5 % of the budget, counted by the process's wall clock (scene loading
+/// and writing the EXR included), with passes of ~10–30 ms.
+#[test]
+fn time_budget_is_met_within_five_percent() {
+    let d = common::scratch_dir("time-budget");
+    let (out, stats) = (d.join("t.exr"), d.join("t.json"));
+    let budget = 2.0;
+    let t = std::time::Instant::now();
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_photonwave"))
+        .args(["render", common::bundled("cornell-spheres.toml").to_str().unwrap()])
+        .args(["--width", "32", "--height", "32", "--photons", "1000", "--caustic-photons", "2000"])
+        .args(["--time", "2s", "--threads", "1", "-q", "-o", out.to_str().unwrap(), "--stats", stats.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let wall = t.elapsed().as_secs_f64();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    let passes = s["progressive"]["passes"].as_u64().unwrap();
+    assert!(passes >= 20, "{passes} passes");
+    assert!(
+        (wall - budget).abs() <= 0.05 * budget,
+        "finished after {wall:.3} s for a {budget} s budget ({passes} passes)"
+    );
+}
