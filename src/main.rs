@@ -357,15 +357,22 @@ fn render_progressive(
         Engine::Reference => reference::render(scene, rays, s, &reference::NoProgress),
         _ => photonwave::wavefront::render(scene.clone(), rays, s, &reference::NoProgress),
     };
+    let plan = Effects::plan(scene, settings);
+    let maps: Vec<String> =
+        [(plan.global_map.on, settings.photons, "global"), (plan.caustic_map.on, settings.caustic_photons, "caustic")]
+            .iter()
+            .filter(|m| m.0)
+            .map(|m| format!("{} {} photons", m.1, m.2))
+            .collect();
     eprintln!(
-        "progressive: {} each {} spp, {} global + {} caustic photons, α = {:.3}",
+        "progressive: {} each {} spp{}{}, α = {:.3}",
         match budget {
             Some(b) => format!("passes for {:.2} s,", b.as_secs_f64()),
             None => format!("{} passes,", settings.passes),
         },
         settings.spp,
-        settings.photons,
-        settings.caustic_photons,
+        if maps.is_empty() { "" } else { ", " },
+        maps.join(" + "),
         settings.alpha
     );
     let mut p = Progressive::new(scene, settings)?;
