@@ -56,10 +56,7 @@ pub fn pass_seed(seed: u64, i: u32) -> u64 {
     if i == 0 {
         return seed;
     }
-    let mut z = seed ^ u64::from(i).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
+    crate::rng::mix64(seed ^ u64::from(i).wrapping_mul(0x9e37_79b9_7f4a_7c15))
 }
 
 /// r²ᵢ / r²₁ for pass `i` (1-based): ∏ⱼ₌₁^{i−1} (j + α)/(j + 1).
@@ -119,6 +116,8 @@ pub fn initial_radii(scene: &Scene, settings: &Settings) -> FixedRadii {
 pub struct Progressive {
     settings: Settings,
     first: FixedRadii,
+    /// r² of the next pass over r² of the first ([`radius2_scale`], kept as a running product).
+    scale2: f64,
     sum: Vec<Terms>,
     /// Stats of the passes so far (rays and phase times summed; the rest from the last pass).
     pub stats: RenderStats,
@@ -135,6 +134,7 @@ impl Progressive {
         Ok(Progressive {
             settings: settings.clone(),
             first,
+            scale2: 1.0,
             sum: vec![Terms::default(); settings.width as usize * settings.height as usize],
             stats: RenderStats::default(),
             progress: ProgressiveStats {
@@ -145,10 +145,10 @@ impl Progressive {
         })
     }
 
-    /// The radii of pass `i` (1-based).
+    /// The radii of the next pass.
     #[must_use]
-    pub fn radii(&self, i: u32) -> FixedRadii {
-        let s = radius2_scale(i, self.settings.alpha).sqrt() as f32;
+    pub fn next_radii(&self) -> FixedRadii {
+        let s = self.scale2.sqrt() as f32;
         FixedRadii { global: self.first.global * s, caustic: self.first.caustic * s }
     }
 
@@ -162,25 +162,29 @@ impl Progressive {
     pub fn step(&mut self, engine: &dyn Fn(&Settings) -> Result<(Film, RenderStats)>) -> Result<()> {
         let t = Instant::now();
         let i = self.progress.passes;
-        let radii = self.radii(i + 1);
+        let radii = self.next_radii();
         let pass =
             Settings { seed: pass_seed(self.settings.seed, i), fixed_radii: Some(radii), ..self.settings.clone() };
         let (film, stats) = engine(&pass)?;
         for (s, p) in self.sum.iter_mut().zip(&film.pixels) {
             *s += *p;
         }
-        let (rays, nf_s, nf_p, times) =
-            (self.stats.rays, self.stats.non_finite_samples, self.stats.non_finite_photons, self.stats.times.clone());
+        // This pass's stats, with the counts and phase times of the earlier passes added.
+        let mut stats = stats;
+        let old = &self.stats;
+        stats.rays += old.rays;
+        stats.non_finite_samples += old.non_finite_samples;
+        stats.non_finite_photons += old.non_finite_photons;
+        stats.times.global_photons_s += old.times.global_photons_s;
+        stats.times.caustic_photons_s += old.times.caustic_photons_s;
+        stats.times.map_build_s += old.times.map_build_s;
+        stats.times.camera_s += old.times.camera_s;
+        stats.seed = self.settings.seed;
         self.stats = stats;
-        self.stats.rays += rays;
-        self.stats.non_finite_samples += nf_s;
-        self.stats.non_finite_photons += nf_p;
-        self.stats.times.global_photons_s += times.global_photons_s;
-        self.stats.times.caustic_photons_s += times.caustic_photons_s;
-        self.stats.times.map_build_s += times.map_build_s;
-        self.stats.times.camera_s += times.camera_s;
-        self.stats.seed = self.settings.seed;
         self.progress.passes += 1;
+        // Pass i + 1 (1-based) done: r²ᵢ₊₂ = r²ᵢ₊₁ · (i + 1 + α)/(i + 2).
+        let j = f64::from(self.progress.passes);
+        self.scale2 *= (j + f64::from(self.settings.alpha)) / (j + 1.0);
         self.progress.final_radii = [radii.global, radii.caustic];
         self.progress.pass_seconds.push(t.elapsed().as_secs_f64());
         Ok(())
