@@ -2,7 +2,7 @@
 //! beauty image and for each Jensen term layer present in both files.
 
 use crate::error::{Error, Result};
-use crate::film::read_exr;
+use crate::film::{read_exr, ExrLayers};
 use glam::Vec3;
 use serde::Serialize;
 use std::path::Path;
@@ -53,6 +53,19 @@ pub fn layer_error(layer: &str, a: &[Vec3], b: &[Vec3]) -> LayerError {
     }
 }
 
+/// The error of each layer of `image` that `reference` also has, in `image`'s order; `""` is
+/// reported as `beauty`. Layers of equal length are assumed.
+#[must_use]
+pub fn layer_errors(image: &[(String, Vec<Vec3>)], reference: &[(String, Vec<Vec3>)]) -> Vec<LayerError> {
+    image
+        .iter()
+        .filter_map(|(name, pa)| {
+            let (_, pb) = reference.iter().find(|(n, _)| n == name)?;
+            Some(layer_error(if name.is_empty() { "beauty" } else { name }, pa, pb))
+        })
+        .collect()
+}
+
 /// The comparison of two EXR files.
 #[derive(Clone, Debug, Serialize)]
 pub struct Comparison {
@@ -68,11 +81,29 @@ pub struct Comparison {
     pub layers: Vec<LayerError>,
 }
 
+/// Reads every RGB layer of the EXR at `path`, refusing NaN or infinite pixels with the layer's
+/// name and count.
+pub fn read_finite_exr(path: &Path) -> Result<ExrLayers> {
+    let img = read_exr(path)?;
+    for (name, pixels) in &img.layers {
+        let bad = pixels.iter().filter(|p| !p.is_finite()).count();
+        if bad > 0 {
+            let name = if name.is_empty() { "beauty" } else { name.as_str() };
+            return Err(Error::parse(
+                path,
+                0,
+                format!("layer `{name}`: {bad} of {} pixels are NaN or infinite", pixels.len()),
+            ));
+        }
+    }
+    Ok(img)
+}
+
 /// Compares the EXR at `image` with the reference EXR at `reference`: both must have the same
 /// size and finite values; layers present in only one file are skipped.
 pub fn compare_files(image: &Path, reference: &Path) -> Result<Comparison> {
-    let a = read_exr(image)?;
-    let b = read_exr(reference)?;
+    let a = read_finite_exr(image)?;
+    let b = read_finite_exr(reference)?;
     if (a.width, a.height) != (b.width, b.height) {
         return Err(Error::parse(
             image,
@@ -87,25 +118,7 @@ pub fn compare_files(image: &Path, reference: &Path) -> Result<Comparison> {
             ),
         ));
     }
-    for (path, img) in [(image, &a), (reference, &b)] {
-        for (name, pixels) in &img.layers {
-            let bad = pixels.iter().filter(|p| !p.is_finite()).count();
-            if bad > 0 {
-                let name = if name.is_empty() { "beauty" } else { name.as_str() };
-                return Err(Error::parse(
-                    path,
-                    0,
-                    format!("layer `{name}`: {bad} of {} pixels are NaN or infinite", pixels.len()),
-                ));
-            }
-        }
-    }
-    let mut layers = Vec::new();
-    for (name, pa) in &a.layers {
-        if let Some((_, pb)) = b.layers.iter().find(|(n, _)| n == name) {
-            layers.push(layer_error(if name.is_empty() { "beauty" } else { name }, pa, pb));
-        }
-    }
+    let layers = layer_errors(&a.layers, &b.layers);
     if layers.is_empty() {
         return Err(Error::parse(image, 0, format!("shares no RGB layer with {}", reference.display())));
     }

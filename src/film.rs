@@ -89,21 +89,28 @@ impl Film {
         sum / self.pixels.len().max(1) as f32
     }
 
+    /// The image as named RGB layers, as [`Film::write_exr`] writes and [`read_exr`] reads them:
+    /// `""` (beauty) first, then each term in [`TERM_NAMES`] order.
+    #[must_use]
+    pub fn layers(&self) -> Vec<(String, Vec<Vec3>)> {
+        let mut layers = vec![(String::new(), self.beauty())];
+        for (i, name) in TERM_NAMES.iter().enumerate() {
+            layers.push((name.to_string(), self.pixels.iter().map(|t| t.as_array()[i]).collect()));
+        }
+        layers
+    }
+
     /// Writes the EXR: default layer R, G, B = beauty; one layer per term (`direct.R`, …).
     pub fn write_exr(&self, path: &Path) -> Result<()> {
         use exr::prelude::*;
         let size = Vec2(self.width as usize, self.height as usize);
         let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
-        let mut push = |name: String, get: &dyn Fn(&Terms) -> Vec3| {
+        for (name, pixels) in self.layers() {
             for (c, suffix) in ["R", "G", "B"].iter().enumerate() {
-                let data: Vec<f32> = self.pixels.iter().map(|t| get(t)[c]).collect();
+                let data: Vec<f32> = pixels.iter().map(|p| p[c]).collect();
                 let full = if name.is_empty() { suffix.to_string() } else { format!("{name}.{suffix}") };
                 channels.push(AnyChannel::new(full.as_str(), FlatSamples::F32(data)));
             }
-        };
-        push(String::new(), &|t| t.beauty());
-        for (i, name) in TERM_NAMES.iter().enumerate() {
-            push(name.to_string(), &move |t: &Terms| t.as_array()[i]);
         }
         let layer =
             Layer::new(size, LayerAttributes::default(), Encoding::FAST_LOSSLESS, AnyChannels::sort(channels.into()));

@@ -13,12 +13,14 @@
 pub mod bench;
 pub mod compare;
 pub mod effects;
+pub mod engine;
 pub mod error;
 pub mod film;
 pub mod geometry;
 pub mod kernels;
 pub mod material;
 pub mod photon_map;
+pub mod plot;
 pub mod progressive;
 pub mod reference;
 pub mod rng;
@@ -26,6 +28,7 @@ pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod stats;
+pub mod sweep;
 pub mod wavefront;
 
 pub use error::{Error, Result};

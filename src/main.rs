@@ -4,10 +4,12 @@ use clap::{Parser, Subcommand};
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use photonwave::effects::Effects;
+use photonwave::engine::{Budget, Engine};
 use photonwave::error::{Error, Result};
-use photonwave::reference::{self, Progress};
+use photonwave::progressive::PerPass;
+use photonwave::reference::Progress;
 use photonwave::scene::file::{fitted_camera, load_scene};
-use photonwave::settings::Kernel;
+use photonwave::settings::{Kernel, Preset};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Mutex;
@@ -30,6 +32,50 @@ enum Command {
     /// Error of an image against a reference (both EXRs written by `render`): RMSE, relMSE
     /// ((a−b)²/(b²+0.01)) and mean ratio for the beauty image and each term layer in both.
     Compare(CompareArgs),
+    /// What accuracy costs in time: render a scene over a grid of settings, time each render and
+    /// measure its error against a reference; writes DIR/sweep.csv and a log-log
+    /// error-against-time plot per knob (DIR/KNOB.svg and .png).
+    Sweep(Box<SweepArgs>),
+}
+
+#[derive(clap::Args)]
+struct SweepArgs {
+    /// Scene file (.toml) or mesh (.obj with its .mtl).
+    scene: PathBuf,
+    /// The reference image (.exr), e.g. from `render --preset reference`; the sweep renders at
+    /// its size.
+    #[arg(long)]
+    reference: PathBuf,
+    /// A knob and its values, NAME=V1,V2,… (repeatable; the grid is every combination). Any
+    /// setting but width, height and force: spp, photons, caustic_photons, k, caustic_k,
+    /// global_radius, caustic_radius, kernel, gather_rays, final_gather, precompute_irradiance,
+    /// passes, alpha, max_depth, light_samples, seed, threads, kernels.
+    #[arg(long = "knob", required = true)]
+    knobs: Vec<photonwave::sweep::Knob>,
+    /// Equal-time mode: time budgets, e.g. `1s,4s,16s`; every configuration renders progressive
+    /// passes for each budget, and the error it reaches is recorded.
+    #[arg(long, value_delimiter = ',', value_parser = parse_duration)]
+    time: Vec<std::time::Duration>,
+    /// Output directory (created if missing).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// The layer whose RMSE the plots show: beauty, emitted, direct, specular, caustic or
+    /// indirect (the CSV has them all).
+    #[arg(long, default_value = "beauty")]
+    layer: String,
+    /// The error the plots show: `rmse`, or `relmse` ((a−b)²/(b²+0.01), which weighs dark
+    /// regions as much as bright ones).
+    #[arg(long, default_value = "rmse")]
+    metric: photonwave::sweep::Metric,
+    /// Amounts of work the knobs start from (as `render --preset`) [the scene file's settings].
+    #[arg(long)]
+    preset: Option<Preset>,
+    /// Engine for every render: wavefront, reference or path.
+    #[arg(long, default_value = "wavefront")]
+    engine: Engine,
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
 }
 
 #[derive(clap::Args)]
@@ -194,19 +240,14 @@ struct RenderArgs {
     /// or `path` (unbiased path tracer, for validation).
     #[arg(long, default_value = "wavefront")]
     engine: Engine,
+    /// Amounts of work (spp, photons, gather rays, passes) from a named preset, over the scene
+    /// file's settings and under these flags: `preview`, `default`, or `reference` (a long
+    /// progressive run to measure other renders against).
+    #[arg(long)]
+    preset: Option<Preset>,
     /// No progress bars.
     #[arg(long, short)]
     quiet: bool,
-}
-
-#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-enum Engine {
-    /// The wavefront photon mapper: bevy_ecs systems over structure-of-arrays queues.
-    Wavefront,
-    /// The scalar reference photon mapper.
-    Reference,
-    /// An unbiased path tracer with next-event estimation (slow; for checking energy).
-    Path,
 }
 
 /// indicatif progress bars on stderr, one per phase.
@@ -251,19 +292,15 @@ fn render(args: RenderArgs) -> Result<()> {
     let loaded = load_scene(&args.scene)?;
     let scene = std::sync::Arc::new(loaded.scene);
     let mut settings = loaded.settings;
+    let preset_per_pass = args.preset.map(|p| p.apply(&mut settings)).unwrap_or_default();
     macro_rules! set {
         ($($f:ident),*) => { $( if let Some(v) = args.$f { settings.$f = v; } )* };
     }
     set!(width, height, spp, photons, caustic_photons, gather_rays, max_depth, seed, threads, kernel, kernels);
+    set!(passes, alpha);
     if let Some(k) = args.k {
         settings.k = k;
         settings.caustic_k = k;
-    }
-    if let Some(p) = args.passes {
-        settings.passes = p;
-    }
-    if let Some(a) = args.alpha {
-        settings.alpha = a;
     }
     settings.force.extend(args.force.iter().cloned());
     if args.no_final_gather {
@@ -300,28 +337,25 @@ fn render(args: RenderArgs) -> Result<()> {
     eprint!("{}", plan.describe());
     let quiet = args.quiet || !std::io::IsTerminal::is_terminal(&std::io::stderr());
     let bars = Bars { bar: Mutex::new(None), quiet };
-    let progressive = settings.passes > 1 || args.time.is_some();
-    let (film, mut stats) = if progressive {
-        if args.engine == Engine::Path {
-            return Err(Error::setting(
-                "--engine",
-                "progressive passes (--passes, --time) need a photon-mapping engine",
-            ));
+    let budget = args.time.map(|limit| Budget { limit, start: t0 });
+    let settings = if photonwave::engine::is_progressive(&settings, budget) {
+        let given = PerPass {
+            spp: args.spp.is_some(),
+            photons: args.photons.is_some(),
+            caustic_photons: args.caustic_photons.is_some(),
+        };
+        let pass = photonwave::progressive::per_pass(&settings, given | preset_per_pass);
+        if args.engine != Engine::Path {
+            eprint!("{}", photonwave::progressive::describe(&scene, &pass, args.time));
         }
-        let pass = photonwave::progressive::per_pass(
-            &settings,
-            args.spp.is_some(),
-            args.photons.is_some(),
-            args.caustic_photons.is_some(),
-        );
-        render_progressive(&scene, &rays, &pass, args.engine, args.time, t0, &bars)?
+        pass
     } else {
-        match args.engine {
-            Engine::Wavefront => photonwave::wavefront::render(scene.clone(), &rays, &settings, &bars)?,
-            Engine::Reference => reference::render(&scene, &rays, &settings, &bars)?,
-            Engine::Path => reference::path::render_path_traced_with_stats(&scene, &rays, &settings, &bars)?,
-        }
+        settings
     };
+    let (film, mut stats) = photonwave::engine::render(&scene, &rays, &settings, args.engine, budget, &bars)?;
+    if let Some(w) = stats.progressive.as_ref().and_then(photonwave::progressive::budget_warning) {
+        eprintln!("warning: {w}");
+    }
     stats.scene = args.scene.display().to_string();
     stats.times.load_s = load_s;
     stats.times.total_s += load_s;
@@ -339,94 +373,6 @@ fn render(args: RenderArgs) -> Result<()> {
         eprintln!("wrote {}", p.display());
     }
     Ok(())
-}
-
-/// Progressive passes until `settings.passes` or the time budget (from `t0`) is reached, with one
-/// progress bar over the passes.
-fn render_progressive(
-    scene: &std::sync::Arc<photonwave::scene::Scene>,
-    rays: &photonwave::scene::camera::CameraRays,
-    settings: &photonwave::settings::Settings,
-    engine: Engine,
-    budget: Option<std::time::Duration>,
-    t0: Instant,
-    bars: &Bars,
-) -> Result<(photonwave::film::Film, photonwave::stats::RenderStats)> {
-    use photonwave::progressive::Progressive;
-    let run = |s: &photonwave::settings::Settings| match engine {
-        Engine::Reference => reference::render(scene, rays, s, &reference::NoProgress),
-        _ => photonwave::wavefront::render(scene.clone(), rays, s, &reference::NoProgress),
-    };
-    let plan = Effects::plan(scene, settings);
-    let maps: Vec<String> =
-        [(plan.global_map.on, settings.photons, "global"), (plan.caustic_map.on, settings.caustic_photons, "caustic")]
-            .iter()
-            .filter(|m| m.0)
-            .map(|m| format!("{} {} photons", m.1, m.2))
-            .collect();
-    eprintln!(
-        "progressive: {} each {} spp{}{}, α = {:.3}",
-        match budget {
-            Some(b) => format!("passes for {:.2} s,", b.as_secs_f64()),
-            None => format!("{} passes,", settings.passes),
-        },
-        settings.spp,
-        if maps.is_empty() { "" } else { ", " },
-        maps.join(" + "),
-        settings.alpha
-    );
-    let mut p = Progressive::new(scene, settings)?;
-    let total = budget.map_or(u64::from(settings.passes), |b| b.as_millis() as u64);
-    bars.start(if budget.is_some() { "ms of budget" } else { "passes" }, total);
-    let mut shown = 0u64;
-    loop {
-        let elapsed = t0.elapsed();
-        let go_on = match budget {
-            Some(b) => p.another_fits(elapsed, b),
-            None => p.passes() < settings.passes,
-        };
-        if !go_on {
-            break;
-        }
-        p.step(&run)?;
-        let elapsed = t0.elapsed();
-        let done = match budget {
-            Some(b) => {
-                bars.message(&format!(
-                    "pass {}, {:.1} s left",
-                    p.passes(),
-                    (b.as_secs_f64() - elapsed.as_secs_f64()).max(0.0)
-                ));
-                (elapsed.as_millis() as u64).min(total)
-            }
-            None => {
-                bars.message(&format!("pass {} of {}", p.passes(), settings.passes));
-                u64::from(p.passes())
-            }
-        };
-        bars.advance(done - shown.min(done));
-        shown = shown.max(done);
-    }
-    bars.finish();
-    let film = p.image();
-    let mut stats = p.stats.clone();
-    let mut prog = p.progress.clone();
-    prog.budget_s = budget.map(|b| b.as_secs_f64());
-    prog.elapsed_s = t0.elapsed().as_secs_f64();
-    if let (Some(b), Some(&first)) = (budget, prog.pass_seconds.first()) {
-        if first > 0.05 * b.as_secs_f64() {
-            eprintln!(
-                "warning: one pass takes {first:.2} s, more than 5 % of the {:.2} s budget; lower --spp or --photons per pass to end closer to it",
-                b.as_secs_f64()
-            );
-        }
-    }
-    stats.progressive = Some(prog);
-    stats.passes.push(format!("{} progressive passes", p.passes()));
-    stats.spp = settings.spp * p.passes();
-    stats.times.total_s = t0.elapsed().as_secs_f64();
-    stats.mean_rgb = film.mean().to_array();
-    Ok((film, stats))
 }
 
 fn bench(args: BenchArgs) -> Result<()> {
@@ -509,12 +455,93 @@ fn compare(args: &CompareArgs) -> Result<()> {
     Ok(())
 }
 
+fn sweep(args: SweepArgs) -> Result<()> {
+    use photonwave::sweep::Sweep;
+    let reference = photonwave::compare::read_finite_exr(&args.reference)?;
+    let layer_key = if args.layer == "beauty" { "" } else { args.layer.as_str() };
+    if !reference.layers.iter().any(|(n, _)| n == layer_key) {
+        let names: Vec<&str> =
+            reference.layers.iter().map(|(n, _)| if n.is_empty() { "beauty" } else { n.as_str() }).collect();
+        return Err(Error::setting(
+            "--layer",
+            format!(
+                "the reference {} has no layer `{}` (it has {})",
+                args.reference.display(),
+                args.layer,
+                names.join(", ")
+            ),
+        ));
+    }
+    let loaded = load_scene(&args.scene)?;
+    let scene = std::sync::Arc::new(loaded.scene);
+    let mut base = loaded.settings;
+    if let Some(p) = args.preset {
+        p.apply(&mut base);
+    }
+    (base.width, base.height) = (reference.width, reference.height);
+    base.validate()?;
+    let sweep = Sweep::new(&base, args.knobs, args.time, args.engine)?;
+    let camera = loaded.camera.unwrap_or_else(|| fitted_camera(&scene, 40.0));
+    let rays = camera.prepare(base.width, base.height)?;
+    std::fs::create_dir_all(&args.output).map_err(|e| Error::output(&args.output, e))?;
+
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    eprint!("{}", Effects::plan(&scene, &base).describe());
+    let runs = sweep.configs.len() * sweep.budgets.len().max(1);
+    eprintln!(
+        "sweep: {} configuration(s){} = {runs} render(s) at {}×{}, {:?} engine, against {}",
+        sweep.configs.len(),
+        if sweep.budgets.is_empty() { String::new() } else { format!(" × {} budget(s)", sweep.budgets.len()) },
+        base.width,
+        base.height,
+        args.engine,
+        args.reference.display()
+    );
+    let quiet = args.quiet || !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let bars = Bars { bar: Mutex::new(None), quiet };
+    let rows = sweep.run(&scene, &rays, &reference, &bars)?;
+
+    let metric = format!("{} {}", args.layer, args.metric.name());
+    eprintln!("{:>4} {:<40} {:>9} {:>7} {:>10} {metric:>14}", "#", "configuration", "budget s", "passes", "seconds");
+    for r in &rows {
+        let err = r.errors.iter().find(|e| e.layer == args.layer).map_or(f64::NAN, |e| args.metric.of(e));
+        eprintln!(
+            "{:>4} {:<40} {:>9} {:>7} {:>10.3} {:>14.4e}",
+            r.config,
+            photonwave::sweep::describe(&sweep.knobs, &r.values),
+            r.budget_s.map_or("-".into(), |b| format!("{b:.2}")),
+            r.passes,
+            r.seconds,
+            err
+        );
+    }
+    let csv = args.output.join("sweep.csv");
+    photonwave::sweep::write_csv(&csv, &sweep.knobs, &rows)?;
+    eprintln!("wrote {}", csv.display());
+    let name = args.scene.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+    for (knob, fig) in sweep.figures(&rows, &args.layer, args.metric, &name) {
+        for ext in ["svg", "png"] {
+            let path = args.output.join(format!("{knob}.{ext}"));
+            if ext == "svg" {
+                photonwave::plot::write_svg(&fig, &path)?;
+            } else {
+                photonwave::plot::write_png(&fig, &path)?;
+            }
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render(*args),
         Command::Bench(args) => bench(args),
         Command::Compare(args) => compare(&args),
+        Command::Sweep(args) => sweep(*args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -17,15 +17,18 @@
 //! pass here, which the probabilistic analysis covers but which blurs sparse regions as much as
 //! dense ones.
 
+use crate::engine::{Budget, Engine};
 use crate::error::Result;
 use crate::film::{Film, Terms};
 use crate::kernels::KernelSet;
 use crate::photon_map::{Filter, Lookup, PhotonMap};
-use crate::reference::build_maps;
+use crate::reference::{build_maps, NoProgress, Progress};
+use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::{FixedRadii, Settings};
 use crate::stats::RenderStats;
 use serde::Serialize;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Photons sampled for the first radii.
@@ -216,21 +219,135 @@ impl Progressive {
     }
 }
 
+/// Which per-pass amounts were given explicitly (by a flag, a sweep knob or a preset); those are
+/// used as they are in every pass instead of being spread over the passes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PerPass {
+    /// `spp` is per pass.
+    pub spp: bool,
+    /// `photons` is per pass.
+    pub photons: bool,
+    /// `caustic_photons` is per pass.
+    pub caustic_photons: bool,
+}
+
+impl std::ops::BitOr for PerPass {
+    type Output = PerPass;
+    fn bitor(self, o: PerPass) -> PerPass {
+        PerPass {
+            spp: self.spp || o.spp,
+            photons: self.photons || o.photons,
+            caustic_photons: self.caustic_photons || o.caustic_photons,
+        }
+    }
+}
+
 /// Settings for each pass when a one-pass render's `spp` samples and photon counts are spread
-/// over passes: 1 sample per pixel and photons / spp per map (at least 1 000), unless the caller
-/// set these per pass (`spp_set`, `photons_set`, `caustic_set`).
+/// over passes: 1 sample per pixel and photons / spp per map (at least 1 000), except for the
+/// amounts `given` per pass.
 #[must_use]
-pub fn per_pass(settings: &Settings, spp_set: bool, photons_set: bool, caustic_set: bool) -> Settings {
+pub fn per_pass(settings: &Settings, given: PerPass) -> Settings {
     let mut s = settings.clone();
     let spread = settings.spp.max(1);
-    if !spp_set {
+    if !given.spp {
         s.spp = 1;
     }
-    if !photons_set && settings.photons > 0 {
+    if !given.photons && settings.photons > 0 {
         s.photons = (settings.photons / spread).max(1000);
     }
-    if !caustic_set && settings.caustic_photons > 0 {
+    if !given.caustic_photons && settings.caustic_photons > 0 {
         s.caustic_photons = (settings.caustic_photons / spread).max(1000);
     }
     s
+}
+
+/// The line the CLI prints before a progressive render: passes or budget, and each pass's work.
+#[must_use]
+pub fn describe(scene: &Scene, settings: &Settings, budget: Option<Duration>) -> String {
+    let plan = crate::effects::Effects::plan(scene, settings);
+    let maps: Vec<String> =
+        [(plan.global_map.on, settings.photons, "global"), (plan.caustic_map.on, settings.caustic_photons, "caustic")]
+            .iter()
+            .filter(|m| m.0)
+            .map(|m| format!("{} {} photons", m.1, m.2))
+            .collect();
+    format!(
+        "progressive: {} each {} spp{}{}, α = {:.3}\n",
+        match budget {
+            Some(b) => format!("passes for {:.2} s,", b.as_secs_f64()),
+            None => format!("{} passes,", settings.passes),
+        },
+        settings.spp,
+        if maps.is_empty() { "" } else { ", " },
+        maps.join(" + "),
+        settings.alpha
+    )
+}
+
+/// A warning when one pass takes more than 5 % of the budget (the render cannot end within 5 %
+/// of it then).
+#[must_use]
+pub fn budget_warning(p: &ProgressiveStats) -> Option<String> {
+    let (b, first) = (p.budget_s?, *p.pass_seconds.first()?);
+    (first > 0.05 * b).then(|| {
+        format!(
+            "one pass takes {first:.2} s, more than 5 % of the {b:.2} s budget; lower --spp or --photons per pass to end closer to it"
+        )
+    })
+}
+
+/// Progressive passes of `engine` with `settings` per pass, until `settings.passes` or, with a
+/// budget, until the budget is spent ([`Progressive::another_fits`]). `progress` gets one bar:
+/// passes, or the budget's milliseconds, with the pass number and time left as its message.
+pub fn render_passes(
+    scene: &Arc<Scene>,
+    rays: &CameraRays,
+    settings: &Settings,
+    engine: Engine,
+    budget: Option<Budget>,
+    progress: &dyn Progress,
+) -> Result<(Film, RenderStats)> {
+    let t = Instant::now();
+    let start = budget.map_or(t, |b| b.start);
+    let run = |s: &Settings| crate::engine::render_once(scene, rays, s, engine, &NoProgress);
+    let mut p = Progressive::new(scene, settings)?;
+    let total = budget.map_or(u64::from(settings.passes), |b| b.limit.as_millis() as u64);
+    progress.start(if budget.is_some() { "ms of budget" } else { "passes" }, total);
+    let mut shown = 0u64;
+    loop {
+        let go_on = match budget {
+            Some(b) => p.another_fits(start.elapsed(), b.limit),
+            None => p.passes() < settings.passes,
+        };
+        if !go_on {
+            break;
+        }
+        p.step(&run)?;
+        let elapsed = start.elapsed();
+        let done = match budget {
+            Some(b) => {
+                let left = (b.limit.as_secs_f64() - elapsed.as_secs_f64()).max(0.0);
+                progress.message(&format!("pass {}, {left:.1} s left", p.passes()));
+                (elapsed.as_millis() as u64).min(total)
+            }
+            None => {
+                progress.message(&format!("pass {} of {}", p.passes(), settings.passes));
+                u64::from(p.passes())
+            }
+        };
+        progress.advance(done - shown.min(done));
+        shown = shown.max(done);
+    }
+    progress.finish();
+    let film = p.image();
+    let mut stats = p.stats;
+    let mut prog = p.progress;
+    prog.budget_s = budget.map(|b| b.limit.as_secs_f64());
+    prog.elapsed_s = start.elapsed().as_secs_f64();
+    stats.passes.push(format!("{} progressive passes", prog.passes));
+    stats.spp = settings.spp * prog.passes;
+    stats.progressive = Some(prog);
+    stats.times.total_s = t.elapsed().as_secs_f64();
+    stats.mean_rgb = film.mean().to_array();
+    Ok((film, stats))
 }

@@ -1,0 +1,77 @@
+//! Which renderer turns a scene into a film, and the one call that runs it — a single render or
+//! progressive passes under a pass count or a time budget. `photonwave render` and
+//! `photonwave sweep` both go through [`render`], so a sweep row is what `render` gives with the
+//! same settings.
+
+use crate::error::{Error, Result};
+use crate::film::Film;
+use crate::reference::Progress;
+use crate::scene::camera::CameraRays;
+use crate::scene::Scene;
+use crate::settings::Settings;
+use crate::stats::RenderStats;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// A rendering engine.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Engine {
+    /// The wavefront photon mapper: bevy_ecs systems over structure-of-arrays queues.
+    #[default]
+    Wavefront,
+    /// The scalar reference photon mapper.
+    Reference,
+    /// An unbiased path tracer with next-event estimation (slow; for checking energy).
+    Path,
+}
+
+/// A time budget: stop starting passes so that the render ends near `start + limit`.
+#[derive(Clone, Copy, Debug)]
+pub struct Budget {
+    /// The whole budget.
+    pub limit: Duration,
+    /// When the budget started counting (the CLI counts scene loading too).
+    pub start: Instant,
+}
+
+/// Whether `settings` (and an optional budget) make a progressive render.
+#[must_use]
+pub fn is_progressive(settings: &Settings, budget: Option<Budget>) -> bool {
+    settings.passes > 1 || budget.is_some()
+}
+
+/// One render of `scene` with `engine`, with no progressive passes.
+pub fn render_once(
+    scene: &Arc<Scene>,
+    rays: &CameraRays,
+    settings: &Settings,
+    engine: Engine,
+    progress: &dyn Progress,
+) -> Result<(Film, RenderStats)> {
+    match engine {
+        Engine::Wavefront => crate::wavefront::render(scene.clone(), rays, settings, progress),
+        Engine::Reference => crate::reference::render(scene, rays, settings, progress),
+        Engine::Path => crate::reference::path::render_path_traced_with_stats(scene, rays, settings, progress),
+    }
+}
+
+/// Renders `scene`: once, or — when `settings.passes > 1` or a budget is given — progressive
+/// passes with `settings` as each pass's settings (see [`crate::progressive::per_pass`]).
+/// `progress` sees one phase per pass in a single render, or one bar over the passes (or the
+/// budget's milliseconds) in a progressive one.
+pub fn render(
+    scene: &Arc<Scene>,
+    rays: &CameraRays,
+    settings: &Settings,
+    engine: Engine,
+    budget: Option<Budget>,
+    progress: &dyn Progress,
+) -> Result<(Film, RenderStats)> {
+    if !is_progressive(settings, budget) {
+        return render_once(scene, rays, settings, engine, progress);
+    }
+    if engine == Engine::Path {
+        return Err(Error::setting("--engine", "progressive passes (--passes, --time) need a photon-mapping engine"));
+    }
+    crate::progressive::render_passes(scene, rays, settings, engine, budget, progress)
+}
