@@ -188,3 +188,29 @@ pub fn write_png(fig: &Figure, path: &Path) -> Result<()> {
     writer.write_image_data(&rgb).map_err(|e| Error::output(path, e))?;
     writer.finish().map_err(|e| Error::output(path, e))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_are_readable_on_narrow_and_wide_log_ranges() {
+        assert_eq!(log_ticks(&(0.3..30.0)), [0.5, 1.0, 2.0, 5.0, 10.0, 20.0]);
+        assert_eq!(log_ticks(&(0.9..1.6)), [1.0, 1.5]);
+        assert_eq!(log_ticks(&(0.85..2.5)), [1.0, 1.5, 2.0]);
+        assert_eq!(log_ticks(&(5e-7..2e2)).len(), 9);
+        assert_eq!(
+            (tick(0.012345), tick(1.5), tick(250.0), tick(2.0)),
+            ("0.0123".into(), "1.5".into(), "250".into(), "2".into())
+        );
+    }
+
+    #[test]
+    fn ranges_keep_every_point_off_the_frame() {
+        let r = log_range([0.01, 1.0, -1.0, 0.0, f64::NAN].into_iter());
+        assert!(r.start < 0.01 && r.end > 1.0 && r.start > 0.0);
+        let single = log_range([2.0].into_iter());
+        assert!(single.start < 2.0 && single.end > 2.0);
+        assert_eq!(log_range(std::iter::empty()), 0.1..10.0);
+    }
+}

@@ -347,13 +347,14 @@ fn csv_field(s: &str) -> String {
 }
 
 /// The CSV text: one row per render — configuration index, each knob's value, budget (empty
-/// without one), passes, spp, wall seconds, then RMSE, relMSE and mean ratio per layer.
+/// without one), passes and samples per pixel rendered, wall seconds, then RMSE, relMSE and
+/// mean ratio per layer.
 #[must_use]
 pub fn csv(knobs: &[Knob], rows: &[Row]) -> String {
     let layers: Vec<&str> = rows.first().map_or(Vec::new(), |r| r.errors.iter().map(|e| e.layer.as_str()).collect());
     let mut head: Vec<String> = vec!["config".into()];
     head.extend(knobs.iter().map(|k| csv_field(&k.name)));
-    head.extend(["budget_s", "passes", "spp", "seconds"].map(String::from));
+    head.extend(["budget_s", "passes_rendered", "spp_rendered", "seconds"].map(String::from));
     for l in &layers {
         head.extend([format!("{l}_rmse"), format!("{l}_relmse"), format!("{l}_mean_ratio")]);
     }

@@ -160,3 +160,65 @@ fn time_budget_is_met_within_five_percent() {
         "finished after {wall:.3} s for a {budget} s budget ({passes} passes)"
     );
 }
+
+/// Presets set only the amounts of work, leave the scene's other settings alone, and say which
+/// amounts are per pass.
+#[test]
+fn presets_set_only_amounts_of_work() {
+    use photonwave::progressive::PerPass;
+    use photonwave::settings::Preset;
+    let scene_file =
+        Settings { width: 50, k: 20, caustic_radius: 0.01, max_depth: 3, seed: 5, spp: 9, ..Default::default() };
+    let amounts = |s: &Settings| (s.passes, s.spp, s.photons, s.caustic_photons, s.gather_rays);
+    let rest = |s: &Settings| (s.width, s.k, s.caustic_radius, s.max_depth, s.seed);
+    let all = PerPass { spp: true, photons: true, caustic_photons: true };
+    let d = Settings::default();
+    for (preset, expect, per_pass) in [
+        (Preset::Reference, (512, 4, 100_000, 100_000, 16), all),
+        (Preset::Preview, (1, 4, 50_000, 25_000, 8), PerPass::default()),
+        (Preset::Default, amounts(&d), PerPass::default()),
+    ] {
+        let mut s = scene_file.clone();
+        assert_eq!(preset.apply(&mut s), per_pass, "{preset:?}");
+        assert_eq!(amounts(&s), expect, "{preset:?}");
+        assert_eq!(rest(&s), rest(&scene_file), "{preset:?}");
+        s.validate().unwrap();
+    }
+}
+
+/// `render --preset reference`: the preset's amounts are per pass, flags override them, and
+/// without a preset `--passes` spreads the default amounts over the passes.
+#[test]
+fn cli_preset_reference_renders_progressive_passes() {
+    let d = common::scratch_dir("preset");
+    let scene = common::bundled("cornell-spheres.toml");
+    let render = |extra: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_photonwave"))
+            .args(["render", scene.to_str().unwrap(), "--width", "8", "--height", "8", "-q"])
+            .args(["-o", d.join("p.exr").to_str().unwrap(), "--stats", d.join("p.json").to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{err}");
+        let stats: serde_json::Value = serde_json::from_slice(&std::fs::read(d.join("p.json")).unwrap()).unwrap();
+        (err, stats)
+    };
+    let (err, stats) = render(&[
+        "--preset",
+        "reference",
+        "--passes",
+        "2",
+        "--spp",
+        "1",
+        "--photons",
+        "3000",
+        "--caustic-photons",
+        "3000",
+    ]);
+    assert!(err.contains("progressive: 2 passes, each 1 spp, 3000 global photons + 3000 caustic photons"), "{err}");
+    assert_eq!(stats["progressive"]["passes"], 2);
+    assert_eq!(stats["spp"], 2);
+    let (err, _) = render(&["--passes", "2"]);
+    assert!(err.contains("progressive: 2 passes, each 1 spp, 12500 global photons + 6250 caustic photons"), "{err}");
+}
