@@ -21,11 +21,11 @@ use crate::engine::{Budget, Engine};
 use crate::error::Result;
 use crate::film::{Film, Terms};
 use crate::kernels::KernelSet;
-use crate::photon_map::{Filter, Lookup, PhotonMap};
+use crate::photon_map::{flags, Filter, Lookup, PhotonMap};
 use crate::reference::{build_maps, NoProgress, Progress};
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
-use crate::settings::{FixedRadii, Settings};
+use crate::settings::{FixedRadii, PixelRadii, Settings};
 use crate::stats::RenderStats;
 use serde::Serialize;
 use std::sync::Arc;
@@ -45,6 +45,11 @@ pub struct ProgressiveStats {
     pub initial_radii: [f32; 2],
     /// Last pass's global and caustic radii.
     pub final_radii: [f32; 2],
+    /// First caustic radii per pixel (10th, 50th, 90th percentile), with per-pixel radii.
+    pub pixel_caustic_radii: Option<[f32; 3]>,
+    /// First global radii per pixel (10th, 50th, 90th percentile), with per-pixel radii and
+    /// final gathering off.
+    pub pixel_global_radii: Option<[f32; 3]>,
     /// Time budget in seconds, if one was given.
     pub budget_s: Option<f64>,
     /// Seconds from the caller's start to the last pass's end.
@@ -100,18 +105,111 @@ pub fn median_knn_radius(map: &PhotonMap, k: u32, r_max: f32, kernels: KernelSet
     Some(*radii.select_nth_unstable_by(mid, f32::total_cmp).1)
 }
 
-/// The first pass's radii: the median k-th-neighbour distance in each map of pass 0's photons
-/// (traced once more here; the maximum radius where a map is empty or too sparse).
+/// The pilot photon pass's seed: its photons are independent of every pass's.
 #[must_use]
-pub fn initial_radii(scene: &Scene, settings: &Settings) -> FixedRadii {
+pub fn pilot_seed(seed: u64) -> u64 {
+    pass_seed(seed, u32::MAX)
+}
+
+/// The first pass's radii from a pilot photon pass (traced with [`pilot_seed`]): per map, the
+/// median k-th-neighbour distance over the pilot's photons (the maximum radius where a map is
+/// empty or too sparse); with `per_pixel_radii`, each pixel's own as well ([`pixel_radii`]).
+#[must_use]
+pub fn initial_radii(scene: &Scene, rays: &CameraRays, settings: &Settings) -> FixedRadii {
     let d = scene.diagonal();
     let (r_global, r_caustic) = (settings.global_radius * d, settings.caustic_radius * d);
-    let pilot = Settings { fixed_radii: None, precompute_irradiance: false, ..settings.clone() };
+    let pilot = Settings {
+        fixed_radii: None,
+        precompute_irradiance: false,
+        seed: pilot_seed(settings.seed),
+        ..settings.clone()
+    };
     let (maps, _, _) = build_maps(scene, &pilot);
-    FixedRadii {
-        global: median_knn_radius(&maps.global, settings.k, r_global, settings.kernels).unwrap_or(r_global),
-        caustic: median_knn_radius(&maps.caustic, settings.caustic_k, r_caustic, settings.kernels).unwrap_or(r_caustic),
+    let uniform = FixedRadii::uniform(
+        median_knn_radius(&maps.global, settings.k, r_global, settings.kernels).unwrap_or(r_global),
+        median_knn_radius(&maps.caustic, settings.caustic_k, r_caustic, settings.kernels).unwrap_or(r_caustic),
+    );
+    let pixels = settings.per_pixel_radii.then(|| Arc::new(pixel_radii(scene, rays, settings, &maps, &uniform)));
+    FixedRadii { pixels, ..uniform }
+}
+
+/// Each pixel's first radii: the radius a k-nearest-neighbour estimate would use at the first
+/// non-specular point of the pixel's first camera sample (reached through mirrors and glass as
+/// that sample's path goes) — the distance to the k-th nearest same-facing photon of `maps`,
+/// or the maximum radius where fewer than k lie within it (`caustic_k` and the caustic map;
+/// `k` and the global map without direct and caustic photons). `fallback`'s radii where the
+/// path finds no such point. Global radii are found only where the camera reads the global
+/// map (final gathering off).
+#[must_use]
+pub fn pixel_radii(
+    scene: &Scene,
+    rays: &CameraRays,
+    settings: &Settings,
+    maps: &crate::reference::PhotonMaps,
+    fallback: &FixedRadii,
+) -> PixelRadii {
+    use crate::reference::camera::{camera_sample, first_non_specular, Context};
+    let ctx = Context::new(scene, maps, settings);
+    let w = settings.width as usize;
+    let pixels = w * settings.height as usize;
+    let want_global = ctx.effects.global_map.on && !ctx.effects.final_gather.on;
+    let knn = |map: &PhotonMap, k: u32, r_max: f32, q: Lookup, scratch: &mut Vec<(f32, u32)>| {
+        map.nearest(settings.kernels, &Lookup { k: k as usize, r_max, ..q }, scratch);
+        let r = scratch.iter().map(|c| c.0).fold(0.0, f32::max).sqrt();
+        if scratch.len() == k as usize && r > 0.0 && r.is_finite() {
+            r
+        } else {
+            r_max
+        }
+    };
+    let chunks = crate::reference::parallel::map_chunks(
+        pixels,
+        256,
+        settings.thread_count(),
+        |range| {
+            let mut scratch = Vec::new();
+            let mut counts = crate::stats::RayCounts::default();
+            range
+                .map(|pixel| {
+                    let (sampler, (fx, fy)) = camera_sample(settings, pixel as u64 * u64::from(settings.spp));
+                    let (o, d) = rays.ray((pixel % w) as f32 + fx, (pixel / w) as f32 + fy);
+                    let Some((sp, d, _)) = first_non_specular(&ctx, o, d, &sampler, 1, &mut counts) else {
+                        return (fallback.global, fallback.caustic);
+                    };
+                    let (ng, _) = sp.frame.oriented(-d);
+                    let q = Lookup {
+                        p: sp.p,
+                        k: 0,
+                        r_max: 0.0,
+                        kernel: settings.kernel,
+                        filter: Filter { n: ng, flags_mask: 0 },
+                    };
+                    let caustic = knn(&maps.caustic, settings.caustic_k, ctx.caustic_radius, q, &mut scratch);
+                    let global = if want_global {
+                        let q = Lookup { filter: Filter { n: ng, flags_mask: flags::DIRECT | flags::CAUSTIC }, ..q };
+                        knn(&maps.global, settings.k, ctx.global_radius, q, &mut scratch)
+                    } else {
+                        fallback.global
+                    };
+                    (global, caustic)
+                })
+                .collect::<Vec<_>>()
+        },
+        |_| {},
+    );
+    let (global, caustic): (Vec<f32>, Vec<f32>) = chunks.into_iter().flatten().unzip();
+    PixelRadii { global: if want_global { global } else { Vec::new() }, caustic }
+}
+
+/// 10th, 50th and 90th percentiles of `values` (none for an empty slice).
+fn percentiles(values: &[f32]) -> Option<[f32; 3]> {
+    if values.is_empty() {
+        return None;
     }
+    let mut v = values.to_vec();
+    v.sort_by(f32::total_cmp);
+    let at = |q: f32| v[((v.len() - 1) as f32 * q).round() as usize];
+    Some([at(0.1), at(0.5), at(0.9)])
 }
 
 /// A progressive render in progress: call [`Progressive::step`] for each pass, read the mean
@@ -129,22 +227,26 @@ pub struct Progressive {
 }
 
 impl Progressive {
-    /// Prepares a progressive render of `scene` with `settings` (spp and photon counts per
-    /// pass): finds the first radii.
-    pub fn new(scene: &Scene, settings: &Settings) -> Result<Self> {
+    /// Prepares a progressive render of `scene` seen through `rays` with `settings` (spp and
+    /// photon counts per pass): finds the first radii.
+    pub fn new(scene: &Scene, rays: &CameraRays, settings: &Settings) -> Result<Self> {
         settings.validate()?;
-        let first = initial_radii(scene, settings);
+        let first = initial_radii(scene, rays, settings);
+        let pixel = first.pixels.as_deref();
+        let progress = ProgressiveStats {
+            alpha: settings.alpha,
+            initial_radii: [first.global, first.caustic],
+            pixel_caustic_radii: pixel.and_then(|p| percentiles(&p.caustic)),
+            pixel_global_radii: pixel.and_then(|p| percentiles(&p.global)),
+            ..Default::default()
+        };
         Ok(Progressive {
             settings: settings.clone(),
             first,
             scale2: 1.0,
             sum: vec![Terms::default(); settings.width as usize * settings.height as usize],
             stats: RenderStats::default(),
-            progress: ProgressiveStats {
-                alpha: settings.alpha,
-                initial_radii: [first.global, first.caustic],
-                ..Default::default()
-            },
+            progress,
         })
     }
 
@@ -152,7 +254,12 @@ impl Progressive {
     #[must_use]
     pub fn next_radii(&self) -> FixedRadii {
         let s = self.scale2.sqrt() as f32;
-        FixedRadii { global: self.first.global * s, caustic: self.first.caustic * s }
+        FixedRadii {
+            global: self.first.global * s,
+            caustic: self.first.caustic * s,
+            pixels: self.first.pixels.clone(),
+            scale: s,
+        }
     }
 
     /// Passes so far.
@@ -166,6 +273,7 @@ impl Progressive {
         let t = Instant::now();
         let i = self.progress.passes;
         let radii = self.next_radii();
+        let final_radii = [radii.global, radii.caustic];
         let pass =
             Settings { seed: pass_seed(self.settings.seed, i), fixed_radii: Some(radii), ..self.settings.clone() };
         let (film, stats) = engine(&pass)?;
@@ -188,7 +296,7 @@ impl Progressive {
         // Pass i + 1 (1-based) done: r²ᵢ₊₂ = r²ᵢ₊₁ · (i + 1 + α)/(i + 2).
         let j = f64::from(self.progress.passes);
         self.scale2 *= (j + f64::from(self.settings.alpha)) / (j + 1.0);
-        self.progress.final_radii = [radii.global, radii.caustic];
+        self.progress.final_radii = final_radii;
         self.progress.pass_seconds.push(t.elapsed().as_secs_f64());
         Ok(())
     }
@@ -310,7 +418,7 @@ pub fn render_passes(
     let t = Instant::now();
     let start = budget.map_or(t, |b| b.start);
     let run = |s: &Settings| crate::engine::render_once(scene, rays, s, engine, &NoProgress);
-    let mut p = Progressive::new(scene, settings)?;
+    let mut p = Progressive::new(scene, rays, settings)?;
     let total = budget.map_or(u64::from(settings.passes), |b| b.limit.as_millis() as u64);
     progress.start(if budget.is_some() { "ms of budget" } else { "passes" }, total);
     let mut shown = 0u64;

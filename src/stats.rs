@@ -177,9 +177,27 @@ impl RenderStats {
         let Some(p) = &self.progressive else { return String::new() };
         let budget =
             p.budget_s.map_or(String::new(), |b| format!(", budget {b:.2} s, finished at {:.2} s", p.elapsed_s));
+        let shrink = if p.initial_radii[1] > 0.0 { p.final_radii[1] / p.initial_radii[1] } else { 1.0 };
+        let per_pixel = |name: &str, r: Option<[f32; 3]>| {
+            r.map_or(String::new(), |[a, b, c]| {
+                format!(
+                    "\n    per-pixel {name} radii: 10/50/90 % {a:.4} / {b:.4} / {c:.4} → {:.4} / {:.4} / {:.4}",
+                    a * shrink,
+                    b * shrink,
+                    c * shrink
+                )
+            })
+        };
         format!(
-            "  progressive: {} passes (α = {:.3}), radii global {:.4} → {:.4}, caustic {:.4} → {:.4}{budget}\n",
-            p.passes, p.alpha, p.initial_radii[0], p.final_radii[0], p.initial_radii[1], p.final_radii[1]
+            "  progressive: {} passes (α = {:.3}), radii global {:.4} → {:.4}, caustic {:.4} → {:.4}{budget}{}{}\n",
+            p.passes,
+            p.alpha,
+            p.initial_radii[0],
+            p.final_radii[0],
+            p.initial_radii[1],
+            p.final_radii[1],
+            per_pixel("caustic", p.pixel_caustic_radii),
+            per_pixel("global", p.pixel_global_radii)
         )
     }
 

@@ -42,7 +42,7 @@ fn progressive(
     passes: u32,
     mut at: impl FnMut(u32, Film),
 ) {
-    let mut p = Progressive::new(scene, settings).unwrap();
+    let mut p = Progressive::new(scene, cam, settings).unwrap();
     let engine = |s: &Settings| photonwave::wavefront::render(scene.clone(), cam, s, &NoProgress);
     for _ in 0..passes {
         p.step(&engine).unwrap();
@@ -221,4 +221,76 @@ fn cli_preset_reference_renders_progressive_passes() {
     assert_eq!(stats["spp"], 2);
     let (err, _) = render(&["--passes", "2"]);
     assert!(err.contains("progressive: 2 passes, each 1 spp, 12500 global photons + 6250 caustic photons"), "{err}");
+}
+
+/// Settings of one fixed-radius pass of the small spheres scene with the given radii.
+fn fixed_pass(radii: photonwave::settings::FixedRadii) -> Settings {
+    Settings { fixed_radii: Some(radii), final_gather: false, ..small(11) }
+}
+
+/// Per-pixel radii reach the estimates pixel by pixel, in both engines: radii equal to the
+/// uniform ones give the same image bit for bit; a larger radius in one pixel changes that
+/// pixel's caustic and (final gathering off) indirect terms and no other pixel.
+#[test]
+fn per_pixel_radii_apply_to_their_own_pixel_only() {
+    use photonwave::engine::{render, Engine};
+    use photonwave::settings::{FixedRadii, PixelRadii};
+    let (scene, cam) = spheres();
+    let n = 24 * 24;
+    let uniform = FixedRadii { scale: 0.8, ..FixedRadii::uniform(0.03, 0.01) };
+    let with = |global: Vec<f32>, caustic: Vec<f32>| FixedRadii {
+        pixels: Some(Arc::new(PixelRadii { global, caustic })),
+        ..uniform.clone()
+    };
+    // Pixel radii are scaled by `scale`; the uniform ones are already this pass's.
+    let same = with(vec![0.03 / 0.8; n], vec![0.01 / 0.8; n]);
+    for engine in [Engine::Wavefront, Engine::Reference] {
+        let image = |r: FixedRadii| render(&scene, &cam, &fixed_pass(r), engine, None, &NoProgress).unwrap().0;
+        let base = image(uniform.clone());
+        // The pixel that sees the brightest caustic directly (on the floor under the glass).
+        let pixel = (0..n).max_by(|&a, &b| base.pixels[a].caustic.x.total_cmp(&base.pixels[b].caustic.x)).unwrap();
+        let mut bigger = (vec![0.03 / 0.8; n], vec![0.01 / 0.8; n]);
+        bigger.0[pixel] *= 2.0;
+        bigger.1[pixel] *= 2.0;
+        let bigger = with(bigger.0, bigger.1);
+        assert_eq!(base, image(same.clone()), "{engine:?}");
+        let changed = image(bigger.clone());
+        for (i, (a, b)) in base.pixels.iter().zip(&changed.pixels).enumerate() {
+            if i == pixel {
+                assert!(a.caustic != b.caustic && a.indirect != b.indirect, "{engine:?}: {a:?}");
+                assert_eq!((a.direct, a.emitted), (b.direct, b.emitted), "{engine:?}");
+            } else {
+                assert_eq!(a, b, "{engine:?}: pixel {i} changed");
+            }
+        }
+    }
+}
+
+/// Each pixel's first radius is a k-NN radius capped at the maximum radius: small in the glass
+/// sphere's focused caustic, the maximum where the caustic is sparse; global radii only where
+/// the camera reads the global map.
+#[test]
+fn pixel_radii_follow_the_photon_density() {
+    use photonwave::progressive::{initial_radii, pixel_radii};
+    let (scene, cam) = spheres();
+    let s = Settings { caustic_photons: 20_000, ..small(5) };
+    let d = scene.diagonal();
+    let r_max = s.caustic_radius * d;
+    let first = initial_radii(&scene, &cam, &s);
+    let pixels = first.pixels.as_deref().expect("per-pixel radii are on by default");
+    assert_eq!((pixels.caustic.len(), pixels.global.len()), (24 * 24, 24 * 24));
+    assert!(pixels.caustic.iter().all(|&r| r > 0.0 && r <= r_max));
+    let focused = pixels.caustic.iter().filter(|&&r| r < 0.5 * r_max).count();
+    let mut sorted = pixels.caustic.clone();
+    sorted.sort_by(f32::total_cmp);
+    assert!(focused >= 3, "{focused} pixels with a dense caustic: {:?}", &sorted[..10]);
+    assert!(pixels.caustic.iter().filter(|&&r| r == r_max).count() > 24 * 24 / 2);
+    assert!(pixels.global.iter().all(|&r| r > 0.0 && r <= s.global_radius * d));
+
+    // Final gathering reads the global map at gather hits only: no global radii per pixel.
+    let gather = Settings { final_gather: true, ..s.clone() };
+    let (maps, _, _) = photonwave::reference::build_maps(&scene, &gather);
+    let uniform = photonwave::settings::FixedRadii::uniform(0.1, 0.1);
+    assert!(pixel_radii(&scene, &cam, &gather, &maps, &uniform).global.is_empty());
+    assert!(initial_radii(&scene, &cam, &Settings { per_pixel_radii: false, ..s }).pixels.is_none());
 }

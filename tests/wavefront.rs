@@ -148,3 +148,21 @@ fn both_engines_emit_and_store_the_same_photons() {
     assert_eq!((r.caustic_map.emitted, r.caustic_map.stored), (w.caustic_map.emitted, w.caustic_map.stored));
     assert_eq!(r.irradiance_points, w.irradiance_points);
 }
+
+/// Progressive passes with per-pixel radii: the engines still agree per pixel (same tolerance
+/// as one-pass renders), with final gathering on and off.
+#[test]
+fn wavefront_matches_reference_with_per_pixel_radii() {
+    use photonwave::engine::{render as render_with, Engine};
+    let loaded = load("cornell-spheres.toml");
+    let rays = loaded.camera.unwrap().prepare(24, 24).unwrap();
+    let scene = Arc::new(loaded.scene);
+    for final_gather in [true, false] {
+        let s = Settings { passes: 2, spp: 1, final_gather, ..small() };
+        let image = |e| render_with(&scene, &rays, &s, e, None, &NoProgress).unwrap();
+        let ((reference, rs), (wave, _)) = (image(Engine::Reference), image(Engine::Wavefront));
+        assert!(rs.progressive.unwrap().pixel_caustic_radii.is_some());
+        let d = max_rel_diff(&reference, &wave);
+        assert!(d < 1e-6, "final gather {final_gather}: max relative difference {d}");
+    }
+}

@@ -58,7 +58,7 @@ impl<'a> Context<'a> {
             settings,
             global_radius: settings.global_radius * d,
             caustic_radius: settings.caustic_radius * d,
-            fixed: settings.fixed_radii,
+            fixed: settings.fixed_radii.clone(),
             effects: Effects::plan(scene, settings),
         }
     }
@@ -74,20 +74,21 @@ pub fn render_image(
     progress: &dyn Progress,
 ) -> (Film, RayCounts, u64) {
     let ctx = Context::new(scene, maps, settings);
-    render_pixels(settings, camera, threads, progress, |o, d, s, rays, scratch| {
-        trace_camera_path(&ctx, o, d, s, rays, scratch)
+    render_pixels(settings, camera, threads, progress, |pixel, o, d, s, rays, scratch| {
+        trace_camera_path(&ctx, pixel, o, d, s, rays, scratch)
     })
 }
 
 /// The pixel loop shared by the photon mapper and the path tracer: rows in parallel, each pixel
 /// the mean of its jittered samples (stratified when spp is a square), non-finite samples
-/// dropped and counted. `radiance(o, d, sampler, rays, scratch)` traces one camera ray.
+/// dropped and counted. `radiance(pixel, o, d, sampler, rays, scratch)` traces one camera ray of
+/// `pixel` (row-major index).
 pub fn render_pixels(
     settings: &Settings,
     camera: &CameraRays,
     threads: usize,
     progress: &dyn Progress,
-    radiance: impl Fn(Vec3, Vec3, &Sampler, &mut RayCounts, &mut Vec<(f32, u32)>) -> Terms + Sync,
+    radiance: impl Fn(usize, Vec3, Vec3, &Sampler, &mut RayCounts, &mut Vec<(f32, u32)>) -> Terms + Sync,
 ) -> (Film, RayCounts, u64) {
     let (w, h) = (settings.width as usize, settings.height as usize);
     let spp = settings.spp;
@@ -108,7 +109,7 @@ pub fn render_pixels(
                         let index = ((y * w + x) as u64) * spp as u64 + s as u64;
                         let (sampler, (fx, fy)) = camera_sample(settings, index);
                         let (o, d) = camera.ray(x as f32 + fx, y as f32 + fy);
-                        let t = radiance(o, d, &sampler, &mut rays, &mut scratch);
+                        let t = radiance(y * w + x, o, d, &sampler, &mut rays, &mut scratch);
                         if t.is_finite() {
                             sum += t;
                         } else {
@@ -151,9 +152,10 @@ pub fn camera_sample(settings: &Settings, index: u64) -> (Sampler, (f32, f32)) {
     (sampler, offset)
 }
 
-/// Radiance along one camera ray, split into terms.
+/// Radiance along one camera ray of `pixel`, split into terms.
 pub fn trace_camera_path(
     ctx: &Context,
+    pixel: usize,
     mut o: Vec3,
     mut d: Vec3,
     s: &Sampler,
@@ -192,12 +194,12 @@ pub fn trace_camera_path(
         }
         let ls = s.fork(TAG_LIGHT + depth as u64);
         let direct = beta * direct_light(ctx, &sp, &mat.bsdf, wo, &ls, rays);
-        let caustic = beta * caustic_estimate(ctx, &sp, &mat.bsdf, wo, scratch);
+        let caustic = beta * caustic_estimate(ctx, &sp, &mat.bsdf, wo, Some(pixel), scratch);
         let indirect = beta
             * if ctx.effects.final_gather.on {
                 final_gather(ctx, &sp, &mat.bsdf, wo, &s.fork(TAG_GATHER + depth as u64), rays, scratch)
             } else {
-                global_estimate(ctx, &sp, &mat.bsdf, wo, flags::DIRECT | flags::CAUSTIC, scratch)
+                global_estimate(ctx, &sp, &mat.bsdf, wo, flags::DIRECT | flags::CAUSTIC, Some(pixel), scratch)
             };
         let glossy =
             beta * glossy_reflection(ctx, &sp, &mat.bsdf, wo, &s.fork(TAG_GLOSSY + depth as u64), rays, scratch);
@@ -323,28 +325,32 @@ fn map_estimate(
     }
 }
 
-/// Caustic-map radiance estimate at `sp` toward `wo`.
+/// Caustic-map radiance estimate at `sp` toward `wo`; `pixel` when `sp` is a camera path's first
+/// non-specular hit (progressive passes may give each pixel its own radius).
 pub fn caustic_estimate(
     ctx: &Context,
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
+    pixel: Option<usize>,
     scratch: &mut Vec<(f32, u32)>,
 ) -> Vec3 {
-    let fixed = ctx.fixed.map(|r| r.caustic);
+    let fixed = ctx.fixed.as_ref().map(|r| r.caustic_at(pixel));
     map_estimate(ctx, &ctx.maps.caustic, ctx.settings.caustic_k, ctx.caustic_radius, sp, bsdf, wo, 0, fixed, scratch)
 }
 
-/// Global-map radiance estimate at `sp` toward `wo`, ignoring photons with any `mask` flag.
+/// Global-map radiance estimate at `sp` toward `wo`, ignoring photons with any `mask` flag;
+/// `pixel` as for [`caustic_estimate`].
 pub fn global_estimate(
     ctx: &Context,
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
     mask: u8,
+    pixel: Option<usize>,
     scratch: &mut Vec<(f32, u32)>,
 ) -> Vec3 {
-    let fixed = ctx.fixed.map(|r| r.global);
+    let fixed = ctx.fixed.as_ref().map(|r| r.global_at(pixel));
     map_estimate(ctx, &ctx.maps.global, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, fixed, scratch)
 }
 
@@ -381,7 +387,7 @@ pub fn final_gather(
 /// Follows a ray through mirrors and glass (at most `max_depth` bounces, sampling each with `s`
 /// at bounce `first_bounce + depth`) to its first non-specular hit: that point, the incoming
 /// direction and the throughput of the specular chain. `None` if it escapes or is absorbed.
-fn first_non_specular(
+pub fn first_non_specular(
     ctx: &Context,
     mut o: Vec3,
     mut d: Vec3,
@@ -442,7 +448,7 @@ pub fn map_radiance(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, scr
             return *kd * std::f32::consts::FRAC_1_PI * irr.power(i as usize);
         }
     }
-    global_estimate(ctx, sp, bsdf, wo, 0, scratch)
+    global_estimate(ctx, sp, bsdf, wo, 0, None, scratch)
 }
 
 /// The glossy lobe's reflection: one ray sampled from the lobe; at its first non-specular hit,
@@ -462,7 +468,7 @@ pub fn glossy_reflection(
     let Some((y, d, beta)) = first_non_specular(ctx, o, bs.wi, s, 1, rays) else { return Vec3::ZERO };
     let b = &ctx.scene.materials[y.material as usize].bsdf;
     let direct = direct_light(ctx, &y, b, -d, &s.fork(7), rays);
-    let caustic = caustic_estimate(ctx, &y, b, -d, scratch);
-    let rest = global_estimate(ctx, &y, b, -d, flags::DIRECT | flags::CAUSTIC, scratch);
+    let caustic = caustic_estimate(ctx, &y, b, -d, None, scratch);
+    let rest = global_estimate(ctx, &y, b, -d, flags::DIRECT | flags::CAUSTIC, None, scratch);
     bs.weight * beta * (direct + caustic + rest)
 }

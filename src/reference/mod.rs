@@ -90,7 +90,7 @@ fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings,
                         filter: Filter { n: src.normal, flags_mask: 0 },
                     };
                     let f = Reflectance::Constant(Vec3::ONE);
-                    let e = match settings.fixed_radii {
+                    let e = match &settings.fixed_radii {
                         Some(r) => {
                             // Leave the photon itself out (see `PhotonMap::own_share`).
                             let mut e =

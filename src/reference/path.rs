@@ -32,7 +32,7 @@ pub fn render_path_traced(
 ) -> (Film, RayCounts, u64) {
     let empty = super::PhotonMaps::default();
     let ctx = super::camera::Context::new(scene, &empty, settings);
-    render_pixels(settings, camera, settings.thread_count(), progress, |o, d, s, rays, _| {
+    render_pixels(settings, camera, settings.thread_count(), progress, |_, o, d, s, rays, _| {
         trace_path(&ctx, o, d, s, rays)
     })
 }

@@ -23,8 +23,8 @@ pub fn camera_slot(through_specular: u8, own: u8) -> u8 {
     }
 }
 
-/// Runs `estimate(ctx, point, bsdf, wo, kind, scratch)` at the diffuse hit of every lane whose
-/// kind passes `wanted`, in parallel, and adds `beta × value` to the lane's sample in lane order.
+/// Runs `estimate(ctx, point, bsdf, wo, kind, pixel, scratch)` at the diffuse hit of every lane
+/// whose kind passes `wanted` (`pixel` is the lane's pixel for camera lanes, `None` for others), in parallel, and adds `beta × value` to the lane's sample in lane order.
 /// `own_slot` is the term for camera lanes that did not pass through a mirror or glass; gather
 /// and glossy lanes use the slot they carry. Returns the number of estimates.
 fn estimate_at_diffuse_hits(
@@ -33,9 +33,10 @@ fn estimate_at_diffuse_hits(
     work: &mut CameraWork,
     wanted: impl Fn(PathKind) -> bool,
     own_slot: u8,
-    estimate: impl Fn(&Context, &SurfacePoint, &Bsdf, Vec3, PathKind, &mut Vec<(f32, u32)>) -> Vec3 + Sync,
+    estimate: impl Fn(&Context, &SurfacePoint, &Bsdf, Vec3, PathKind, Option<usize>, &mut Vec<(f32, u32)>) -> Vec3 + Sync,
 ) -> usize {
     let ctx = Context::new(&shared.scene, &maps.0, &shared.settings);
+    let spp = u64::from(shared.settings.spp);
     let w = &*work;
     let lanes: Vec<u32> = w.classified.diffuse.iter().copied().filter(|&l| wanted(w.paths.kind[l as usize])).collect();
     let out: Vec<(u32, u8, Vec3)> = par_lanes(lanes.len(), GATHER_CHUNK, shared.threads, |r| {
@@ -45,7 +46,9 @@ fn estimate_at_diffuse_hits(
             let sp = ctx.scene.surface(&w.paths.hits.get(i)?);
             let bsdf = &ctx.scene.materials[sp.material as usize].bsdf;
             let kind = w.paths.kind[i];
-            let value = estimate(&ctx, &sp, bsdf, -w.paths.rays.direction(i), kind, &mut scratch);
+            let pixel =
+                (kind == PathKind::Camera).then(|| ((w.first_sample + u64::from(w.paths.sample[i])) / spp) as usize);
+            let value = estimate(&ctx, &sp, bsdf, -w.paths.rays.direction(i), kind, pixel, &mut scratch);
             let s = match kind {
                 PathKind::Camera => camera_slot(w.paths.through_specular[i], own_slot),
                 _ => w.paths.slot[i],
@@ -74,7 +77,7 @@ pub fn gather_caustics(
         &mut work,
         |kind| kind != PathKind::Gather,
         slot::CAUSTIC,
-        |ctx, sp, bsdf, wo, _, scratch| caustic_estimate(ctx, sp, bsdf, wo, scratch),
+        |ctx, sp, bsdf, wo, _, pixel, scratch| caustic_estimate(ctx, sp, bsdf, wo, pixel, scratch),
     );
     stats.record("gather_caustics", n, t);
 }
@@ -96,9 +99,9 @@ pub fn gather_global(
         &mut work,
         |kind| !(kind == PathKind::Camera && gather_on),
         slot::INDIRECT,
-        |ctx, sp, bsdf, wo, kind, scratch| match kind {
+        |ctx, sp, bsdf, wo, kind, pixel, scratch| match kind {
             PathKind::Gather => map_radiance(ctx, sp, bsdf, wo, scratch),
-            _ => global_estimate(ctx, sp, bsdf, wo, flags::DIRECT | flags::CAUSTIC, scratch),
+            _ => global_estimate(ctx, sp, bsdf, wo, flags::DIRECT | flags::CAUSTIC, pixel, scratch),
         },
     );
     stats.record("gather_global", n, t);
