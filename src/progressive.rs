@@ -56,6 +56,8 @@ pub struct ProgressiveStats {
     pub elapsed_s: f64,
     /// Wall time of each pass.
     pub pass_seconds: Vec<f64>,
+    /// Wall time of the pilot photon pass and the per-pixel radii.
+    pub pilot_seconds: f64,
 }
 
 /// The seed of pass `i`: pass 0 keeps the user's seed; later ones are mixed from it.
@@ -231,6 +233,7 @@ impl Progressive {
     /// photon counts per pass): finds the first radii.
     pub fn new(scene: &Scene, rays: &CameraRays, settings: &Settings) -> Result<Self> {
         settings.validate()?;
+        let t = Instant::now();
         let first = initial_radii(scene, rays, settings);
         let pixel = first.pixels.as_deref();
         let progress = ProgressiveStats {
@@ -238,6 +241,7 @@ impl Progressive {
             initial_radii: [first.global, first.caustic],
             pixel_caustic_radii: pixel.and_then(|p| percentiles(&p.caustic)),
             pixel_global_radii: pixel.and_then(|p| percentiles(&p.global)),
+            pilot_seconds: t.elapsed().as_secs_f64(),
             ..Default::default()
         };
         Ok(Progressive {

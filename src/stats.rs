@@ -189,9 +189,10 @@ impl RenderStats {
             })
         };
         format!(
-            "  progressive: {} passes (α = {:.3}), radii global {:.4} → {:.4}, caustic {:.4} → {:.4}{budget}{}{}\n",
+            "  progressive: {} passes (α = {:.3}), pilot {:.2} s, radii global {:.4} → {:.4}, caustic {:.4} → {:.4}{budget}{}{}\n",
             p.passes,
             p.alpha,
+            p.pilot_seconds,
             p.initial_radii[0],
             p.final_radii[0],
             p.initial_radii[1],
