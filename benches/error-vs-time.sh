@@ -26,7 +26,7 @@ sweep() {
   "$pw" sweep "$scene" --reference "$ref" --layer "$layer" -o "$out/$name" -q "$@"
 }
 # Progressive passes (16 passes ≈ one default render's work), with and without per-pixel radii.
-sweep passes beauty --knob passes=1,2,4,8,16,32,64,128 --knob per_pixel_radii=true,false
+sweep passes caustic --knob passes=1,2,4,8,16,32,64,128 --knob per_pixel_radii=true,false
 # The same two radius schemes at equal time.
 sweep equal-time caustic --knob per_pixel_radii=true,false --time 2s,4s,8s,16s,32s
 # One-pass knobs, each from the defaults, plotted on the layer they act on.

@@ -49,7 +49,7 @@ struct SweepArgs {
     /// A knob and its values, NAME=V1,V2,… (repeatable; the grid is every combination). Any
     /// setting but width, height and force: spp, photons, caustic_photons, k, caustic_k,
     /// global_radius, caustic_radius, kernel, gather_rays, final_gather, precompute_irradiance,
-    /// passes, alpha, max_depth, light_samples, seed, threads, kernels.
+    /// per_pixel_radii, passes, alpha, max_depth, light_samples, seed, threads, kernels.
     #[arg(long = "knob", required = true)]
     knobs: Vec<photonwave::sweep::Knob>,
     /// Equal-time mode: time budgets, e.g. `1s,4s,16s`; every configuration renders progressive
@@ -475,12 +475,10 @@ fn sweep(args: SweepArgs) -> Result<()> {
     let loaded = load_scene(&args.scene)?;
     let scene = std::sync::Arc::new(loaded.scene);
     let mut base = loaded.settings;
-    if let Some(p) = args.preset {
-        p.apply(&mut base);
-    }
+    let given = args.preset.map(|p| p.apply(&mut base)).unwrap_or_default();
     (base.width, base.height) = (reference.width, reference.height);
     base.validate()?;
-    let sweep = Sweep::new(&base, args.knobs, args.time, args.engine)?;
+    let sweep = Sweep::new(&base, given, args.knobs, args.time, args.engine)?;
     let camera = loaded.camera.unwrap_or_else(|| fitted_camera(&scene, 40.0));
     let rays = camera.prepare(base.width, base.height)?;
     std::fs::create_dir_all(&args.output).map_err(|e| Error::output(&args.output, e))?;

@@ -595,16 +595,6 @@ impl PhotonMap {
         Estimate { radiance: (sum + simd) * q.kernel.normalisation(r2), radius: q.r_max, count }
     }
 
-    /// What photon `i` adds to a fixed-radius estimate (radius `r`, f = 1) made at its own
-    /// position: subtracted to leave it out when estimating at photons (precomputed irradiance),
-    /// where it would otherwise add Φ·K(0) to every estimate — a bias that grows as the radius
-    /// shrinks.
-    #[must_use]
-    pub fn own_share(&self, i: usize, r: f32, kernel: Kernel) -> Vec3 {
-        let r2 = r * r;
-        self.contribution(i, 0.0, r2, kernel, Reflectance::Constant(Vec3::ONE)) * kernel.normalisation(r2)
-    }
-
     /// f(wi)·Φ·weight of photon `i` at squared distance `d2` (scalar twin of [`Self::contribution8`]).
     #[inline]
     fn contribution(&self, i: usize, d2: f32, r2: f32, kernel: Kernel, f: Reflectance<'_>) -> Vec3 {

@@ -62,7 +62,8 @@ pub struct Settings {
     pub final_gather: bool,
     /// Final-gather rays that end on a Lambertian surface read irradiance precomputed at every
     /// 4th global photon (Christensen 1999) instead of a full density estimate: one
-    /// nearest-neighbour search instead of k. Slightly blurrier, several times faster.
+    /// nearest-neighbour search instead of k. Slightly blurrier, several times faster. Not used
+    /// by progressive passes, where it would be biased (see `reference::precompute_irradiance`).
     pub precompute_irradiance: bool,
     /// Longest photon path and longest specular chain of a camera path (bounces).
     pub max_depth: u32,

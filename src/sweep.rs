@@ -54,14 +54,17 @@ impl std::str::FromStr for Knob {
 }
 
 /// The settings as a TOML table (every field, by its name in scene files).
-fn table(settings: &Settings) -> toml::Table {
-    toml::Table::try_from(settings).expect("Settings serialises to a TOML table")
+fn table(settings: &Settings) -> Result<toml::Table> {
+    // Only a value TOML cannot hold (a seed above 2⁶³ − 1) fails here.
+    toml::Table::try_from(settings).map_err(|e| Error::setting("seed", e.to_string()))
 }
 
 /// The names of every knob a sweep can vary, sorted.
 #[must_use]
 pub fn knob_names() -> Vec<String> {
-    table(&Settings::default()).keys().filter(|k| !FIXED_FIELDS.contains(&k.as_str())).cloned().collect()
+    table(&Settings::default())
+        .map(|t| t.keys().filter(|k| !FIXED_FIELDS.contains(&k.as_str())).cloned().collect())
+        .unwrap_or_default()
 }
 
 /// `settings` with knob `name` set to `value`, parsed as that field's type.
@@ -72,7 +75,7 @@ pub fn set_knob(settings: &Settings, name: &str, value: &str) -> Result<Settings
             "cannot be swept: the image size is the reference's, and `force` is a list (set it in the scene file)",
         ));
     }
-    let mut t = table(settings);
+    let mut t = table(settings)?;
     let bad = |what: &str| Error::setting(name, format!("`{value}` is not {what}"));
     let parsed = match t.get(name) {
         None => {
@@ -100,8 +103,9 @@ pub struct Config {
 
 /// Every combination of the knobs' values over `base` (the first knob varies slowest). Each
 /// configuration is validated; a progressive one gets per-pass amounts as `render --passes`
-/// would, with the knobs among `spp`, `photons` and `caustic_photons` taken per pass.
-pub fn grid(base: &Settings, knobs: &[Knob], budgets: &[Duration]) -> Result<Vec<Config>> {
+/// would, with the amounts in `given` (e.g. a preset's) and the knobs among `spp`, `photons`
+/// and `caustic_photons` taken per pass.
+pub fn grid(base: &Settings, given: PerPass, knobs: &[Knob], budgets: &[Duration]) -> Result<Vec<Config>> {
     for (i, k) in knobs.iter().enumerate() {
         if knobs[..i].iter().any(|o| o.name == k.name) {
             return Err(Error::setting(&k.name, "given twice: list all its values in one --knob"));
@@ -114,11 +118,12 @@ pub fn grid(base: &Settings, knobs: &[Knob], budgets: &[Duration]) -> Result<Vec
     if runs.is_none_or(|n| n > MAX_RUNS) {
         return Err(Error::setting("--knob", format!("the grid has more than {MAX_RUNS} renders")));
     }
-    let given = PerPass {
-        spp: knobs.iter().any(|k| k.name == "spp"),
-        photons: knobs.iter().any(|k| k.name == "photons"),
-        caustic_photons: knobs.iter().any(|k| k.name == "caustic_photons"),
-    };
+    let given = given
+        | PerPass {
+            spp: knobs.iter().any(|k| k.name == "spp"),
+            photons: knobs.iter().any(|k| k.name == "photons"),
+            caustic_photons: knobs.iter().any(|k| k.name == "caustic_photons"),
+        };
     let mut configs = vec![Config { values: Vec::new(), settings: base.clone() }];
     for k in knobs {
         let mut next = Vec::with_capacity(configs.len() * k.values.len());
@@ -202,12 +207,19 @@ pub struct Sweep {
 }
 
 impl Sweep {
-    /// The sweep of `knobs` over `base`, validated before anything renders.
-    pub fn new(base: &Settings, knobs: Vec<Knob>, budgets: Vec<Duration>, engine: Engine) -> Result<Self> {
-        if engine == Engine::Path && (!budgets.is_empty() || base.passes > 1) {
+    /// The sweep of `knobs` over `base` (with the per-pass amounts `given`, see [`grid`]),
+    /// validated before anything renders.
+    pub fn new(
+        base: &Settings,
+        given: PerPass,
+        knobs: Vec<Knob>,
+        budgets: Vec<Duration>,
+        engine: Engine,
+    ) -> Result<Self> {
+        let configs = grid(base, given, &knobs, &budgets)?;
+        if engine == Engine::Path && (!budgets.is_empty() || configs.iter().any(|c| c.settings.passes > 1)) {
             return Err(Error::setting("--engine", "progressive passes (--time, passes) need a photon-mapping engine"));
         }
-        let configs = grid(base, &knobs, &budgets)?;
         Ok(Sweep { knobs, configs, budgets, engine })
     }
 

@@ -8,6 +8,7 @@ use common::{bundled, load, scratch_dir};
 use photonwave::compare::layer_errors;
 use photonwave::engine::{self, Engine};
 use photonwave::film::Film;
+use photonwave::progressive::PerPass;
 use photonwave::reference::NoProgress;
 use photonwave::settings::{Kernel, Settings};
 use photonwave::sweep::{grid, set_knob, Knob, Metric, Sweep};
@@ -73,7 +74,8 @@ fn knobs_take_their_fields_types_and_bad_ones_are_named() {
 
 #[test]
 fn the_grid_is_every_combination_first_knob_slowest() {
-    let configs = grid(&tiny(), &[knob("k=8,16"), knob("kernel=box,cone,epanechnikov")], &[]).unwrap();
+    let configs =
+        grid(&tiny(), PerPass::default(), &[knob("k=8,16"), knob("kernel=box,cone,epanechnikov")], &[]).unwrap();
     let seen: Vec<(u32, Kernel)> = configs.iter().map(|c| (c.settings.k, c.settings.kernel)).collect();
     use Kernel::*;
     assert_eq!(seen, [(8, Box), (8, Cone), (8, Epanechnikov), (16, Box), (16, Cone), (16, Epanechnikov)]);
@@ -82,24 +84,29 @@ fn the_grid_is_every_combination_first_knob_slowest() {
     // Progressive configurations spread the base's samples and photons over passes, as
     // `render --passes` does, unless a knob sets them (then they are per pass).
     let base = Settings { spp: 16, photons: 160_000, ..tiny() };
-    let spread = grid(&base, &[knob("passes=1,8")], &[]).unwrap();
+    let spread = grid(&base, PerPass::default(), &[knob("passes=1,8")], &[]).unwrap();
     assert_eq!((spread[0].settings.spp, spread[0].settings.photons), (16, 160_000));
     assert_eq!((spread[1].settings.spp, spread[1].settings.photons), (1, 10_000));
     // spp given per pass: photons are still spread over the spp (`per_pass`'s rule).
-    let given = grid(&base, &[knob("passes=8"), knob("spp=2")], &[]).unwrap();
+    let given = grid(&base, PerPass::default(), &[knob("passes=8"), knob("spp=2")], &[]).unwrap();
     assert_eq!((given[0].settings.spp, given[0].settings.photons), (2, 80_000));
-    let given = grid(&base, &[knob("passes=8"), knob("photons=5000")], &[]).unwrap();
+    let given = grid(&base, PerPass::default(), &[knob("passes=8"), knob("photons=5000")], &[]).unwrap();
     assert_eq!((given[0].settings.spp, given[0].settings.photons), (1, 5000));
+    // Amounts a preset gives per pass stay as they are.
+    let all = PerPass { spp: true, photons: true, caustic_photons: true };
+    let preset = grid(&base, all, &[knob("passes=8")], &[]).unwrap();
+    assert_eq!((preset[0].settings.spp, preset[0].settings.photons), (16, 160_000));
 
-    let e = grid(&tiny(), &[knob("k=8"), knob("k=16")], &[]).unwrap_err().to_string();
+    let e = grid(&tiny(), PerPass::default(), &[knob("k=8"), knob("k=16")], &[]).unwrap_err().to_string();
     assert!(e.contains("`k`") && e.contains("twice"), "{e}");
-    let e = grid(&tiny(), &[knob("passes=1,2")], &[Duration::from_secs(1)]).unwrap_err().to_string();
+    let e =
+        grid(&tiny(), PerPass::default(), &[knob("passes=1,2")], &[Duration::from_secs(1)]).unwrap_err().to_string();
     assert!(e.contains("`passes`") && e.contains("budget"), "{e}");
     let many: Vec<Knob> = ["k", "caustic_k", "gather_rays"]
         .iter()
         .map(|n| knob(&format!("{n}={}", (2..30).map(|v| v.to_string()).collect::<Vec<_>>().join(","))))
         .collect();
-    let e = grid(&tiny(), &many, &[]).unwrap_err().to_string();
+    let e = grid(&tiny(), PerPass::default(), &many, &[]).unwrap_err().to_string();
     assert!(e.contains("more than"), "{e}");
 }
 
@@ -112,8 +119,14 @@ fn rows_are_what_render_and_compare_give() {
     let rays = loaded.camera.unwrap().prepare(12, 12).unwrap();
     let reference_film = reference_film();
     let reference = photonwave::film::ExrLayers { width: 12, height: 12, layers: reference_film.layers() };
-    let sweep =
-        Sweep::new(&tiny(), vec![knob("gather_rays=1,4"), knob("passes=1,3")], Vec::new(), Engine::Wavefront).unwrap();
+    let sweep = Sweep::new(
+        &tiny(),
+        PerPass::default(),
+        vec![knob("gather_rays=1,4"), knob("passes=1,3")],
+        Vec::new(),
+        Engine::Wavefront,
+    )
+    .unwrap();
     let rows = sweep.run(&scene, &rays, &reference, &NoProgress).unwrap();
     assert_eq!(rows.len(), 4);
     for (row, config) in rows.iter().zip(&sweep.configs) {
@@ -159,7 +172,8 @@ fn equal_time_mode_renders_each_configuration_per_budget() {
     let rays = loaded.camera.unwrap().prepare(12, 12).unwrap();
     let reference = photonwave::film::ExrLayers { width: 12, height: 12, layers: reference_film().layers() };
     let budgets = vec![Duration::from_millis(150), Duration::from_millis(450)];
-    let sweep = Sweep::new(&tiny(), vec![knob("kernel=box,cone")], budgets, Engine::Wavefront).unwrap();
+    let sweep =
+        Sweep::new(&tiny(), PerPass::default(), vec![knob("kernel=box,cone")], budgets, Engine::Wavefront).unwrap();
     let rows = sweep.run(&scene, &rays, &reference, &NoProgress).unwrap();
     let got: Vec<(usize, Option<f64>)> = rows.iter().map(|r| (r.config, r.budget_s)).collect();
     assert_eq!(got, [(0, Some(0.15)), (1, Some(0.15)), (0, Some(0.45)), (1, Some(0.45))]);
@@ -249,5 +263,6 @@ fn cli_names_bad_input() {
     fails(&["--reference", reference, "--knob", "k=8", "--layer", "glossy"], &["glossy", "caustic"]);
     fails(&["--reference", reference], &["--knob"]);
     fails(&["--reference", reference, "--knob", "k=8", "--engine", "path", "--time", "1s"], &["--engine"]);
+    fails(&["--reference", reference, "--knob", "passes=1,2", "--engine", "path"], &["--engine"]);
     assert!(!d.join("o").exists(), "nothing is written before the input is checked");
 }
