@@ -130,3 +130,42 @@ mtl("cornell-spheres.mtl", BOX_MATERIALS + [
 o = Obj("furnace.mtl"); o.sphere("enclosure", "furnace", (0, 0, 0), 1.0, inward=True, seg=32, rings=16)
 o.write("furnace.obj")
 mtl("furnace.mtl", [("furnace", "illum 1\nKd 0.5 0.5 0.5\nKe 1 1 1")])
+
+# ---- hard cases (scenes/hard/): geometry in metres, no Cornell conversion -------------------
+
+class RawObj(Obj):
+    """An Obj whose points are written as given (no Cornell-box conversion)."""
+    def quad(self, name, material, pts, facing):
+        n = cross(sub(pts[1], pts[0]), sub(pts[2], pts[0]))
+        if dot(n, facing) < 0:
+            pts = pts[::-1]
+        self.lines.append(f"o {name}")
+        self.lines.append(f"usemtl {material}")
+        for p in pts:
+            self.lines.append("v %.6f %.6f %.6f" % p)
+        self.lines.append("f " + " ".join(str(self.nv + 1 + i) for i in range(len(pts))))
+        self.nv += len(pts)
+
+def thin_wall(path):
+    """A closed 2 x 1 x 1 room (x in [-1, 1], y in [0, 1], z in [-0.5, 0.5]) split at x = 0 by one
+    zero-thickness quad. Every face of the room is split at x = 0 too, so the wall's edges are
+    shared edges, not T-junctions. Faces point into their half of the room."""
+    o = RawObj("thin-wall.mtl")
+    for side, (x0, x1) in [("left", (-1.0, 0.0)), ("right", (0.0, 1.0))]:
+        c = ((x0 + x1) / 2, 0.5, 0.0)
+        def face(name, pts):
+            m = tuple(sum(p[i] for p in pts) / 4 for i in range(3))
+            o.quad(f"{side}_{name}", "white", pts, sub(c, m))
+        face("floor", [(x0, 0, -0.5), (x1, 0, -0.5), (x1, 0, 0.5), (x0, 0, 0.5)])
+        face("ceiling", [(x0, 1, -0.5), (x1, 1, -0.5), (x1, 1, 0.5), (x0, 1, 0.5)])
+        face("back", [(x0, 0, -0.5), (x1, 0, -0.5), (x1, 1, -0.5), (x0, 1, -0.5)])
+        face("front", [(x0, 0, 0.5), (x1, 0, 0.5), (x1, 1, 0.5), (x0, 1, 0.5)])
+        end = x0 if side == "left" else x1
+        face("end", [(end, 0, -0.5), (end, 0, 0.5), (end, 1, 0.5), (end, 1, -0.5)])
+    o.quad("divider", "white", [(0, 0, -0.5), (0, 0, 0.5), (0, 1, 0.5), (0, 1, -0.5)], (-1, 0, 0))
+    o.write(path)
+    mtl(path.replace(".obj", ".mtl"), [("white", "illum 1\nKd 0.73 0.73 0.73")])
+
+import os
+os.makedirs("hard", exist_ok=True)
+thin_wall("hard/thin-wall.obj")

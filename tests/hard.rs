@@ -1,0 +1,63 @@
+//! Hard cases (scenes/hard/): each scene's known answer, on both photon-mapping engines.
+
+mod common;
+
+use glam::Vec3;
+use photonwave::engine::{render, Engine};
+use photonwave::reference::NoProgress;
+use photonwave::scene::file::{load_scene, LoadedScene};
+use photonwave::settings::Settings;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+fn hard(name: &str) -> LoadedScene {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/hard").join(name);
+    load_scene(&path).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+const ENGINES: [Engine; 2] = [Engine::Wavefront, Engine::Reference];
+
+/// Case 3: the dark half of a room split by a zero-thickness wall gets exactly nothing — no
+/// light, no photon — while the lit half is lit.
+///
+/// Not yet true (issue 6 open): the photons are right, but density estimates on the coplanar
+/// floor, ceiling and side walls reach across the wall, and a gather hit on the dark side reads
+/// the nearest precomputed irradiance point on the lit side (there is none on its own side within
+/// the 0.12 m search radius). Dark-half indirect mean, 64², default settings: 0.085 with
+/// precomputed irradiance, 0.012 with full estimates, 0.011 reading the global map at the first
+/// hit — against 1.26 in the lit half. Run with `cargo test --test hard -- --ignored`.
+#[test]
+#[ignore = "known leak across thin walls (issue 6): indirect light 0.9–6.7 % of the lit side"]
+fn thin_wall_lets_nothing_through() {
+    let loaded = hard("thin-wall.toml");
+    let scene = Arc::new(loaded.scene);
+    let base = Settings { width: 32, height: 32, spp: 4, photons: 20_000, gather_rays: 8, ..Default::default() };
+    let dark = loaded.camera.unwrap();
+    let mut lit = dark;
+    (lit.eye, lit.target) = (Vec3::new(-0.95, 0.5, 0.0), Vec3::new(0.0, 0.5, 0.0));
+    // Photons: none in the dark half; on the wall itself only on its lit face (normal toward −x).
+    let (maps, stats, _) = photonwave::reference::build_maps(&scene, &base);
+    assert!(stats.stored >= 20_000);
+    for i in 0..maps.global.len() {
+        let p = maps.global.photon(i);
+        assert!(p.position.x <= 0.0, "photon {i} at {:?} in the dark half", p.position);
+        if p.position.x == 0.0 {
+            assert!(p.normal.x < 0.0, "photon {i} on the wall's dark face: {p:?}");
+        }
+    }
+    for engine in ENGINES {
+        for final_gather in [true, false] {
+            let s = Settings { final_gather, ..base.clone() };
+            let image = |cam: photonwave::scene::Camera| {
+                render(&scene, &cam.prepare(32, 32).unwrap(), &s, engine, None, &NoProgress).unwrap().0
+            };
+            let film = image(dark);
+            let lit_pixels = film.pixels.iter().filter(|t| t.as_array().iter().any(|v| *v != Vec3::ZERO)).count();
+            assert_eq!(lit_pixels, 0, "{engine:?}, final gather {final_gather}: light leaked into the dark half");
+            // The other side of the same wall, from the lit half: direct and indirect light.
+            let film = image(lit);
+            let sum = film.pixels.iter().fold(Vec3::ZERO, |a, t| a + t.direct + t.indirect);
+            assert!(sum.min_element() > 0.0, "{engine:?}: the lit half is dark");
+        }
+    }
+}
