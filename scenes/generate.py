@@ -169,3 +169,39 @@ def thin_wall(path):
 import os
 os.makedirs("hard", exist_ok=True)
 thin_wall("hard/thin-wall.obj")
+
+def grazing(folder):
+    """A 2 x 2 Lambertian plane (kd 0.5) at y = 0 facing +y, seen from straight above, lit by a
+    directional light of perpendicular irradiance 1 at theta = 0, 60, 85 and 89 degrees to the
+    normal: the plane's irradiance is cos(theta), its radiance 0.5 cos(theta) / pi."""
+    o = RawObj("grazing.mtl")
+    o.quad("plane", "half", [(-1, 0, -1), (1, 0, -1), (1, 0, 1), (-1, 0, 1)], (0, 1, 0))
+    o.write(f"{folder}/grazing.obj")
+    mtl(f"{folder}/grazing.mtl", [("half", "illum 1\nKd 0.5 0.5 0.5")])
+    for deg in (0, 60, 85, 89):
+        t = math.radians(deg)
+        d = (math.sin(t), -math.cos(t), 0.0)
+        with open(f"{folder}/grazing-{deg}.toml", "w") as f:
+            f.write(f"""# Grazing light, written by scenes/generate.py: a directional light {deg} degrees from the
+# plane's normal. Irradiance on the plane is cos({deg} deg) = {math.cos(t):.6f} of the perpendicular
+# irradiance (1), from light sampling and from photons alike; radiance 0.5 x that / pi.
+[[mesh]]
+file = "grazing.obj"
+
+[camera]
+eye = [0.0, 1.0, 0.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, -1.0]
+fov = 40
+
+[[light]]
+type = "directional"
+direction = [{d[0]:.9f}, {d[1]:.9f}, {d[2]:.1f}]
+irradiance = [1, 1, 1]
+
+[render]
+width = 32
+height = 32
+""")
+
+grazing("hard")

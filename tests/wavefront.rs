@@ -147,6 +147,14 @@ fn both_engines_emit_and_store_the_same_photons() {
     assert_eq!((r.global_map.emitted, r.global_map.stored), (w.global_map.emitted, w.global_map.stored));
     assert_eq!((r.caustic_map.emitted, r.caustic_map.stored), (w.caustic_map.emitted, w.caustic_map.stored));
     assert_eq!(r.irradiance_points, w.irradiance_points);
+    // Photon by photon: same positions, powers, directions and flags, in the same order.
+    let scene = Arc::new(load("cornell-spheres.toml").scene);
+    let (rm, _, _) = photonwave::reference::build_maps(&scene, &s);
+    let (wm, _) = photonwave::wavefront::build_maps(scene, &s).unwrap();
+    for (a, b) in [(&rm.global, &wm.global), (&rm.caustic, &wm.caustic), (&rm.irradiance, &wm.irradiance)] {
+        assert_eq!(a.len(), b.len());
+        assert!((0..a.len()).all(|i| a.photon(i) == b.photon(i)));
+    }
 }
 
 /// Progressive passes with per-pixel radii: the engines still agree per pixel (same tolerance

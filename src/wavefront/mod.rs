@@ -330,20 +330,8 @@ pub fn schedules() -> [Schedule; 4] {
     all
 }
 
-/// Renders with the wavefront engine.
-pub fn render(
-    scene: Arc<Scene>,
-    camera: &CameraRays,
-    settings: &Settings,
-    progress: &dyn Progress,
-) -> Result<(Film, RenderStats)> {
-    settings.validate()?;
-    let effects = Effects::plan(&scene, settings);
-    effects.check(settings)?;
-    let threads = settings.thread_count();
-    let start = Instant::now();
-    let mut stats =
-        RenderStats { effects: Some(effects.clone()), ..RenderStats::new("wavefront", &scene, settings, threads) };
+/// A world holding the shared resources and the schedules of both passes.
+fn new_world(scene: &Arc<Scene>, settings: &Settings, effects: &Effects, threads: usize) -> World {
     let mut world = World::new();
     world.insert_resource(Shared {
         scene: scene.clone(),
@@ -357,7 +345,20 @@ pub fn render(
     for s in schedules() {
         world.add_schedule(s);
     }
+    world
+}
 
+/// The photon pass of both maps the plan wants, run through the photon schedule, and the maps
+/// built from it; counts and times go into `stats`.
+fn photon_pass(
+    world: &mut World,
+    scene: &Arc<Scene>,
+    settings: &Settings,
+    effects: &Effects,
+    stats: &mut RenderStats,
+    progress: &dyn Progress,
+) -> PhotonMaps {
+    let threads = settings.thread_count();
     // Photon passes, batch by batch, exactly as many batches as the reference engine emits.
     let mut maps_photons: [Vec<Photon>; 2] = [Vec::new(), Vec::new()];
     for (k, (domain, on, target)) in [
@@ -439,10 +440,43 @@ pub fn render(
 
     let t = Instant::now();
     let [global, caustic] = maps_photons;
-    let maps = PhotonMaps::build(&scene, settings, global, caustic, threads);
+    let maps = PhotonMaps::build(scene, settings, global, caustic, threads);
     stats.irradiance_points = maps.irradiance.len() as u64;
-    world.insert_resource(Maps(Arc::new(maps)));
     stats.times.map_build_s = t.elapsed().as_secs_f64();
+
+    maps
+}
+
+/// The wavefront engine's photon maps for `scene` with `settings` (no camera pass): the same
+/// photons as [`crate::reference::build_maps`].
+pub fn build_maps(scene: Arc<Scene>, settings: &Settings) -> Result<(PhotonMaps, RenderStats)> {
+    settings.validate()?;
+    let effects = Effects::plan(&scene, settings);
+    effects.check(settings)?;
+    let threads = settings.thread_count();
+    let mut stats = RenderStats::new("wavefront", &scene, settings, threads);
+    let mut world = new_world(&scene, settings, &effects, threads);
+    let maps = photon_pass(&mut world, &scene, settings, &effects, &mut stats, &crate::reference::NoProgress);
+    Ok((maps, stats))
+}
+
+/// Renders with the wavefront engine.
+pub fn render(
+    scene: Arc<Scene>,
+    camera: &CameraRays,
+    settings: &Settings,
+    progress: &dyn Progress,
+) -> Result<(Film, RenderStats)> {
+    settings.validate()?;
+    let effects = Effects::plan(&scene, settings);
+    effects.check(settings)?;
+    let threads = settings.thread_count();
+    let start = Instant::now();
+    let mut stats =
+        RenderStats { effects: Some(effects.clone()), ..RenderStats::new("wavefront", &scene, settings, threads) };
+    let mut world = new_world(&scene, settings, &effects, threads);
+    let maps = photon_pass(&mut world, &scene, settings, &effects, &mut stats, progress);
+    world.insert_resource(Maps(Arc::new(maps)));
 
     // Camera pass, wave by wave.
     let t = Instant::now();
