@@ -205,3 +205,37 @@ height = 32
 """)
 
 grazing("hard")
+
+def degenerate_light(folder):
+    """A 2 x 2 floor (kd 0.5) under a 0.5 x 0.5 quad light facing down at y = 1; the `-degenerate`
+    variant adds a zero-area triangle (three collinear points) to the light's mesh, last."""
+    for variant in ("", "-degenerate"):
+        name = f"emitter{variant}"
+        o = RawObj(f"{name}.mtl")
+        o.quad("floor", "half", [(-1, 0, -1), (1, 0, -1), (1, 0, 1), (-1, 0, 1)], (0, 1, 0))
+        o.quad("light", "light", [(-0.25, 1, -0.25), (0.25, 1, -0.25), (0.25, 1, 0.25), (-0.25, 1, 0.25)], (0, -1, 0))
+        if variant:
+            o.lines.append("v -0.25 1.0 0.3\nv 0.0 1.0 0.3\nv 0.25 1.0 0.3\nf %d %d %d" % (o.nv + 1, o.nv + 2, o.nv + 3))
+            o.nv += 3
+        o.write(f"{folder}/{name}.obj")
+        mtl(f"{folder}/{name}.mtl", [("half", "illum 1\nKd 0.5 0.5 0.5"), ("light", "illum 1\nKd 0 0 0\nKe 4 4 4")])
+        what = ("a quad light over a floor whose mesh also holds a\n# zero-area triangle; it must be "
+                "sampled with probability zero and change nothing") if variant else \
+               ("a quad light over a floor; the reference for\n# emitter-degenerate.toml, which must "
+                "render the same image")
+        with open(f"{folder}/{name}.toml", "w") as f:
+            f.write(f"""# Degenerate emitter, written by scenes/generate.py: {what}.
+[[mesh]]
+file = "{name}.obj"
+
+[camera]
+eye = [0.0, 0.5, 1.8]
+target = [0.0, 0.3, 0.0]
+fov = 50
+
+[render]
+width = 32
+height = 32
+""")
+
+degenerate_light("hard")

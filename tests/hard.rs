@@ -107,3 +107,28 @@ fn grazing_light_follows_the_cosine_law() {
         }
     }
 }
+
+/// Case 10: a light mesh holding a zero-area triangle renders exactly as the same light without
+/// it, on both engines: the triangle is dropped with a warning, never sampled (each remaining
+/// emitter has a positive probability and the light's power is unchanged).
+#[test]
+fn a_zero_area_emitter_triangle_changes_nothing() {
+    let (plain, degenerate) = (hard("emitter.toml"), hard("emitter-degenerate.toml"));
+    assert!(plain.scene.warnings.is_empty(), "{:?}", plain.scene.warnings);
+    assert!(degenerate.scene.warnings.iter().any(|w| w.contains("degenerate")), "{:?}", degenerate.scene.warnings);
+    assert_eq!(plain.scene.area_lights.len(), 2);
+    assert_eq!(degenerate.scene.area_lights.len(), 2);
+    assert_eq!(plain.scene.total_power(), degenerate.scene.total_power());
+    let power = degenerate.scene.area_power.as_ref().expect("an area light");
+    assert!((0..2).all(|i| power.pmf(i) > 0.0));
+    let s = Settings { width: 24, height: 24, spp: 4, photons: 20_000, gather_rays: 4, ..Default::default() };
+    let rays = plain.camera.unwrap().prepare(24, 24).unwrap();
+    let (plain, degenerate) = (Arc::new(plain.scene), Arc::new(degenerate.scene));
+    for engine in ENGINES {
+        let image =
+            |scene: &Arc<photonwave::scene::Scene>| render(scene, &rays, &s, engine, None, &NoProgress).unwrap().0;
+        let (a, b) = (image(&plain), image(&degenerate));
+        assert!(a.mean().min_element() > 0.0, "{engine:?}: the scene is dark");
+        assert_eq!(a, b, "{engine:?}: the zero-area triangle changed the image");
+    }
+}
