@@ -239,3 +239,22 @@ height = 32
 """)
 
 degenerate_light("hard")
+
+def light_in_glass(folder):
+    """A closed 2 x 2 x 2 white room (kd 0.5) centred on the origin, a glass sphere (n = 1.5,
+    radius 0.2) centred on the origin, and (in the TOML) a point light at the origin."""
+    o = RawObj("light-in-glass.mtl")
+    c = (0.0, 0.0, 0.0)
+    for name, pts in [("floor", [(-1, -1, -1), (1, -1, -1), (1, -1, 1), (-1, -1, 1)]),
+                      ("ceiling", [(-1, 1, -1), (1, 1, -1), (1, 1, 1), (-1, 1, 1)]),
+                      ("back", [(-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1)]),
+                      ("front", [(-1, -1, 1), (1, -1, 1), (1, 1, 1), (-1, 1, 1)]),
+                      ("left", [(-1, -1, -1), (-1, -1, 1), (-1, 1, 1), (-1, 1, -1)]),
+                      ("right", [(1, -1, -1), (1, -1, 1), (1, 1, 1), (1, 1, -1)])]:
+        m = tuple(sum(p[i] for p in pts) / 4 for i in range(3))
+        o.quad(name, "white", pts, sub(c, m))
+    o.sphere("glass_sphere", "glass", c, 0.2, seg=96, rings=48)
+    o.write(f"{folder}/light-in-glass.obj")
+    mtl(f"{folder}/light-in-glass.mtl", [("white", "illum 1\nKd 0.5 0.5 0.5"), ("glass", "illum 7\nNi 1.5")])
+
+light_in_glass("hard")

@@ -132,3 +132,48 @@ fn a_zero_area_emitter_triangle_changes_nothing() {
         assert_eq!(a, b, "{engine:?}: the zero-area triangle changed the image");
     }
 }
+
+/// Case 2: a point light (I = 1 W/sr) at the centre of a glass sphere in a closed room. Rays leave
+/// the sphere along radii, unbent, so direct light is exactly 0 everywhere (shadow rays meet the
+/// glass) and the caustic map carries it all: irradiance I·cos θ/D² on the walls. Over a disk of
+/// radius r centred on a wall at distance 1 that averages (2/r²)·(1 − 1/√(1 + r²)) = 0.7917 for
+/// r = 0.6. The box-kernel estimate counts photons of equal power (Fresnel choices are sampled,
+/// not weighted), so its relative standard deviation is 1/√count (≈ 1 % here); the tolerance is
+/// 3 of them plus 1 % for the tessellated sphere's shading normals bending rays slightly.
+#[test]
+fn light_inside_glass_reaches_the_walls_only_as_caustics() {
+    use photonwave::kernels::KernelSet;
+    use photonwave::photon_map::{Filter, Lookup, Reflectance};
+    use photonwave::settings::Kernel;
+    let loaded = hard("light-in-glass.toml");
+    let scene = Arc::new(loaded.scene);
+    let rays = loaded.camera.unwrap().prepare(16, 16).unwrap();
+    let s = Settings {
+        width: 16,
+        height: 16,
+        spp: 1,
+        photons: 5_000,
+        caustic_photons: 150_000,
+        gather_rays: 4,
+        ..Default::default()
+    };
+    for engine in ENGINES {
+        let film = render(&scene, &rays, &s, engine, None, &NoProgress).unwrap().0;
+        assert!(film.pixels.iter().all(|t| t.direct == Vec3::ZERO), "{engine:?}: direct light through glass");
+        assert!(film.pixels.iter().filter(|t| t.caustic.min_element() > 0.0).count() > 200, "{engine:?}");
+    }
+    let r = 0.6f32;
+    let expected = 2.0 / (r * r) * (1.0 - 1.0 / (1.0 + r * r).sqrt());
+    let (reference, _, _) = photonwave::reference::build_maps(&scene, &s);
+    let (wavefront, _) = photonwave::wavefront::build_maps(scene.clone(), &s).unwrap();
+    for (name, map) in [("reference", &reference.caustic), ("wavefront", &wavefront.caustic)] {
+        for (wall, p, n) in [("back", -Vec3::Z, Vec3::Z), ("floor", -Vec3::Y, Vec3::Y)] {
+            let q = Lookup { p, k: 0, r_max: r, kernel: Kernel::Box, filter: Filter { n, flags_mask: 0 } };
+            let e = map.estimate_radius(KernelSet::Simd, &q, Reflectance::Constant(Vec3::ONE));
+            let ratio = e.radiance / expected;
+            let tol = 3.0 / (e.count as f32).sqrt() + 0.01;
+            println!("{name}, {wall}: caustic irradiance / I·cos θ/D² = {ratio} from {} photons (± {tol})", e.count);
+            assert!((ratio - Vec3::ONE).abs().max_element() < tol, "{name}, {wall}: {ratio} ({} photons)", e.count);
+        }
+    }
+}
