@@ -19,14 +19,16 @@ def cross(a, b): return (a[1]*b[2]-a[2]*b[1], a[2]*b[0]-a[0]*b[2], a[0]*b[1]-a[1
 def dot(a, b): return sum(a[i]*b[i] for i in range(3))
 
 class Obj:
-    def __init__(self, mtl):
+    def __init__(self, mtl, convert=conv):
+        """`convert` maps quad corners to metres (the Cornell conversion unless told otherwise)."""
         self.lines = [f"# photonwave bundled scene, written by scenes/generate.py", f"mtllib {mtl}"]
         self.nv = 0
         self.nn = 0
+        self.convert = convert
 
     def quad(self, name, material, pts, facing):
         """A planar polygon whose normal is turned toward `facing` (a direction)."""
-        pts = [conv(p) for p in pts]
+        pts = [self.convert(p) for p in pts]
         n = cross(sub(pts[1], pts[0]), sub(pts[2], pts[0]))
         if dot(n, facing) < 0:
             pts = pts[::-1]
@@ -133,18 +135,9 @@ mtl("furnace.mtl", [("furnace", "illum 1\nKd 0.5 0.5 0.5\nKe 1 1 1")])
 
 # ---- hard cases (scenes/hard/): geometry in metres, no Cornell conversion -------------------
 
-class RawObj(Obj):
-    """An Obj whose points are written as given (no Cornell-box conversion)."""
-    def quad(self, name, material, pts, facing):
-        n = cross(sub(pts[1], pts[0]), sub(pts[2], pts[0]))
-        if dot(n, facing) < 0:
-            pts = pts[::-1]
-        self.lines.append(f"o {name}")
-        self.lines.append(f"usemtl {material}")
-        for p in pts:
-            self.lines.append("v %.6f %.6f %.6f" % p)
-        self.lines.append("f " + " ".join(str(self.nv + 1 + i) for i in range(len(pts))))
-        self.nv += len(pts)
+def RawObj(mtl):
+    """An Obj whose points are written as given, in metres (no Cornell-box conversion)."""
+    return Obj(mtl, convert=lambda p: tuple(float(c) for c in p))
 
 def thin_wall(path):
     """A closed 2 x 1 x 1 room (x in [-1, 1], y in [0, 1], z in [-0.5, 0.5]) split at x = 0 by one
