@@ -168,6 +168,8 @@ fn intersect8(p: &Packet, lanes: u32, v: [Vec3; 3], t_max: f32x8) -> (u32, u32, 
     let neg = e0.simd_lt(zero) | e1.simd_lt(zero) | e2.simd_lt(zero);
     let pos = e0.simd_gt(zero) | e1.simd_gt(zero) | e2.simd_gt(zero);
     let det = e0 + e1 + e2;
+    // The shear's error is in length units: it takes z before the scaling to ray parameters.
+    let max_z_len = z0.abs().max(z1.abs()).max(z2.abs());
     let (z0, z1, z2) = (z0 * p.sz, z1 * p.sz, z2 * p.sz);
     let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
     let bound = t_max * det;
@@ -180,8 +182,8 @@ fn intersect8(p: &Packet, lanes: u32, v: [Vec3; 3], t_max: f32x8) -> (u32, u32, 
     let delta_z = f32x8::splat(gamma(3)) * max_zt;
     let max_xt = x0.abs().max(x1.abs()).max(x2.abs());
     let max_yt = y0.abs().max(y1.abs()).max(y2.abs());
-    let delta_x = f32x8::splat(gamma(5)) * (max_xt + max_zt);
-    let delta_y = f32x8::splat(gamma(5)) * (max_yt + max_zt);
+    let delta_x = f32x8::splat(gamma(5)) * (max_xt + max_z_len);
+    let delta_y = f32x8::splat(gamma(5)) * (max_yt + max_z_len);
     let delta_e = f32x8::splat(2.0) * (f32x8::splat(gamma(2)) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
     let max_e = e0.abs().max(e1.abs()).max(e2.abs());
     let delta_t = f32x8::splat(3.0)

@@ -95,6 +95,11 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
     if det == 0.0 || !det.is_finite() {
         return None;
     }
+    // The shear's error (below) is in length units: it takes z before the scaling to ray
+    // parameters. pbrt-v4 uses the scaled z there, which is the same only for |d| ≈ 1; a shadow
+    // ray aimed at a light point (|d| = the distance) in a scene 1e-4 units across then rejects
+    // true hits as "not provably positive" and light leaks through closed objects.
+    let max_z_len = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
     p0t.z *= sz;
     p1t.z *= sz;
     p2t.z *= sz;
@@ -117,8 +122,8 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
     let delta_z = gamma(3) * max_zt;
     let max_xt = p0t.x.abs().max(p1t.x.abs()).max(p2t.x.abs());
     let max_yt = p0t.y.abs().max(p1t.y.abs()).max(p2t.y.abs());
-    let delta_x = gamma(5) * (max_xt + max_zt);
-    let delta_y = gamma(5) * (max_yt + max_zt);
+    let delta_x = gamma(5) * (max_xt + max_z_len);
+    let delta_y = gamma(5) * (max_yt + max_z_len);
     let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
     let max_e = e0.abs().max(e1.abs()).max(e2.abs());
     let delta_t = 3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
@@ -131,6 +136,22 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A shadow ray's direction is the vector to the light point, so its length is a distance in
+    /// scene units, and t runs over [0, 1]. A triangle 10⁻³ of that distance across must be hit
+    /// at every scale; when the positivity bound mixed t with lengths, it was lost at 1e-4.
+    #[test]
+    fn unnormalised_rays_hit_small_triangles_at_any_scale() {
+        for s in [1e-4f32, 1.0, 1e5] {
+            let a = 1e-3 * s;
+            let (p0, p1, p2) = (Vec3::new(-a, -a, 0.5 * s), Vec3::new(a, -a, 0.5 * s), Vec3::new(0.0, a, 0.5 * s));
+            for d in [Vec3::new(0.0, 0.0, s), Vec3::Z, Vec3::new(1e-4 * s, 2e-4 * s, s)] {
+                let h = intersect_triangle(Vec3::ZERO, d, f32::INFINITY, p0, p1, p2);
+                let want = 0.5 * s / d.z;
+                assert!(h.is_some_and(|h| (h.t - want).abs() <= 1e-6 * want), "scale {s}, d {d}: {h:?}");
+            }
+        }
+    }
 
     #[test]
     fn hits_centre_and_misses_outside() {
