@@ -251,3 +251,28 @@ def light_in_glass(folder):
     mtl(f"{folder}/light-in-glass.mtl", [("white", "illum 1\nKd 0.5 0.5 0.5"), ("glass", "illum 7\nNi 1.5")])
 
 light_in_glass("hard")
+
+def scaled_cornell(folder):
+    """The mirror-and-glass Cornell box (../cornell-spheres.obj) scaled by 1e-4, 1 and 1e5, camera
+    scaled with it. Radiance does not change under a uniform scale (the light's radiance is fixed),
+    so the three images must agree within noise."""
+    for label, s in (("1e-4", 1e-4), ("1", 1.0), ("1e5", 1e5)):
+        with open(f"{folder}/scale-{label}.toml", "w") as f:
+            f.write(f"""# Scale, written by scenes/generate.py: the Cornell box with a mirror and a glass sphere,
+# scaled by {label} (camera too). Ray offsets and search radii are relative to the scene's size, so the
+# image must equal scale-1's within noise: no acne, no black rows, no lost caustic.
+[[mesh]]
+file = "../cornell-spheres.obj"
+scale = {s:.6g}
+
+[camera]
+eye = [0.0, {0.273 * s:.6g}, {1.0796 * s:.6g}]
+target = [0.0, {0.273 * s:.6g}, 0.0]
+fov = 39.3
+
+[render]
+width = 32
+height = 32
+""")
+
+scaled_cornell("hard")

@@ -287,6 +287,16 @@ impl Progress for Bars {
     }
 }
 
+/// `x` with three decimals, or in scientific notation outside [10⁻³, 10⁵) (scenes modelled
+/// in micrometres or kilometres have light powers of any size).
+fn significant(x: f32) -> String {
+    if x == 0.0 || (1e-3..1e5).contains(&x.abs()) {
+        format!("{x:.3}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
 fn render(args: RenderArgs) -> Result<()> {
     let t0 = Instant::now();
     let loaded = load_scene(&args.scene)?;
@@ -327,12 +337,12 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let plan = Effects::plan(&scene, &settings);
     eprintln!(
-        "scene: {} triangles, {} materials, {} lights ({} emissive triangles), total power {:.3} W",
+        "scene: {} triangles, {} materials, {} lights ({} emissive triangles), total power {} W",
         scene.triangle_count(),
         scene.materials.len(),
         scene.lights.len(),
         scene.area_lights.len(),
-        scene.total_power().element_sum() / 3.0
+        significant(scene.total_power().element_sum() / 3.0)
     );
     eprint!("{}", plan.describe());
     let quiet = args.quiet || !std::io::IsTerminal::is_terminal(&std::io::stderr());
