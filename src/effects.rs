@@ -78,7 +78,14 @@ impl Effects {
             Part::new(false, "no glass in the scene")
         };
         let shadow_rays = if diffuse {
-            Part::new(true, format!("{} lights can light diffuse surfaces", scene.lights.len()))
+            Part::new(
+                true,
+                format!(
+                    "{} light{} can light diffuse surfaces",
+                    scene.lights.len(),
+                    if scene.lights.len() == 1 { "" } else { "s" }
+                ),
+            )
         } else if forced("shadow_rays") {
             Part::new(true, "forced on by the `force` setting")
         } else {

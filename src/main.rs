@@ -297,8 +297,23 @@ fn significant(x: f32) -> String {
     }
 }
 
+/// Refuses an output path whose extension names another format than the one written there.
+fn check_extension(flag: &str, path: &std::path::Path, ext: &str, hint: &str) -> Result<()> {
+    match path.extension().and_then(|e| e.to_str()) {
+        Some(e) if e.eq_ignore_ascii_case(ext) => Ok(()),
+        _ => Err(Error::setting(
+            flag,
+            format!("writes {ext} only, so {} must end in .{}{hint}", path.display(), ext.to_lowercase()),
+        )),
+    }
+}
+
 fn render(args: RenderArgs) -> Result<()> {
     let t0 = Instant::now();
+    check_extension("--output", &args.output, "EXR", " (for a PNG preview add --png FILE.png)")?;
+    if let Some(p) = &args.png {
+        check_extension("--png", p, "PNG", "")?;
+    }
     let loaded = load_scene(&args.scene)?;
     let scene = std::sync::Arc::new(loaded.scene);
     let mut settings = loaded.settings;
@@ -337,7 +352,7 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let plan = Effects::plan(&scene, &settings);
     eprintln!(
-        "scene: {} triangles, {} materials, {} lights ({} emissive triangles), total power {} W",
+        "scene: {} triangles, {} materials, lights: {} ({} emissive triangles), total power {} W",
         scene.triangle_count(),
         scene.materials.len(),
         scene.lights.len(),

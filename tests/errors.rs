@@ -147,6 +147,10 @@ fn the_cli_reports_errors_with_a_nonzero_exit() {
     assert!(code != 0 && e.contains("camera.target"), "{e}");
     let (code, e) = cli(&["render", scene, "--k", "1", "-o", out]);
     assert!(code != 0 && e.contains("`k`"), "{e}");
+    let (code, e) = cli(&["render", scene, "-o", "x.png"]);
+    assert!(code != 0 && e.contains("--output") && e.contains("x.png") && e.contains("--png"), "{e}");
+    let (code, e) = cli(&["render", scene, "-o", out, "--png", "x.exr"]);
+    assert!(code != 0 && e.contains("--png") && e.contains("x.exr"), "{e}");
     let (code, e) = cli(&["render", scene, "--width", "4", "--height", "4", "--spp", "1", "-o", "/no/such/dir/x.exr"]);
     assert!(code != 0 && e.contains("/no/such/dir/x.exr"), "{e}");
 }
