@@ -381,6 +381,15 @@ fn render(args: RenderArgs) -> Result<()> {
     if let Some(w) = stats.progressive.as_ref().and_then(photonwave::progressive::budget_warning) {
         eprintln!("warning: {w}");
     }
+    if stats.progressive.is_none() {
+        let short = [
+            stats.global_map.shortfall("global", settings.photons.into()),
+            stats.caustic_map.shortfall("caustic", settings.caustic_photons.into()),
+        ];
+        for w in short.into_iter().flatten() {
+            eprintln!("warning: {w}");
+        }
+    }
     stats.scene = args.scene.display().to_string();
     stats.times.load_s = load_s;
     stats.times.total_s += load_s;

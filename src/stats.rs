@@ -45,6 +45,26 @@ pub struct MapStats {
     pub stored: u64,
 }
 
+impl MapStats {
+    /// A warning when the map holds fewer photons than `asked` because its photon pass hit the
+    /// cap of [`MAX_PATHS_PER_PHOTON`](crate::reference::photons::MAX_PATHS_PER_PHOTON) paths per
+    /// photon asked: few light paths reach the surfaces it stores on, and its estimates are
+    /// sparse (or, when it is empty, zero).
+    #[must_use]
+    pub fn shortfall(&self, name: &str, asked: u64) -> Option<String> {
+        (self.built && self.stored < asked).then(|| {
+            format!(
+                "{name} map: {} of {asked} photons stored from {} paths, the cap of {} per photon asked — \
+                 few light paths reach the surfaces it stores on{}",
+                self.stored,
+                self.emitted,
+                crate::reference::photons::MAX_PATHS_PER_PHOTON,
+                if self.stored == 0 { "; it is empty and adds nothing" } else { "" }
+            )
+        })
+    }
+}
+
 /// Wall time per phase, seconds.
 #[derive(Clone, Debug, Default, Serialize, PartialEq)]
 pub struct PhaseTimes {

@@ -216,3 +216,17 @@ fn the_bench_command_checks_its_input_and_prints_one_json_object() {
         assert!(row["photons"].as_u64().unwrap() > 0 && row["ratio"].as_f64().unwrap() > 0.0, "{row}");
     }
 }
+
+/// A map that the photon-path cap leaves short of its count is reported: here no photon can
+/// reach the only diffuse surface (scenes/hard/tir-slab.toml), so both maps stay empty.
+#[test]
+fn the_cli_warns_when_a_map_falls_short() {
+    let d = scratch_dir("cli-short");
+    let scene = bundled("hard/tir-slab.toml");
+    let out = d.join("o.exr");
+    let args = ["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--spp", "1", "--width", "8"];
+    let (code, e) = cli(&[&args[..], &["--height", "8", "--photons", "50", "--caustic-photons", "50"]].concat());
+    assert_eq!(code, 0, "{e}");
+    assert!(e.contains("warning: global map: 0 of 50 photons stored") && e.contains("it is empty"), "{e}");
+    assert!(e.contains("warning: caustic map: 0 of 50 photons stored"), "{e}");
+}
