@@ -74,6 +74,21 @@ class Obj:
                         t = t[::-1]
                     self.lines.append("f " + " ".join(f"{base_v + i}//{base_n + i}" for i in t))
 
+    def box(self, name, material, lo, hi):
+        """An axis-aligned box, six quads facing outward."""
+        c = tuple((lo[i] + hi[i]) / 2 for i in range(3))
+        for axis in range(3):
+            for side, v in (("lo", lo[axis]), ("hi", hi[axis])):
+                u, w = (axis + 1) % 3, (axis + 2) % 3
+                pts = []
+                for a, b in ((lo[u], lo[w]), (hi[u], lo[w]), (hi[u], hi[w]), (lo[u], hi[w])):
+                    p = [0.0, 0.0, 0.0]
+                    p[axis], p[u], p[w] = v, a, b
+                    pts.append(tuple(p))
+                facing = [0.0, 0.0, 0.0]
+                facing[axis] = v - c[axis]
+                self.quad(f"{name}_{'xyz'[axis]}{side}", material, pts, tuple(facing))
+
     def write(self, path):
         with open(path, "w") as f:
             f.write("\n".join(self.lines) + "\n")
@@ -276,3 +291,118 @@ height = 32
 """)
 
 scaled_cornell("hard")
+
+def ball_lens(folder):
+    """A glass ball (n = 1.5, radius 1) at the origin; a black plate at z = 1.2 with a 0.2 x 0.2
+    hole on the axis, so the directional light (down -z) reaches the ball as a narrow collimated
+    beam; behind the ball, a white screen in the plane y = 0 along the axis (z from -1.02 to -2.2).
+    Paraxial rays cross the axis at n R / (2 (n - 1)) = 1.5 from the centre, and every ray of the
+    beam meets the screen where it crosses the plane y = 0: at the focus."""
+    o = RawObj("ball-lens.mtl")
+    o.sphere("ball", "glass", (0.0, 0.0, 0.0), 1.0, seg=192, rings=96)
+    a, e, z = 0.1, 1.3, 1.2
+    for name, (x0, x1, y0, y1) in [("top", (-e, e, a, e)), ("bottom", (-e, e, -e, -a)),
+                                   ("left", (-e, -a, -a, a)), ("right", (a, e, -a, a))]:
+        o.quad(f"plate_{name}", "black", [(x0, y0, z), (x1, y0, z), (x1, y1, z), (x0, y1, z)], (0, 0, 1))
+    o.quad("screen", "white", [(-0.3, 0, -1.02), (0.3, 0, -1.02), (0.3, 0, -2.2), (-0.3, 0, -2.2)], (0, 1, 0))
+    o.write(f"{folder}/ball-lens.obj")
+    mtl(f"{folder}/ball-lens.mtl", [("glass", "illum 7\nNi 1.5"), ("black", "illum 1\nKd 0 0 0"),
+                                    ("white", "illum 1\nKd 0.5 0.5 0.5")])
+    with open(f"{folder}/ball-lens.toml", "w") as f:
+        f.write("""# Ball lens, written by scenes/generate.py: a collimated beam (a directional light through a
+# 0.2 x 0.2 hole in a black plate) through a glass ball (n = 1.5, R = 1) focuses on the axis at
+# n R / (2 (n - 1)) = 1.5 from the centre (paraxial), where it meets the screen lying along the axis.
+[[mesh]]
+file = "ball-lens.obj"
+
+[camera]
+eye = [1.2, 0.8, -1.6]
+target = [0.0, 0.0, -1.6]
+fov = 50
+
+[[light]]
+type = "directional"
+direction = [0.0, 0.0, -1.0]
+irradiance = [1, 1, 1]
+
+[render]
+width = 32
+height = 32
+""")
+
+ball_lens("hard")
+
+def total_internal_reflection(folder):
+    """Two scenes of total internal reflection (n = 1.5, critical angle 41.8 degrees).
+
+    light-pipe: a glass rod (0.5 x 0.5 x 2.5, z from 1 to -1.5) fed at its top end by a narrow spot
+    (2 degrees) 30 degrees off the axis; inside, the beam meets the side faces at 70.5 degrees and
+    is reflected whole; a white screen at z = -2 catches what leaves the far end.
+
+    tir-slab: a spot inside a glass slab (4 x 0.2 x 1) aimed at its top face 50 degrees from the
+    normal, past the critical angle; a white screen 0.01 above the top face must receive nothing."""
+    o = RawObj("light-pipe.mtl")
+    o.box("rod", "glass", (-0.25, -0.25, -1.5), (0.25, 0.25, 1.0))
+    o.quad("screen", "white", [(-1, -1, -2), (1, -1, -2), (1, 1, -2), (-1, 1, -2)], (0, 0, 1))
+    o.write(f"{folder}/light-pipe.obj")
+    materials = [("glass", "illum 7\nNi 1.5"), ("white", "illum 1\nKd 0.5 0.5 0.5")]
+    mtl(f"{folder}/light-pipe.mtl", materials)
+    t = math.radians(30)
+    with open(f"{folder}/light-pipe.toml", "w") as f:
+        f.write(f"""# Light pipe, written by scenes/generate.py: a spot 30 degrees off the axis of a glass rod
+# (n = 1.5) lights its near end; inside, the beam meets the side faces at 70.5 degrees, past the
+# critical angle (41.8), and is reflected whole. Flux out of the far end = flux in x T(30)^2 / (1 - R(30)^2).
+[[mesh]]
+file = "light-pipe.obj"
+
+[camera]
+eye = [1.6, 0.9, -0.2]
+target = [0.0, 0.0, -1.9]
+fov = 50
+
+[[light]]
+type = "spot"
+position = [0.0, {0.5 * math.sin(t):.9f}, {1.0 + 0.5 * math.cos(t):.9f}]
+target = [0.0, 0.0, 1.0]
+intensity = [100, 100, 100]
+angle = 2
+
+[render]
+width = 32
+height = 32
+""")
+    o = RawObj("tir-slab.mtl")
+    o.box("slab", "glass", (-2, 0, -0.5), (2, 0.2, 0.5))
+    o.quad("screen", "white", [(-1.9, 0.21, -0.5), (1.9, 0.21, -0.5), (1.9, 0.21, 0.5), (-1.9, 0.21, 0.5)], (0, -1, 0))
+    o.write(f"{folder}/tir-slab.obj")
+    mtl(f"{folder}/tir-slab.mtl", materials)
+    t = math.radians(50)
+    with open(f"{folder}/tir-slab.toml", "w") as f:
+        f.write(f"""# Total internal reflection, written by scenes/generate.py: a spot inside a glass slab (n = 1.5)
+# aimed at the top face 50 degrees from its normal, past the critical angle (41.8): all of it is
+# reflected, and the screen just above the slab receives nothing.
+[[mesh]]
+file = "tir-slab.obj"
+
+[camera]
+eye = [0.0, 1.5, 2.5]
+target = [0.0, 0.1, 0.0]
+fov = 50
+
+[[light]]
+type = "spot"
+position = [0.0, 0.1, 0.0]
+target = [{math.sin(t):.9f}, {0.1 + math.cos(t):.9f}, 0.0]
+intensity = [100, 100, 100]
+angle = 2
+
+[render]
+width = 32
+height = 32
+# No photon can reach a diffuse surface here, so each photon pass ends at its cap of 256 paths
+# per photon asked: small maps keep that short.
+photons = 1000
+caustic_photons = 1000
+""")
+
+total_internal_reflection("hard")
