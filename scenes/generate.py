@@ -406,3 +406,37 @@ caustic_photons = 1000
 """)
 
 total_internal_reflection("hard")
+
+def furnace_materials(folder):
+    """The white furnace (a closed sphere of radius 1 whose inside emits Le = 1 and reflects 0.5)
+    holding one sphere of each material: white Lambert (Kd 1), perfect mirror (Ks 1), glass (n = 1.5)
+    and glossy (Kd 0.3 + Phong Ks 0.7, Ns 30). Radiance is Le / (1 - 0.5) = 2 wherever every surface
+    is lossless; the glossy lobe loses what it sends below the horizon, so nothing may exceed 2."""
+    o = RawObj("furnace-materials.mtl")
+    o.sphere("enclosure", "furnace", (0, 0, 0), 1.0, inward=True, seg=32, rings=16)
+    for name, c in [("white", (-0.3, 0.2, -0.35)), ("mirror", (0.3, 0.2, -0.35)),
+                    ("glass", (-0.3, -0.2, -0.35)), ("glossy", (0.3, -0.2, -0.35))]:
+        o.sphere(name, name, c, 0.17, seg=48, rings=24)
+    o.write(f"{folder}/furnace-materials.obj")
+    mtl(f"{folder}/furnace-materials.mtl", [
+        ("furnace", "illum 1\nKd 0.5 0.5 0.5\nKe 1 1 1"), ("white", "illum 1\nKd 1 1 1"),
+        ("mirror", "illum 3\nKs 1 1 1"), ("glass", "illum 7\nNi 1.5"),
+        ("glossy", "illum 2\nKd 0.3 0.3 0.3\nKs 0.7 0.7 0.7\nNs 30")])
+    with open(f"{folder}/furnace-materials.toml", "w") as f:
+        f.write("""# Energy, written by scenes/generate.py: the white furnace (inside a closed sphere that emits
+# Le = 1 and reflects 0.5) holding a white Lambertian, a mirror, a glass and a glossy sphere.
+# Radiance is 2 wherever every surface is lossless; no surface may return more than it receives.
+[[mesh]]
+file = "furnace-materials.obj"
+
+[camera]
+eye = [0.0, 0.0, 0.6]
+target = [0.0, 0.0, -0.35]
+fov = 60
+
+[render]
+width = 32
+height = 32
+""")
+
+furnace_materials("hard")

@@ -349,3 +349,80 @@ fn total_internal_reflection_lets_nothing_out() {
         }
     }
 }
+
+/// Case 12: the white furnace (a closed sphere emitting Le = 1, reflecting 0.5) holding a white
+/// Lambertian, a mirror, a glass and a glossy sphere. Where every surface is lossless radiance is
+/// Le/(1 − 0.5) = 2 (less the depth cut: 1 − 2⁻¹¹ at max_depth 10); the glossy lobe loses what it
+/// sends below the horizon, so it and what sees it are darker — and nothing may be brighter.
+/// Per object (pixels whose 3 × 3 neighbourhood sees only it), on both photon-mapping engines and
+/// the path tracer: the mean must not exceed 2 by more than 4 standard errors + 0.5 % (the
+/// photon maps' correlated noise), and the two engines must agree with the path tracer within
+/// 4 standard errors of the difference + 1.5 %.
+#[test]
+fn a_furnace_of_every_material_never_gains_energy() {
+    let loaded = hard("furnace-materials.toml");
+    let scene = Arc::new(loaded.scene);
+    let (w, h) = (32usize, 32usize);
+    let rays = loaded.camera.unwrap().prepare(w as u32, h as u32).unwrap();
+    // Which object each pixel's centre sees.
+    let seen: Vec<Option<u32>> = (0..w * h)
+        .map(|i| {
+            let (o, d) = rays.ray((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
+            scene.intersect(o, d, f32::INFINITY).map(|hit| scene.surface(&hit).material)
+        })
+        .collect();
+    let interior = |i: usize| {
+        let (x, y) = ((i % w) as i64, (i / w) as i64);
+        (-1..=1).all(|dy| {
+            (-1..=1).all(|dx| {
+                let (u, v) = (x + dx, y + dy);
+                (0..w as i64).contains(&u) && (0..h as i64).contains(&v) && seen[(v * w as i64 + u) as usize] == seen[i]
+            })
+        })
+    };
+    let s = Settings {
+        width: 32,
+        height: 32,
+        spp: 32,
+        photons: 40_000,
+        caustic_photons: 40_000,
+        gather_rays: 16,
+        ..Default::default()
+    };
+    let path = photonwave::reference::path::render_path_traced(
+        &scene,
+        &rays,
+        &Settings { spp: 512, ..s.clone() },
+        &NoProgress,
+    )
+    .0;
+    let regions = |film: &photonwave::film::Film| -> Vec<(String, f64, f64)> {
+        let grey = common::grey(film);
+        scene
+            .materials
+            .iter()
+            .enumerate()
+            .map(|(m, mat)| {
+                let v: Vec<f32> =
+                    (0..w * h).filter(|&i| seen[i] == Some(m as u32) && interior(i)).map(|i| grey[i]).collect();
+                assert!(v.len() >= 9, "{}: {} pixels", mat.name, v.len());
+                let (mean, se) = common::mean_and_se(&v);
+                (mat.name.clone(), mean, se)
+            })
+            .collect()
+    };
+    let truth = regions(&path);
+    for (name, mean, se) in &truth {
+        println!("path tracer, {name}: {mean:.4} ± {se:.4}");
+        assert!(*mean <= 2.0 + 4.0 * se + 0.01, "path tracer, {name}: {mean} > 2");
+    }
+    for engine in ENGINES {
+        let film = render(&scene, &rays, &s, engine, None, &NoProgress).unwrap().0;
+        for ((name, mean, se), (_, want, want_se)) in regions(&film).into_iter().zip(&truth) {
+            println!("{engine:?}, {name}: {mean:.4} ± {se:.4} (path tracer {want:.4})");
+            assert!(mean <= 2.0 + 4.0 * se + 0.01, "{engine:?}, {name}: {mean} > 2");
+            let tol = 4.0 * (se * se + want_se * want_se).sqrt() + 0.015 * want;
+            assert!((mean - want).abs() <= tol, "{engine:?}, {name}: {mean} against the path tracer's {want} ± {tol}");
+        }
+    }
+}
