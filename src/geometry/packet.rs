@@ -141,8 +141,9 @@ fn bits(m: f32x8) -> u32 {
 /// The watertight ray/triangle test of [`intersect_triangle`] for 8 rays against one triangle:
 /// the same operations in the same order (no fused multiply-adds on either side), so every lane's
 /// decision, t and barycentrics are bit-identical to the scalar test. Returns (hit lanes,
-/// lanes to decide with the scalar test, t, b0, b1, b2). The scalar test recomputes edge
-/// functions that round to exactly zero in f64; lanes where that happens are handed back.
+/// lanes to decide with the scalar test, t, b0, b1, b2). The scalar test recomputes in f64 edge
+/// functions that round to exactly zero and the sign of a t that f32 cannot prove positive;
+/// lanes where either happens are handed back.
 #[inline(always)]
 #[allow(clippy::many_single_char_names)]
 fn intersect8(p: &Packet, lanes: u32, v: [Vec3; 3], t_max: f32x8) -> (u32, u32, f32x8, [f32x8; 3]) {
@@ -189,13 +190,11 @@ fn intersect8(p: &Packet, lanes: u32, v: [Vec3; 3], t_max: f32x8) -> (u32, u32, 
     let delta_t = f32x8::splat(3.0)
         * (f32x8::splat(gamma(3)) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
         * inv_det.abs();
-    let ok = !(neg & pos)
-        & det.simd_ne(zero)
-        & det.is_finite()
-        & !det_neg
-        & !det_pos
-        & t.simd_lt(t_max)
-        & t.simd_gt(delta_t);
+    let inside = !(neg & pos) & det.simd_ne(zero) & det.is_finite() & !det_neg & !det_pos & t.simd_lt(t_max);
+    let ok = inside & t.simd_gt(delta_t);
+    // Where f32 cannot prove t > 0 (slivers), the scalar test decides in f64.
+    let undecided = inside & t.simd_gt(zero) & !t.simd_gt(delta_t);
+    let fallback = fallback | (bits(undecided) & lanes);
     let hit = bits(ok) & lanes & !fallback;
     (hit, fallback, t, [e0 * inv_det, e1 * inv_det, e2 * inv_det])
 }
