@@ -440,3 +440,66 @@ height = 32
 """)
 
 furnace_materials("hard")
+
+def watertight(folder):
+    """A closed cube [-1, 1]^3 facing inward, every face a grid over the coordinates
+    -1, -0.5, -1e-6, 0, 0.5, 1 (so a strip of sliver triangles 1e-6 wide runs along 0, and the
+    grid lines lie on the planes where a ray's direction components are zero), split into
+    triangles; plus, per face, a zero-area triangle along a grid line. The faces share every edge
+    and vertex (no T-junctions): rays from inside must never get out."""
+    o = RawObj("watertight.mtl")
+    g = [-1.0, -0.5, -1e-6, 0.0, 0.5, 1.0]
+    o.lines.append("o cube")
+    o.lines.append("usemtl white")
+    index = {}
+    def vertex(p):
+        if p not in index:
+            o.lines.append("v %r %r %r" % p)
+            o.nv += 1
+            index[p] = o.nv
+        return index[p]
+    faces = []
+    for axis in range(3):
+        for side in (-1.0, 1.0):
+            u, w = (axis + 1) % 3, (axis + 2) % 3
+            def at(a, b):
+                p = [0.0, 0.0, 0.0]
+                p[axis], p[u], p[w] = side, a, b
+                return tuple(p)
+            for i in range(len(g) - 1):
+                for j in range(len(g) - 1):
+                    q = [at(g[i], g[j]), at(g[i + 1], g[j]), at(g[i + 1], g[j + 1]), at(g[i], g[j + 1])]
+                    # Wind so the normal points into the cube (toward -side along axis).
+                    n = cross(sub(q[1], q[0]), sub(q[2], q[0]))
+                    if n[axis] * side > 0:
+                        q = q[::-1]
+                    faces += [(q[0], q[1], q[2]), (q[0], q[2], q[3])]
+            faces.append((at(g[0], g[3]), at(g[1], g[3]), at(g[4], g[3])))  # zero area: collinear
+    for f in faces:
+        o.lines.append("f " + " ".join(str(vertex(p)) for p in f))
+    o.write(f"{folder}/watertight.obj")
+    mtl(f"{folder}/watertight.mtl", [("white", "illum 1\nKd 0.5 0.5 0.5")])
+    with open(f"{folder}/watertight.toml", "w") as f:
+        f.write("""# Watertight mesh, written by scenes/generate.py: a closed cube of grid-triangulated faces with
+# a strip of 1e-6-wide sliver triangles and a zero-area triangle per face, lit from inside by a
+# point light. Rays at its shared edges and vertices never slip out, packet and scalar traversal
+# agree, and every photon lands inside.
+[[mesh]]
+file = "watertight.obj"
+
+[camera]
+eye = [0.6, 0.5, 0.7]
+target = [-1.0, -1.0, -1.0]
+fov = 70
+
+[[light]]
+type = "point"
+position = [0.1, 0.2, 0.05]
+intensity = [1, 1, 1]
+
+[render]
+width = 32
+height = 32
+""")
+
+watertight("hard")

@@ -426,3 +426,30 @@ fn a_furnace_of_every_material_never_gains_energy() {
         }
     }
 }
+
+/// Case 9 (the ray-level half is in tests/packet.rs): a point light inside the closed cube of
+/// grid-triangulated faces with sliver strips and zero-area triangles. Every photon path lands
+/// inside, so the first-hit photons of both engines' global maps carry the light's whole power
+/// (each Φ/N; only the dithered power packing, 2⁻⁸/√N relative, separates the sum from Φ), and
+/// both engines' images are finite and lit.
+#[test]
+fn no_photon_leaves_a_watertight_mesh() {
+    use photonwave::photon_map::flags;
+    let loaded = hard("watertight.toml");
+    let scene = Arc::new(loaded.scene);
+    let s = Settings { width: 16, height: 16, spp: 2, photons: 50_000, gather_rays: 4, ..Default::default() };
+    let phi = scene.total_power();
+    for (name, maps) in both_maps(&scene, &s) {
+        let map = &maps.global;
+        let first: Vec<usize> = (0..map.len()).filter(|&i| map.photon(i).flags & flags::DIRECT != 0).collect();
+        let sum: Vec3 = first.iter().map(|&i| map.power(i)).sum();
+        let tol = 5.0 * 2f32.powi(-8) / (first.len() as f32).sqrt();
+        println!("{name}: first-hit power / Φ = {} from {} paths (± {tol})", sum / phi, first.len());
+        assert!((sum / phi - Vec3::ONE).abs().max_element() < tol, "{name}: {} of the light's power landed", sum / phi);
+    }
+    let rays = loaded.camera.unwrap().prepare(16, 16).unwrap();
+    for engine in ENGINES {
+        let film = render(&scene, &rays, &s, engine, None, &NoProgress).unwrap().0;
+        assert!(film.pixels.iter().all(|t| t.is_finite() && t.beauty().min_element() > 0.0), "{engine:?}");
+    }
+}
