@@ -179,7 +179,8 @@ fn intersect8(p: &Packet, lanes: u32, v: [Vec3; 3], t_max: f32x8) -> (u32, u32, 
     let inv_det = f32x8::ONE / det;
     let t = t_scaled * inv_det;
     // pbrt-v4's bound on t's error; t must exceed it.
-    let max_zt = z0.abs().max(z1.abs()).max(z2.abs());
+    // Rounding is monotonic, so this is the largest scaled |z| exactly, as the scalar test has it.
+    let max_zt = max_z_len * p.sz.abs();
     let delta_z = f32x8::splat(gamma(3)) * max_zt;
     let max_xt = x0.abs().max(x1.abs()).max(x2.abs());
     let max_yt = y0.abs().max(y1.abs()).max(y2.abs());

@@ -54,17 +54,38 @@ pub fn is_degenerate(p0: Vec3, p1: Vec3, p2: Vec3) -> bool {
 
 /// Intersects the ray `o + t·d`, 0 < t < `t_max`, with the triangle (p0, p1, p2).
 /// Degenerate (zero-area) triangles and rays with a zero or non-finite direction never hit.
+#[inline]
 #[must_use]
 pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<TriangleHit> {
+    match intersect_f32(o, d, t_max, p0, p1, p2) {
+        F32Test::Hit(h) => Some(h),
+        F32Test::Miss => None,
+        // The f32 bound on t's error is loose for slivers: their det is tiny beside the edge
+        // functions' error, and the bound can exceed a t of 1 — two slivers sharing an edge
+        // would both refuse a ray through it, and a closed mesh would leak. Decide in f64.
+        F32Test::Unproven(h) => positive_t_f64(o, d, [p0, p1, p2]).then_some(h),
+    }
+}
+
+/// What the f32 test decided.
+enum F32Test {
+    Hit(TriangleHit),
+    Miss,
+    /// Inside the edges at 0 < t < t_max, but t does not exceed the bound on its error.
+    Unproven(TriangleHit),
+}
+
+#[inline(always)]
+fn intersect_f32(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> F32Test {
+    use F32Test::Miss;
     if is_degenerate(p0, p1, p2) {
-        return None;
+        return Miss;
     }
     // Axis along which the direction is largest becomes z.
     let kz = dominant_axis(d);
-    let d_world = d;
     let d = permute(d, kz);
     if d.z == 0.0 || !d.is_finite() {
-        return None;
+        return Miss;
     }
     let mut p0t = permute(p0 - o, kz);
     let mut p1t = permute(p1 - o, kz);
@@ -90,11 +111,11 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
         e2 = f(p0t.x, p0t.y, p1t.x, p1t.y);
     }
     if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
-        return None;
+        return Miss;
     }
     let det = e0 + e1 + e2;
     if det == 0.0 || !det.is_finite() {
-        return None;
+        return Miss;
     }
     // The shear's error (below) is in length units: it takes z before the scaling to ray
     // parameters. pbrt-v4 uses the scaled z there, which is the same only for |d| ≈ 1; a shadow
@@ -106,20 +127,21 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
     p2t.z *= sz;
     let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
     if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
-        return None;
+        return Miss;
     }
     if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
-        return None;
+        return Miss;
     }
     let inv_det = 1.0 / det;
     let b = [e0 * inv_det, e1 * inv_det, e2 * inv_det];
     let t = t_scaled * inv_det;
     if !(t < t_max) {
-        return None;
+        return Miss;
     }
 
     // Reject hits whose t is not provably positive (pbrt-v4 eq. 6.8.4 bounds).
-    let max_zt = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
+    // Rounding is monotonic, so this is the largest scaled |z| exactly, one product cheaper.
+    let max_zt = max_z_len * sz.abs();
     let delta_z = gamma(3) * max_zt;
     let max_xt = p0t.x.abs().max(p1t.x.abs()).max(p2t.x.abs());
     let max_yt = p0t.y.abs().max(p1t.y.abs()).max(p2t.y.abs());
@@ -128,13 +150,13 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
     let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
     let max_e = e0.abs().max(e1.abs()).max(e2.abs());
     let delta_t = 3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
-    // The bound is loose for slivers: their det is tiny beside the edge functions' error, and it
-    // can exceed a t of 1 — two slivers sharing an edge would both refuse a ray through it, and
-    // a closed mesh would leak. Where f32 cannot prove t > 0, decide in f64.
-    if t <= delta_t && !(t > 0.0 && positive_t_f64(o, d_world, [p0, p1, p2], kz)) {
-        return None;
+    if t > delta_t {
+        F32Test::Hit(TriangleHit { t, b })
+    } else if t > 0.0 {
+        F32Test::Unproven(TriangleHit { t, b })
+    } else {
+        Miss
     }
-    Some(TriangleHit { t, b })
 }
 
 /// γₙ in f64.
@@ -148,7 +170,9 @@ fn gamma64(n: f64) -> f64 {
 /// of t is decided here: the hit, t and barycentrics stay the f32 ones, so neighbouring
 /// triangles still agree on which of them an edge belongs to.
 #[cold]
-fn positive_t_f64(o: Vec3, d: Vec3, p: [Vec3; 3], kz: usize) -> bool {
+#[inline(never)]
+fn positive_t_f64(o: Vec3, d: Vec3, p: [Vec3; 3]) -> bool {
+    let kz = dominant_axis(d);
     let perm = |v: Vec3| {
         let v = permute(v, kz);
         [f64::from(v.x), f64::from(v.y), f64::from(v.z)]
