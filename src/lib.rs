@@ -16,6 +16,7 @@ pub mod effects;
 pub mod engine;
 pub mod error;
 pub mod film;
+pub mod fuzzing;
 pub mod geometry;
 pub mod kernels;
 pub mod material;

@@ -1,0 +1,99 @@
+//! The properties that fuzzing checks, shared by the bounded proptest suite (`tests/fuzz.rs`) and
+//! the open-ended cargo-fuzz targets (`fuzz/`). Each returns `Err` with a description when the
+//! property fails; bad input that is refused with an error is not a failure.
+
+use crate::engine::{render, Engine};
+use crate::geometry::bvh::TriangleColumns;
+use crate::geometry::packet::closest_packets;
+use crate::geometry::traverse::closest_rays;
+use crate::geometry::{Bvh, RayQuery};
+use crate::reference::NoProgress;
+use crate::scene::file::load_scene;
+use crate::settings::Settings;
+use glam::Vec3;
+use std::path::Path;
+use std::sync::Arc;
+
+/// Most work a fuzzed scene may ask for before it is only loaded, not rendered.
+const MAX_PIXELS: u32 = 64;
+const MAX_PHOTONS: u32 = 5_000;
+
+/// Writes `s.toml`, `a.obj` and `m.mtl` into `dir` and loads `s.toml`. An error must be a short,
+/// non-empty message; a scene that loads (with a camera and a modest amount of work) must render
+/// on both engines to a finite image or to an error. Panics are the caller's to catch (the
+/// fuzzer and the test harness both report them).
+pub fn scene_files(dir: &Path, toml: &[u8], obj: &[u8], mtl: &[u8]) -> Result<(), String> {
+    for (name, text) in [("s.toml", toml), ("a.obj", obj), ("m.mtl", mtl)] {
+        std::fs::write(dir.join(name), text).map_err(|e| format!("cannot write the input: {e}"))?;
+    }
+    let loaded = match load_scene(&dir.join("s.toml")) {
+        Err(e) => {
+            let msg = e.to_string();
+            return if msg.is_empty() || msg.len() > 2000 { Err(format!("unhelpful error: {msg:?}")) } else { Ok(()) };
+        }
+        Ok(loaded) => loaded,
+    };
+    let Some(camera) = loaded.camera else { return Ok(()) };
+    let s = Settings { threads: 1, ..loaded.settings };
+    let small = s.width.saturating_mul(s.height) <= MAX_PIXELS
+        && s.spp <= 4
+        && s.passes <= 2
+        && s.photons <= MAX_PHOTONS
+        && s.caustic_photons <= MAX_PHOTONS;
+    if s.validate().is_err() || !small {
+        return Ok(());
+    }
+    let Ok(rays) = camera.prepare(s.width, s.height) else { return Ok(()) };
+    let scene = Arc::new(loaded.scene);
+    for engine in [Engine::Wavefront, Engine::Reference] {
+        if let Ok((film, _)) = render(&scene, &rays, &s, engine, None, &NoProgress) {
+            if let Some(i) = film.pixels.iter().position(|t| !t.is_finite()) {
+                return Err(format!("{engine:?}: pixel {i} is {:?}", film.pixels[i]));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Two triangles sharing the edge (a, b), wound as in a closed mesh — (a, b, c1) and (b, a, c2) —
+/// and a ray from `o` toward `target`, a point of the edge, with direction `target − o`
+/// (unnormalised, as shadow rays have) or its unit vector. When `o` lies inside the wedge of the
+/// two triangles, watertight intersection must hit one of them at t > 0; packet and scalar
+/// traversal must return the same hit in any case.
+pub fn edge_ray(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3, target: Vec3, normalise: bool) -> Result<(), String> {
+    let d = if normalise { (target - o).normalize_or_zero() } else { target - o };
+    let (p0, p1, p2) = ([a, b], [b, a], [c1, c2]);
+    let (bvh, order) = Bvh::build(&p0, &p1, &p2);
+    let pick = |v: &[Vec3; 2]| order.iter().map(|&i| v[i as usize]).collect::<Vec<_>>();
+    let (q0, q1, q2) = (pick(&p0), pick(&p1), pick(&p2));
+    let cols = TriangleColumns { p0: &q0, p1: &q1, p2: &q2 };
+    let rays = [RayQuery::new(o, d, f32::INFINITY)];
+    let (mut scalar, mut packet) = ([None], [None]);
+    closest_rays(&bvh, cols, &rays, &mut scalar);
+    closest_packets(&bvh, cols, &rays, &mut packet);
+    if scalar != packet {
+        return Err(format!("{:?}: scalar {:?}, packet {:?}", rays[0], scalar[0], packet[0]));
+    }
+    if in_wedge(a, b, c1, c2, o) && !scalar[0].is_some_and(|h| h.t > 0.0) {
+        return Err(format!("{:?} slipped through the edge {a}–{b} (wings {c1}, {c2})", rays[0]));
+    }
+    Ok(())
+}
+
+/// Whether `o` lies strictly inside the wedge bounded by the half-planes through the line (a, b)
+/// toward `c1` and `c2` (an open dihedral angle below 180°), well away from both.
+fn in_wedge(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3) -> bool {
+    let e = (b - a).normalize_or_zero();
+    let perp = |p: Vec3| (p - a) - e * (p - a).dot(e);
+    let (u1, u2, v) = (perp(c1).normalize_or_zero(), perp(c2).normalize_or_zero(), perp(o));
+    if u1 == Vec3::ZERO || u2 == Vec3::ZERO || v.length() == 0.0 || u1.dot(u2).abs() > 0.95 {
+        return false;
+    }
+    // v, like u1 and u2, is perpendicular to the edge: v = α u1 + β u2 with α, β clearly positive.
+    let g = u1.dot(u2);
+    let (x, y) = (v.dot(u1), v.dot(u2));
+    let det = 1.0 - g * g;
+    let (alpha, beta) = ((x - g * y) / det, (y - g * x) / det);
+    let margin = 0.01 * v.length();
+    alpha > margin && beta > margin
+}
