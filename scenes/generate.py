@@ -503,3 +503,36 @@ height = 32
 """)
 
 watertight("hard")
+
+def corner(folder):
+    """A floor (y = 0, x in [0, 2]) meeting a wall (x = 0, facing +x), both kd 0.5, under a
+    directional light straight down: the floor is lit, the wall (parallel to the light) only by
+    what the floor reflects."""
+    o = RawObj("corner.mtl")
+    o.quad("floor", "half", [(0, 0, -1), (2, 0, -1), (2, 0, 1), (0, 0, 1)], (0, 1, 0))
+    o.quad("wall", "half", [(0, 0, -1), (0, 2, -1), (0, 2, 1), (0, 0, 1)], (1, 0, 0))
+    o.write(f"{folder}/corner.obj")
+    mtl(f"{folder}/corner.mtl", [("half", "illum 1\nKd 0.5 0.5 0.5")])
+    with open(f"{folder}/corner.toml", "w") as f:
+        f.write("""# Corner leak, written by scenes/generate.py: a lit floor meets a wall that the light (straight
+# down, parallel to the wall) never reaches directly. No photon of the floor may be counted on the
+# wall, or the wall's foot would glow with the floor's direct light.
+[[mesh]]
+file = "corner.obj"
+
+[camera]
+eye = [1.8, 1.0, 0.0]
+target = [0.0, 0.3, 0.0]
+fov = 60
+
+[[light]]
+type = "directional"
+direction = [0.0, -1.0, 0.0]
+irradiance = [1, 1, 1]
+
+[render]
+width = 32
+height = 32
+""")
+
+corner("hard")
