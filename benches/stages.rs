@@ -51,7 +51,7 @@ fn setup(threads: usize) -> World {
         terms: Vec::new(),
         film: vec![Terms::default(); 128 * 128],
         rays: Default::default(),
-        non_finite: 0,
+        numerics: Default::default(),
     });
     w
 }

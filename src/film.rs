@@ -64,6 +64,43 @@ impl std::ops::Mul<f32> for Terms {
     }
 }
 
+/// The mean of one pixel's samples, as both engines take it: NaN or infinite samples are dropped
+/// and counted, and where the f32 sum of the rest overflows (samples near f32's largest value),
+/// each sample is scaled by 1/spp before it is summed. Sums that do not overflow give the plain
+/// mean, bit for bit.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PixelMean {
+    sum: Terms,
+    scaled: Terms,
+    dropped: u64,
+}
+
+impl PixelMean {
+    /// Adds one sample; `inv` is 1/spp.
+    #[inline]
+    pub fn add(&mut self, t: Terms, inv: f32) {
+        if t.is_finite() {
+            self.sum += t;
+            self.scaled += t * inv;
+        } else {
+            self.dropped += 1;
+        }
+    }
+
+    /// The mean (`inv` is 1/spp), with the dropped samples and any overflow added to `numerics`.
+    #[must_use]
+    pub fn finish(self, inv: f32, numerics: &mut crate::stats::Numerics) -> Terms {
+        numerics.camera_samples += self.dropped;
+        let mean = self.sum * inv;
+        if mean.is_finite() {
+            mean
+        } else {
+            numerics.pixel_overflow += 1;
+            self.scaled
+        }
+    }
+}
+
 /// A finished image: per-pixel mean of each term, row-major, y down.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
@@ -82,11 +119,11 @@ impl Film {
         self.pixels.iter().map(Terms::beauty).collect()
     }
 
-    /// Mean of the beauty image.
+    /// Mean of the beauty image (summed in f64, so that bright images do not overflow).
     #[must_use]
     pub fn mean(&self) -> Vec3 {
-        let sum: Vec3 = self.pixels.iter().map(Terms::beauty).sum();
-        sum / self.pixels.len().max(1) as f32
+        let sum: glam::DVec3 = self.pixels.iter().map(|t| t.beauty().as_dvec3()).sum();
+        (sum / self.pixels.len().max(1) as f64).as_vec3()
     }
 
     /// The image as named RGB layers, as [`Film::write_exr`] writes and [`read_exr`] reads them:

@@ -288,8 +288,10 @@ impl Progressive {
         let mut stats = stats;
         let old = &self.stats;
         stats.rays += old.rays;
-        stats.non_finite_samples += old.non_finite_samples;
-        stats.non_finite_photons += old.non_finite_photons;
+        // The load's count is the scene's, the same in every pass.
+        let load_normals = stats.numerics.load_normals;
+        stats.numerics += old.numerics;
+        stats.numerics.load_normals = load_normals;
         stats.times.global_photons_s += old.times.global_photons_s;
         stats.times.caustic_photons_s += old.times.caustic_photons_s;
         stats.times.map_build_s += old.times.map_build_s;

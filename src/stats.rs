@@ -65,6 +65,33 @@ impl MapStats {
     }
 }
 
+/// Values that could not be used, per stage of the pipeline where they were caught. Nothing
+/// counted here reaches the film or a photon map.
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+pub struct Numerics {
+    /// Load: vertex normals given with zero length, replaced by their face's geometric normal
+    /// (non-finite ones are refused with an error naming the line).
+    pub load_normals: u64,
+    /// Photon emission: paths whose emitted power or direction was not finite, dropped.
+    pub photon_emission: u64,
+    /// Photon scattering: paths whose power stopped being finite at a bounce, dropped there.
+    pub photon_scatter: u64,
+    /// Camera: samples with a NaN or infinite term, dropped before the film.
+    pub camera_samples: u64,
+    /// Film: pixels whose sum of samples overflowed f32, averaged sample by sample instead.
+    pub pixel_overflow: u64,
+}
+
+impl std::ops::AddAssign for Numerics {
+    fn add_assign(&mut self, o: Numerics) {
+        self.load_normals += o.load_normals;
+        self.photon_emission += o.photon_emission;
+        self.photon_scatter += o.photon_scatter;
+        self.camera_samples += o.camera_samples;
+        self.pixel_overflow += o.pixel_overflow;
+    }
+}
+
 /// Wall time per phase, seconds.
 #[derive(Clone, Debug, Default, Serialize, PartialEq)]
 pub struct PhaseTimes {
@@ -117,10 +144,8 @@ pub struct RenderStats {
     pub passes: Vec<String>,
     /// Rays traced.
     pub rays: RayCounts,
-    /// Camera samples dropped because a term was NaN or infinite.
-    pub non_finite_samples: u64,
-    /// Photons dropped because their power was NaN or infinite.
-    pub non_finite_photons: u64,
+    /// Values caught and dropped (or replaced), per stage.
+    pub numerics: Numerics,
     /// Phase times.
     pub times: PhaseTimes,
     /// Per-system runs, lanes and time (wavefront engine).
@@ -150,6 +175,7 @@ impl RenderStats {
             threads,
             kernels: format!("{:?}", settings.kernels).to_lowercase(),
             seed: settings.seed,
+            numerics: Numerics { load_normals: scene.replaced_normals, ..Default::default() },
             ..Default::default()
         }
     }
@@ -168,7 +194,8 @@ impl RenderStats {
         format!(
             "summary ({} engine, {} kernels, {} threads)\n{}{}  rays: {} total ({} camera, {} shadow, {} gather, {} photon)\n  \
              time: load {:.2} s, global photons {:.2} s, caustic photons {:.2} s, maps {:.2} s, camera {:.2} s, total {:.2} s\n  \
-             non-finite samples dropped: {} camera, {} photon\n",
+             non-finite values dropped: {} photon emissions, {} photon bounces, {} camera samples; \
+             {} pixel sums overflowed; {} vertex normals replaced at load\n",
             self.engine,
             self.kernels,
             self.threads,
@@ -185,8 +212,11 @@ impl RenderStats {
             t.map_build_s,
             t.camera_s,
             t.total_s,
-            self.non_finite_samples,
-            self.non_finite_photons,
+            self.numerics.photon_emission,
+            self.numerics.photon_scatter,
+            self.numerics.camera_samples,
+            self.numerics.pixel_overflow,
+            self.numerics.load_normals,
         ) + &self.progressive_summary()
             + &self.stage_summary()
     }

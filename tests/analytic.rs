@@ -198,6 +198,7 @@ fn quad_light_irradiance_matches_lamberts_formula() {
         normals: vec![],
         triangles: vec![[0, 1, 2], [0, 2, 3]],
         material: vec![0, 0],
+        ..Default::default()
     };
     let light = Material { name: "light".into(), bsdf: Bsdf::Lambert { kd: Vec3::ZERO }, emission: Vec3::splat(le) };
     let scene = Scene::build(vec![mesh], vec![light], vec![], vec![]).unwrap();
@@ -273,6 +274,7 @@ fn directional_light_irradiance_is_cosine_weighted_by_both_methods() {
             normals: vec![],
             triangles: vec![[0, 2, 1], [0, 3, 2]],
             material: vec![0, 0],
+            ..Default::default()
         };
         let mat = Material { name: "white".into(), bsdf: Bsdf::Lambert { kd: Vec3::splat(kd) }, emission: Vec3::ZERO };
         let th = deg.to_radians();

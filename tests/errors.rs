@@ -230,3 +230,21 @@ fn the_cli_warns_when_a_map_falls_short() {
     assert!(e.contains("warning: global map: 0 of 50 photons stored") && e.contains("it is empty"), "{e}");
     assert!(e.contains("warning: caustic map: 0 of 50 photons stored"), "{e}");
 }
+
+/// An emission whose power overflows f32 is refused, naming the material (an infinite `Ke` is
+/// already refused by the MTL check, naming its line), and so is a light whose intensity does.
+#[test]
+fn overflowing_light_power_is_refused() {
+    let d = scratch_dir("overflow");
+    write(&d, "m.mtl", &MTL.replace("Ke 1 1 1", "Ke 3e38 3e38 3e38"));
+    let obj = write(&d, "a.obj", OBJ);
+    let e = err(&obj);
+    assert!(e.contains("`light`") && e.contains("overflows"), "{e}");
+    write(&d, "m.mtl", &MTL.replace("Ke 1 1 1", "Ke inf 1 1"));
+    let e = err(&obj);
+    assert!(e.contains("m.mtl:3") && e.contains("not finite"), "{e}");
+    write(&d, "m.mtl", MTL);
+    let toml = "[[mesh]]\nfile = \"a.obj\"\n[[light]]\ntype = \"point\"\nposition = [0.2, 0.2, 0.2]\nintensity = [3e38, 3e38, 3e38]\n";
+    let e = err(&write(&d, "s.toml", toml));
+    assert!(e.contains("light[0]") && e.contains("overflows"), "{e}");
+}

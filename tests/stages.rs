@@ -168,7 +168,7 @@ fn camera_world(segments: &[(usize, PathKind)]) -> World {
         terms: vec![Terms::default(); 8],
         film: vec![Terms::default(); 2],
         rays: Default::default(),
-        non_finite: 0,
+        numerics: Default::default(),
     });
     w
 }
@@ -238,12 +238,18 @@ fn resolve_averages_each_pixels_samples_and_drops_non_finite_ones() {
             t.direct = Vec3::splat(i as f32);
         }
         work.terms[5].caustic = Vec3::splat(f32::NAN);
+        // Four finite samples whose f32 sum overflows: averaged sample by sample.
+        for t in &mut work.terms[..4] {
+            t.emitted = Vec3::splat(3e38);
+        }
     }
     w.run_system_once(photonwave::wavefront::shade::resolve_wave).unwrap();
     let work = w.resource::<CameraWork>();
     assert_eq!(work.film[0].direct, Vec3::splat((0.0 + 1.0 + 2.0 + 3.0) / 4.0));
+    assert_eq!(work.film[0].emitted, Vec3::splat(3e38));
     assert_eq!(work.film[1].direct, Vec3::splat((4.0 + 6.0 + 7.0) / 4.0));
-    assert_eq!(work.non_finite, 1);
+    assert_eq!(work.numerics.camera_samples, 1);
+    assert_eq!(work.numerics.pixel_overflow, 1);
 }
 
 #[test]

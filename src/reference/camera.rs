@@ -10,7 +10,7 @@
 use super::parallel::map_chunks;
 use super::{PhotonMaps, Progress};
 use crate::effects::Effects;
-use crate::film::{Film, Terms};
+use crate::film::{Film, PixelMean, Terms};
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::{Bsdf, Transport};
 use crate::photon_map::{flags, Filter, Lookup, PhotonMap, Reflectance};
@@ -19,7 +19,7 @@ use crate::sampling::{cosine_hemisphere, Frame};
 use crate::scene::camera::CameraRays;
 use crate::scene::{Scene, SurfacePoint};
 use crate::settings::Settings;
-use crate::stats::RayCounts;
+use crate::stats::{Numerics, RayCounts};
 use glam::Vec3;
 
 /// Shadow rays stop this fraction short of the light point (relative, so scale-free).
@@ -72,7 +72,7 @@ pub fn render_image(
     settings: &Settings,
     threads: usize,
     progress: &dyn Progress,
-) -> (Film, RayCounts, u64) {
+) -> (Film, RayCounts, Numerics) {
     let ctx = Context::new(scene, maps, settings);
     render_pixels(settings, camera, threads, progress, |pixel, o, d, s, rays, scratch| {
         trace_camera_path(&ctx, pixel, o, d, s, rays, scratch)
@@ -89,7 +89,7 @@ pub fn render_pixels(
     threads: usize,
     progress: &dyn Progress,
     radiance: impl Fn(usize, Vec3, Vec3, &Sampler, &mut RayCounts, &mut Vec<(f32, u32)>) -> Terms + Sync,
-) -> (Film, RayCounts, u64) {
+) -> (Film, RayCounts, Numerics) {
     let (w, h) = (settings.width as usize, settings.height as usize);
     let spp = settings.spp;
     progress.start("camera", h as u64);
@@ -99,40 +99,36 @@ pub fn render_pixels(
         threads,
         |range| {
             let mut rays = RayCounts::default();
-            let mut bad = 0u64;
+            let mut numerics = Numerics::default();
             let mut scratch = Vec::new();
             let mut row = Vec::with_capacity(w * range.len());
             for y in range {
                 for x in 0..w {
-                    let mut sum = Terms::default();
+                    let mut mean = PixelMean::default();
                     for s in 0..spp {
                         let index = ((y * w + x) as u64) * spp as u64 + s as u64;
                         let (sampler, (fx, fy)) = camera_sample(settings, index);
                         let (o, d) = camera.ray(x as f32 + fx, y as f32 + fy);
                         let t = radiance(y * w + x, o, d, &sampler, &mut rays, &mut scratch);
-                        if t.is_finite() {
-                            sum += t;
-                        } else {
-                            bad += 1;
-                        }
+                        mean.add(t, 1.0 / spp as f32);
                     }
-                    row.push(sum * (1.0 / spp as f32));
+                    row.push(mean.finish(1.0 / spp as f32, &mut numerics));
                 }
             }
-            (row, rays, bad)
+            (row, rays, numerics)
         },
         |n| progress.advance(n as u64),
     );
     progress.finish();
     let mut pixels = Vec::with_capacity(w * h);
     let mut rays = RayCounts::default();
-    let mut bad = 0;
-    for (row, r, b) in rows {
+    let mut numerics = Numerics::default();
+    for (row, r, n) in rows {
         pixels.extend(row);
         rays += r;
-        bad += b;
+        numerics += n;
     }
-    (Film { width: settings.width, height: settings.height, pixels }, rays, bad)
+    (Film { width: settings.width, height: settings.height, pixels }, rays, numerics)
 }
 
 /// Camera sample `index` (sample `index % spp` of pixel `index / spp`): its random stream and its

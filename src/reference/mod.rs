@@ -154,10 +154,10 @@ pub fn render(
     stats.effects = Some(plan.clone());
 
     let t = Instant::now();
-    let (film, rays, non_finite) = camera::render_image(scene, &maps, camera, settings, threads, progress);
+    let (film, rays, numerics) = camera::render_image(scene, &maps, camera, settings, threads, progress);
     stats.times.camera_s = t.elapsed().as_secs_f64();
     stats.rays += rays;
-    stats.non_finite_samples = non_finite;
+    stats.numerics += numerics;
     stats.passes.push(if plan.final_gather.on { "final gather".into() } else { "global map read at first hit".into() });
     stats.times.total_s = start.elapsed().as_secs_f64();
     stats.mean_rgb = film.mean().to_array();
@@ -182,7 +182,7 @@ pub fn photon_passes(
         let p = photons::trace_photons(scene, settings, domain, target, threads, progress);
         *time = t.elapsed().as_secs_f64();
         stats.rays.photon += p.rays;
-        stats.non_finite_photons += p.non_finite;
+        stats.numerics += p.numerics;
         stats.passes.push(name.to_string());
         let map = if domain == Domain::CausticPhoton { &mut stats.caustic_map } else { &mut stats.global_map };
         map.emitted = p.emitted;

@@ -29,7 +29,7 @@ pub fn render_path_traced(
     camera: &CameraRays,
     settings: &Settings,
     progress: &dyn Progress,
-) -> (Film, RayCounts, u64) {
+) -> (Film, RayCounts, crate::stats::Numerics) {
     let empty = super::PhotonMaps::default();
     let ctx = super::camera::Context::new(scene, &empty, settings);
     render_pixels(settings, camera, settings.thread_count(), progress, |_, o, d, s, rays, _| {
@@ -46,7 +46,7 @@ pub fn render_path_traced_with_stats(
 ) -> crate::Result<(Film, crate::stats::RenderStats)> {
     settings.validate()?;
     let t = std::time::Instant::now();
-    let (film, rays, bad) = render_path_traced(scene, camera, settings, progress);
+    let (film, rays, numerics) = render_path_traced(scene, camera, settings, progress);
     let stats = crate::stats::RenderStats {
         engine: "path".into(),
         triangles: scene.triangle_count(),
@@ -58,7 +58,7 @@ pub fn render_path_traced_with_stats(
         seed: settings.seed,
         passes: vec!["path tracing with next-event estimation".into()],
         rays,
-        non_finite_samples: bad,
+        numerics: crate::stats::Numerics { load_normals: scene.replaced_normals, ..numerics },
         times: crate::stats::PhaseTimes {
             camera_s: t.elapsed().as_secs_f64(),
             total_s: t.elapsed().as_secs_f64(),

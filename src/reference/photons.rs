@@ -16,6 +16,7 @@ use crate::photon_map::{flags, Photon};
 use crate::rng::{Domain, Sampler};
 use crate::scene::{Scene, SurfacePoint};
 use crate::settings::Settings;
+use crate::stats::Numerics;
 use glam::Vec3;
 
 /// Paths per batch; a map stops growing at the first batch boundary past its target.
@@ -33,8 +34,9 @@ pub struct PhotonPass {
     pub emitted: u64,
     /// Ray segments traced.
     pub rays: u64,
-    /// Paths dropped for non-finite power.
-    pub non_finite: u64,
+    /// Paths dropped for non-finite power, at emission and at a bounce (the photon fields of
+    /// [`Numerics`]).
+    pub numerics: Numerics,
 }
 
 /// Emits batches of paths until `target` photons are stored (or the path cap is reached).
@@ -49,7 +51,7 @@ pub fn trace_photons(
     let name = if domain == Domain::CausticPhoton { "caustic photons" } else { "global photons" };
     progress.start(name, target as u64);
     let mut photons = Vec::new();
-    let (mut emitted, mut rays, mut non_finite) = (0u64, 0u64, 0u64);
+    let (mut emitted, mut rays, mut numerics) = (0u64, 0u64, Numerics::default());
     let cap = (target as u64 * MAX_PATHS_PER_PHOTON).max(BATCH as u64);
     let mut reported = 0u64;
     while (photons.len() as u64) < target as u64 && emitted < cap {
@@ -60,7 +62,7 @@ pub fn trace_photons(
             threads,
             |range| {
                 let mut out = Vec::new();
-                let (mut r, mut nf) = (0u64, 0u64);
+                let (mut r, mut nf) = (0u64, Numerics::default());
                 for i in range {
                     trace_path(scene, settings, domain, first + i as u64, &mut out, &mut r, &mut nf);
                 }
@@ -71,7 +73,7 @@ pub fn trace_photons(
         for (out, r, nf) in chunks {
             photons.extend(out);
             rays += r;
-            non_finite += nf;
+            numerics += nf;
         }
         emitted += BATCH as u64;
         let now = (photons.len() as u64).min(target as u64);
@@ -80,7 +82,7 @@ pub fn trace_photons(
     }
     progress.finish();
     normalise_power(&mut photons, emitted);
-    PhotonPass { photons, emitted, rays, non_finite }
+    PhotonPass { photons, emitted, rays, numerics }
 }
 
 /// Divides stored photons' power by the number of paths emitted: each then carries Φ/N.
@@ -209,10 +211,10 @@ pub fn trace_path(
     index: u64,
     out: &mut Vec<Photon>,
     rays: &mut u64,
-    non_finite: &mut u64,
+    numerics: &mut Numerics,
 ) {
     let Some(mut photon) = start_photon(scene, settings, domain, index) else {
-        *non_finite += 1;
+        numerics.photon_emission += 1;
         return;
     };
     let s = Sampler::new(settings.seed, domain, index);
@@ -228,7 +230,7 @@ pub fn trace_path(
             Scattered::Continue(next) => photon = next,
             Scattered::Absorbed => break,
             Scattered::NonFinite => {
-                *non_finite += 1;
+                numerics.photon_scatter += 1;
                 break;
             }
         }

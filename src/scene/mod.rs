@@ -25,8 +25,11 @@ pub struct MeshInput {
     pub source: String,
     /// Vertex positions.
     pub positions: Vec<Vec3>,
-    /// Vertex normals (empty, or one per position).
+    /// Vertex normals (empty, or one per position; zero where a vertex has none, and then its
+    /// face's geometric normal is used).
     pub normals: Vec<Vec3>,
+    /// Vertex normals given in the file with zero length (counted, then treated as absent).
+    pub zero_normals: u64,
     /// Triangles as vertex indices.
     pub triangles: Vec<[u32; 3]>,
     /// Material of each triangle (index into the scene's material table).
@@ -80,6 +83,8 @@ pub struct Scene {
     pub bounds: (Vec3, Vec3),
     /// Degenerate (zero-area) triangles dropped at load.
     pub dropped_degenerate: usize,
+    /// Vertex normals given with zero length (their faces use the geometric normal there).
+    pub replaced_normals: u64,
     /// Non-fatal observations made while loading.
     pub warnings: Vec<String>,
     bvh: Bvh,
@@ -97,6 +102,7 @@ impl Scene {
     ) -> Result<Scene> {
         let (mut p0, mut p1, mut p2, mut vn, mut mat) = (vec![], vec![], vec![], vec![], vec![]);
         let mut dropped = 0usize;
+        let replaced_normals = meshes.iter().map(|m| m.zero_normals).sum();
         // Emissive area per material, to refuse lights whose every triangle is degenerate.
         let mut emitter_area = vec![0.0f64; materials.len()];
         let mut emitter_seen = vec![false; materials.len()];
@@ -189,6 +195,7 @@ impl Scene {
             delta_lights: vec![],
             bounds: (lo, hi),
             dropped_degenerate: dropped,
+            replaced_normals,
             warnings,
             bvh,
             kinds: (false, false, false),
@@ -214,6 +221,20 @@ impl Scene {
                 l.power(tri.as_ref(), radius).element_sum() as f64 / 3.0
             })
             .collect();
+        if let Some(i) = powers.iter().position(|p| !p.is_finite()) {
+            let what = match &scene.lights[i] {
+                Light::Area { tri, .. } => {
+                    format!("emitter material `{}`", scene.materials[scene.material[*tri as usize] as usize].name)
+                }
+                _ => {
+                    let k = scene.lights[..i].iter().filter(|l| !matches!(l, Light::Area { .. })).count();
+                    format!("setting `light[{k}]`")
+                }
+            };
+            return Err(Error::scene(format!(
+                "{what}: its power overflows f32 (emission times area or intensity times solid angle is above 3.4e38 W); scale it down"
+            )));
+        }
         scene.light_power = Distribution1D::try_new(&powers)
             .ok_or_else(|| Error::scene("every light has zero power: check `Ke` and light intensities"))?;
         scene.area_lights = (0..scene.lights.len() as u32).filter(|&i| !scene.lights[i as usize].is_delta()).collect();

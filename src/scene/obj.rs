@@ -127,7 +127,13 @@ pub fn load_obj(
         for (k, p) in m.positions.chunks_exact(3).enumerate() {
             mesh.positions.push(Vec3::new(p[0], p[1], p[2]) * scale + translate);
             mesh.normals.push(if has_normals {
-                Vec3::new(m.normals[3 * k], m.normals[3 * k + 1], m.normals[3 * k + 2])
+                let n = Vec3::new(m.normals[3 * k], m.normals[3 * k + 1], m.normals[3 * k + 2]);
+                if n.try_normalize().is_none() {
+                    mesh.zero_normals += 1;
+                    Vec3::ZERO
+                } else {
+                    n
+                }
             } else {
                 Vec3::ZERO
             });
@@ -146,6 +152,13 @@ pub fn load_obj(
     }
     if !any_normals {
         mesh.normals.clear();
+    }
+    if mesh.zero_normals > 0 {
+        warnings.push(format!(
+            "{}: {} vertex normals have zero length; faces shade with their geometric normal there",
+            path.display(),
+            mesh.zero_normals
+        ));
     }
     if missing_material {
         warnings.push(format!("{}: faces without a known material are grey Lambertian (Kd 0.8)", path.display()));

@@ -39,7 +39,7 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
             non_finite += part.1;
         },
     );
-    w.non_finite += non_finite;
+    w.numerics.photon_emission += non_finite;
     stats.record("emit_photons", n, t);
 }
 

@@ -121,8 +121,9 @@ pub struct PhotonWork {
     pub deposits: Vec<(u64, u32, Photon)>,
     /// Ray segments traced.
     pub rays: u64,
-    /// Paths dropped for non-finite power.
-    pub non_finite: u64,
+    /// Paths dropped for non-finite power, at emission and at a bounce (the photon fields of
+    /// [`Numerics`](crate::stats::Numerics)).
+    pub numerics: crate::stats::Numerics,
 }
 
 /// Camera-pass state for one wave of samples.
@@ -148,8 +149,8 @@ pub struct CameraWork {
     pub film: Vec<Terms>,
     /// Rays traced.
     pub rays: RayCounts,
-    /// Samples dropped as non-finite.
-    pub non_finite: u64,
+    /// Samples dropped as non-finite, and pixel sums that overflowed.
+    pub numerics: crate::stats::Numerics,
 }
 
 /// Work done by one system.
@@ -421,7 +422,7 @@ fn photon_pass(
         normalise_power(&mut photons, emitted);
         let w = world.resource::<PhotonWork>();
         stats.rays.photon += w.rays;
-        stats.non_finite_photons += w.non_finite;
+        stats.numerics += w.numerics;
         let (map, time) = if k == 0 {
             (&mut stats.global_map, &mut stats.times.global_photons_s)
         } else {
@@ -493,7 +494,7 @@ pub fn render(
         terms: Vec::new(),
         film: vec![Terms::default(); pixels],
         rays: RayCounts::default(),
-        non_finite: 0,
+        numerics: crate::stats::Numerics::default(),
     });
     progress.start("camera", pixels as u64);
     // Waves hold whole pixels.
@@ -514,7 +515,7 @@ pub fn render(
     let mut w = world.resource_mut::<CameraWork>();
     let film = Film { width: settings.width, height: settings.height, pixels: std::mem::take(&mut w.film) };
     stats.rays += w.rays;
-    stats.non_finite_samples = w.non_finite;
+    stats.numerics += w.numerics;
     stats.times.camera_s = t.elapsed().as_secs_f64();
     stats.passes.push(if effects.final_gather.on {
         "final gather (wavefront)".into()

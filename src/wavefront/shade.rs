@@ -7,7 +7,7 @@
 use super::gather::camera_slot;
 use super::queues::{PathKind, PathQueue, PhotonQueue, Segment, ShadowQueue};
 use super::{par_columns, par_lanes, slot, CameraWork, Maps, PhotonWork, Shared, StageStats, CHUNK};
-use crate::film::Terms;
+use crate::film::PixelMean;
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::{Bsdf, Transport};
 use crate::reference::camera::{direct_light_rays, Context, ShadowRay, TAG_GATHER, TAG_GLOSSY, TAG_LIGHT};
@@ -56,7 +56,7 @@ pub fn scatter_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
     let t = Instant::now();
     let lanes: Vec<u32> = work.classified.mirror.iter().chain(&work.survivors).copied().collect();
     let mut next = std::mem::take(&mut work.next);
-    work.non_finite += scatter_lanes(&shared, &work, &lanes, &mut next);
+    work.numerics.photon_scatter += scatter_lanes(&shared, &work, &lanes, &mut next);
     work.next = next;
     stats.record("scatter_photons", lanes.len(), t);
 }
@@ -66,7 +66,7 @@ pub fn refract_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
     let t = Instant::now();
     let lanes = work.classified.glass.clone();
     let mut next = std::mem::take(&mut work.next);
-    work.non_finite += scatter_lanes(&shared, &work, &lanes, &mut next);
+    work.numerics.photon_scatter += scatter_lanes(&shared, &work, &lanes, &mut next);
     work.next = next;
     stats.record("refract_photons", lanes.len(), t);
 }
@@ -281,15 +281,11 @@ pub fn resolve_wave(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats
     let w = &mut *work;
     let first_pixel = (w.first_sample / spp as u64) as usize;
     for (k, samples) in w.terms.chunks(spp).enumerate() {
-        let mut sum = Terms::default();
+        let mut mean = PixelMean::default();
         for t in samples {
-            if t.is_finite() {
-                sum += *t;
-            } else {
-                w.non_finite += 1;
-            }
+            mean.add(*t, 1.0 / spp as f32);
         }
-        w.film[first_pixel + k] = sum * (1.0 / spp as f32);
+        w.film[first_pixel + k] = mean.finish(1.0 / spp as f32, &mut w.numerics);
     }
     stats.record("resolve_wave", w.count, t);
 }
