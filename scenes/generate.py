@@ -536,3 +536,33 @@ height = 32
 """)
 
 corner("hard")
+
+def numerics(folder):
+    """emitter.toml's floor and quad light, with every floor vertex normal of zero length and the
+    light's emission 1e38 (its power, 7.9e37 W, still fits f32; four such samples do not)."""
+    o = RawObj("numerics.mtl")
+    o.quad("floor", "half", [(-1, 0, -1), (1, 0, -1), (1, 0, 1), (-1, 0, 1)], (0, 1, 0))
+    o.lines[-1] = "f " + " ".join(f"{i}//1" for i in range(1, 5))
+    o.lines.insert(o.lines.index("o floor"), "vn 0 0 0")
+    o.quad("light", "light", [(-0.25, 1, -0.25), (0.25, 1, -0.25), (0.25, 1, 0.25), (-0.25, 1, 0.25)], (0, -1, 0))
+    o.write(f"{folder}/numerics.obj")
+    mtl(f"{folder}/numerics.mtl", [("half", "illum 1\nKd 0.5 0.5 0.5"), ("light", "illum 1\nKd 0 0 0\nKe 1e38 1e38 1e38")])
+    with open(f"{folder}/numerics.toml", "w") as f:
+        f.write("""# NaN and Inf, written by scenes/generate.py: emitter.toml's floor and light, but every floor vertex
+# normal has zero length (replaced by the face's normal, counted at load) and the light emits 1e38
+# (a pixel's sum of samples overflows f32 and is averaged sample by sample, counted). The image
+# must be 2.5e37 times emitter.toml's (emission 4), and finite.
+[[mesh]]
+file = "numerics.obj"
+
+[camera]
+eye = [0.0, 0.5, 1.8]
+target = [0.0, 0.3, 0.0]
+fov = 50
+
+[render]
+width = 32
+height = 32
+""")
+
+numerics("hard")

@@ -501,3 +501,43 @@ fn no_photon_crosses_a_corner() {
         }
     }
 }
+
+/// Case 11: emitter.toml's floor and light, but with every floor vertex normal of zero length and
+/// the light emitting 1e38 — a power of 7.9e37 W, which fits f32, though four camera samples of
+/// the light do not. Counted per stage: the normals replaced at load, the pixel sums that
+/// overflowed (averaged sample by sample instead); nothing is dropped, no pixel is NaN or
+/// infinite, and the image is 2.5e37 times emitter.toml's (emission 4) to 10⁻⁵ per pixel and
+/// layer — the same random numbers, the same paths, on both engines. (An infinite emission, or
+/// one whose power overflows, is refused at load: tests/errors.rs.)
+#[test]
+fn huge_emission_and_zero_normals_stay_finite_and_counted() {
+    let (plain, huge) = (hard("emitter.toml"), hard("numerics.toml"));
+    assert!(
+        huge.scene.warnings.iter().any(|w| w.contains("4 vertex normals have zero length")),
+        "{:?}",
+        huge.scene.warnings
+    );
+    let s = Settings { width: 24, height: 24, spp: 4, photons: 20_000, gather_rays: 4, ..Default::default() };
+    let rays = plain.camera.unwrap().prepare(24, 24).unwrap();
+    let (plain, huge) = (Arc::new(plain.scene), Arc::new(huge.scene));
+    let scale = 1e38f32 / 4.0;
+    for engine in ENGINES {
+        let (a, _) = render(&plain, &rays, &s, engine, None, &NoProgress).unwrap();
+        let (b, stats) = render(&huge, &rays, &s, engine, None, &NoProgress).unwrap();
+        let n = stats.numerics;
+        println!("{engine:?}: {n:?}");
+        assert_eq!((n.load_normals, n.photon_emission, n.photon_scatter, n.camera_samples), (4, 0, 0, 0), "{engine:?}");
+        assert!(n.pixel_overflow > 0, "{engine:?}: the light's pixels should overflow a plain f32 sum");
+        assert!(stats.mean_rgb.iter().all(|v| v.is_finite()), "{engine:?}: mean {:?}", stats.mean_rgb);
+        for (i, (p, q)) in a.pixels.iter().zip(&b.pixels).enumerate() {
+            assert!(q.is_finite(), "{engine:?}, pixel {i}: {q:?}");
+            for (x, y) in p.as_array().iter().zip(q.as_array()) {
+                let want = *x * scale;
+                assert!(
+                    (y - want).abs().max_element() <= 1e-5 * want.max_element(),
+                    "{engine:?}, pixel {i}: {y} for {want}"
+                );
+            }
+        }
+    }
+}
