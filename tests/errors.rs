@@ -93,6 +93,9 @@ fn malformed_scene_files_name_the_line_or_field() {
     assert!(e.contains("`width`"), "{e}");
     let e = err(&write(&d, "s4.toml", "[[mesh]]\nfile = \"a.obj\"\n[materials.white]\ntype = \"glass\"\nior = -1\n"));
     assert!(e.contains("materials.white.ior"), "{e}");
+    let toml = "[[mesh]]\nfile = \"a.obj\"\n[materials.white]\ntype = \"glass\"\nior = 1.33\noutside_ior = 0\n";
+    let e = err(&write(&d, "s4b.toml", toml));
+    assert!(e.contains("materials.white.outside_ior"), "{e}");
     let e = err(&write(&d, "s5.toml", "[[mesh]]\nfile = \"a.obj\"\n[materials.nosuch]\ntype = \"mirror\"\n"));
     assert!(e.contains("materials.nosuch"), "{e}");
     let e = err(&write(&d, "s6.toml", "[[mesh]]\nfile = \"a.obj\"\n[[light]]\ntype = \"spot\"\nposition = [0,0,0]\ntarget = [0,0,0]\nintensity = [1,1,1]\nangle = 30\n"));

@@ -20,6 +20,7 @@
 //! [materials.sphere]            # replaces the MTL material `sphere`
 //! type = "glass"                # lambert | glossy | mirror | glass
 //! ior = 1.5
+//! outside_ior = 1.0             # glass only: the medium the normal points into (nested dielectrics)
 //!
 //! [render]                      # any field of Settings
 //! spp = 16
@@ -124,6 +125,10 @@ enum MaterialEntry {
     Glass {
         #[serde(default = "ior_default")]
         ior: f32,
+        /// Index of the medium on the side the face's normal points to (1, air, by default):
+        /// one face with `ior` and `outside_ior` is the boundary between two dielectrics.
+        #[serde(default = "one")]
+        outside_ior: f32,
         #[serde(default)]
         emission: Option<[f32; 3]>,
     },
@@ -227,11 +232,14 @@ impl MaterialEntry {
                 (Bsdf::Glossy { kd, ks, exponent }, emission)
             }
             MaterialEntry::Mirror { ks, emission } => (Bsdf::Mirror { ks: albedo(&f("ks"), ks)? }, emission),
-            MaterialEntry::Glass { ior, emission } => {
+            MaterialEntry::Glass { ior, outside_ior, emission } => {
                 if !(ior > 0.0 && ior.is_finite()) {
                     return Err(Error::setting(f("ior"), "must be a positive number"));
                 }
-                (Bsdf::Glass { ior }, emission)
+                if !(outside_ior > 0.0 && outside_ior.is_finite()) {
+                    return Err(Error::setting(f("outside_ior"), "must be a positive number"));
+                }
+                (Bsdf::Glass { ior: ior / outside_ior }, emission)
             }
         };
         let emission = match emission {

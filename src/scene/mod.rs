@@ -92,6 +92,75 @@ pub struct Scene {
     kinds: (bool, bool, bool),
 }
 
+/// A warning when faces of two different materials, at least one a dielectric, overlap in one
+/// plane: which of them a ray meets is arbitrary, and the ratio of indices across the boundary
+/// is lost. Nested dielectrics are modelled with one face per boundary instead. Faces are grouped
+/// by plane (normal up to sign and offset, rounded to 10⁻⁵ of the scene's size); within a plane
+/// that holds a dielectric and another material, a face overlaps another when one of four points
+/// inside either lies inside the other.
+fn coincident_dielectrics(
+    p0: &[Vec3],
+    p1: &[Vec3],
+    p2: &[Vec3],
+    mat: &[u32],
+    materials: &[Material],
+) -> Option<String> {
+    let glass = |m: u32| matches!(materials[m as usize].bsdf, Bsdf::Glass { .. });
+    if !mat.iter().any(|&m| glass(m)) {
+        return None;
+    }
+    let (lo, hi) =
+        p0.iter().chain(p1).chain(p2).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| (l.min(*p), h.max(*p)));
+    let size = (hi - lo).length().max(f32::MIN_POSITIVE);
+    let mut planes: std::collections::HashMap<[i64; 4], Vec<usize>> = std::collections::HashMap::new();
+    for i in 0..p0.len() {
+        let n = (p1[i] - p0[i]).cross(p2[i] - p0[i]).normalize_or_zero();
+        let first = n.to_array().into_iter().find(|c| c.abs() > 1e-6).unwrap_or(1.0);
+        let n = if first < 0.0 { -n } else { n };
+        let q = |x: f32| (f64::from(x) * 1e5).round() as i64;
+        planes.entry([q(n.x), q(n.y), q(n.z), q(n.dot(p0[i]) / size)]).or_default().push(i);
+    }
+    let inside = |p: Vec3, i: usize| {
+        let n = (p1[i] - p0[i]).cross(p2[i] - p0[i]);
+        let edge = |a: Vec3, b: Vec3| (b - a).cross(p - a).dot(n) > 0.0;
+        edge(p0[i], p1[i]) && edge(p1[i], p2[i]) && edge(p2[i], p0[i])
+    };
+    let mut pairs = std::collections::BTreeMap::<(String, String), usize>::new();
+    for faces in planes.values() {
+        if !faces.iter().any(|&i| glass(mat[i])) || faces.iter().all(|&i| mat[i] == mat[faces[0]]) {
+            continue;
+        }
+        for (k, &i) in faces.iter().enumerate() {
+            for &j in &faces[k + 1..] {
+                let (a, b) = (&materials[mat[i] as usize], &materials[mat[j] as usize]);
+                if a.name == b.name || !(glass(mat[i]) || glass(mat[j])) {
+                    continue;
+                }
+                // The centroid and three points toward the corners (a centroid alone can sit on
+                // the other face's edge, as when a quad is split along its other diagonal).
+                let points = |t: usize| {
+                    let (a, b, c) = (p0[t], p1[t], p2[t]);
+                    [(a + b + c) / 3.0, a * 0.6 + (b + c) * 0.2, b * 0.6 + (a + c) * 0.2, c * 0.6 + (a + b) * 0.2]
+                };
+                if points(i).iter().any(|&p| inside(p, j)) || points(j).iter().any(|&p| inside(p, i)) {
+                    let (x, y) = if a.name < b.name { (a, b) } else { (b, a) };
+                    *pairs.entry((x.name.clone(), y.name.clone())).or_default() += 1;
+                }
+            }
+        }
+    }
+    let list: Vec<String> = pairs.iter().map(|((a, b), n)| format!("{n} triangle pairs of `{a}` and `{b}`")).collect();
+    (!list.is_empty()).then(|| {
+        format!(
+            "overlapping faces of different materials in one plane ({}): which one a ray meets is \
+             arbitrary and the ratio of indices across them is lost; model each boundary between two \
+             dielectrics as one face whose glass material has `ior` and `outside_ior` (README, \
+             \"Nested dielectrics\")",
+            list.join(", ")
+        )
+    })
+}
+
 impl Scene {
     /// Assembles meshes, materials and extra lights; validates and builds the BVH.
     pub fn build(
@@ -149,6 +218,9 @@ impl Scene {
             return Err(Error::scene("the scene has no triangles"));
         }
 
+        if let Some(w) = coincident_dielectrics(&p0, &p1, &p2, &mat, &materials) {
+            warnings.push(w);
+        }
         let (bvh, order) = Bvh::build(&p0, &p1, &p2);
         let pick = |v: &Vec<Vec3>| order.iter().map(|&i| v[i as usize]).collect::<Vec<_>>();
         let (p0, p1, p2) = (pick(&p0), pick(&p1), pick(&p2));
