@@ -566,3 +566,67 @@ height = 32
 """)
 
 numerics("hard")
+
+def nested(folder):
+    """The white furnace (Le = 1, albedo 0.5) holding a glass slab (n = 1.5, y from -0.3 to -0.1)
+    under water (n = 1.33, y from -0.1 to 0.2), 0.6 x 0.6 across. nested.obj models the boundary
+    between them as one face (material water_on_glass, normal into the glass, given ior 1.33 and
+    outside_ior 1.5 in nested.toml); nested-coincident.obj closes each slab on its own, so two
+    faces coincide there."""
+    a, y0, y1, y2 = 0.3, -0.3, -0.1, 0.2
+    def slab(o, name, material, lo, hi, skip=None):
+        c = (0.0, (lo + hi) / 2, 0.0)
+        faces = {
+            "bottom": [(-a, lo, -a), (a, lo, -a), (a, lo, a), (-a, lo, a)],
+            "top": [(-a, hi, -a), (a, hi, -a), (a, hi, a), (-a, hi, a)],
+            "xlo": [(-a, lo, -a), (-a, hi, -a), (-a, hi, a), (-a, lo, a)],
+            "xhi": [(a, lo, -a), (a, hi, -a), (a, hi, a), (a, lo, a)],
+            "zlo": [(-a, lo, -a), (a, lo, -a), (a, hi, -a), (-a, hi, -a)],
+            "zhi": [(-a, lo, a), (a, lo, a), (a, hi, a), (-a, hi, a)],
+        }
+        for side, pts in faces.items():
+            if side != skip:
+                m = tuple(sum(p[i] for p in pts) / 4 for i in range(3))
+                o.quad(f"{name}_{side}", material, pts, sub(m, c))
+    for variant in ("", "-coincident"):
+        o = RawObj(f"nested{variant}.mtl")
+        o.sphere("enclosure", "furnace", (0, 0, 0), 1.0, inward=True, seg=32, rings=16)
+        if variant:
+            slab(o, "glass", "glass", y0, y1)
+            slab(o, "water", "water", y1, y2)
+        else:
+            slab(o, "glass", "glass", y0, y1, skip="top")
+            slab(o, "water", "water", y1, y2, skip="bottom")
+            o.quad("boundary", "water_on_glass", [(-a, y1, -a), (a, y1, -a), (a, y1, a), (-a, y1, a)], (0, -1, 0))
+        o.write(f"{folder}/nested{variant}.obj")
+        mtl(f"{folder}/nested{variant}.mtl", [
+            ("furnace", "illum 1\nKd 0.5 0.5 0.5\nKe 1 1 1"), ("glass", "illum 7\nNi 1.5"),
+            ("water", "illum 7\nNi 1.33"), ("water_on_glass", "illum 7\nNi 1.33")])
+        boundary = "" if variant else """
+# The boundary between water and glass is one face whose normal points into the glass.
+[materials.water_on_glass]
+type = "glass"
+ior = 1.33
+outside_ior = 1.5
+"""
+        what = ("each slab closed on its own, so faces of glass and water coincide at y = -0.1: the\n# "
+                "loader warns; which face a ray meets there is arbitrary") if variant else \
+               ("the boundary between them one face with ior 1.33 and outside_ior 1.5: radiance is\n# "
+                "2 through every path, as everywhere in the furnace")
+        with open(f"{folder}/nested{variant}.toml", "w") as f:
+            f.write(f"""# Nested dielectrics, written by scenes/generate.py: in the white furnace (Le = 1, albedo 0.5), a
+# glass slab (n = 1.5) under water (n = 1.33), {what}.
+[[mesh]]
+file = "nested{variant}.obj"
+
+[camera]
+eye = [0.0, 0.55, 0.75]
+target = [0.0, -0.1, 0.0]
+fov = 50
+{boundary}
+[render]
+width = 32
+height = 32
+""")
+
+nested("hard")

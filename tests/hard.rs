@@ -360,7 +360,18 @@ fn total_internal_reflection_lets_nothing_out() {
 /// 4 standard errors of the difference + 1.5 %.
 #[test]
 fn a_furnace_of_every_material_never_gains_energy() {
-    let loaded = hard("furnace-materials.toml");
+    let objects = furnace_objects("furnace-materials.toml");
+    assert_eq!(objects.len(), 5, "{objects:?}");
+}
+
+/// Renders a white-furnace scene (Le = 1, albedo 0.5) with the path tracer (512 spp, paths of up
+/// to 64 bounces: light trapped between dielectric faces takes many) and both
+/// photon-mapping engines (32 spp) and checks, per object seen in at least 9 pixels whose 3 × 3
+/// neighbourhood sees only it: no mean exceeds 2 by more than 4 standard errors + 0.5 %, and both
+/// engines agree with the path tracer within 4 standard errors of the difference + 1.5 %.
+/// Returns the path tracer's (object, mean).
+fn furnace_objects(name: &str) -> Vec<(String, f64)> {
+    let loaded = hard(name);
     let scene = Arc::new(loaded.scene);
     let (w, h) = (32usize, 32usize);
     let rays = loaded.camera.unwrap().prepare(w as u32, h as u32).unwrap();
@@ -392,7 +403,7 @@ fn a_furnace_of_every_material_never_gains_energy() {
     let path = photonwave::reference::path::render_path_traced(
         &scene,
         &rays,
-        &Settings { spp: 512, ..s.clone() },
+        &Settings { spp: 512, max_depth: 64, ..s.clone() },
         &NoProgress,
     )
     .0;
@@ -402,28 +413,50 @@ fn a_furnace_of_every_material_never_gains_energy() {
             .materials
             .iter()
             .enumerate()
-            .map(|(m, mat)| {
+            .filter_map(|(m, mat)| {
                 let v: Vec<f32> =
                     (0..w * h).filter(|&i| seen[i] == Some(m as u32) && interior(i)).map(|i| grey[i]).collect();
-                assert!(v.len() >= 9, "{}: {} pixels", mat.name, v.len());
                 let (mean, se) = common::mean_and_se(&v);
-                (mat.name.clone(), mean, se)
+                (v.len() >= 9).then(|| (mat.name.clone(), mean, se))
             })
             .collect()
     };
     let truth = regions(&path);
-    for (name, mean, se) in &truth {
-        println!("path tracer, {name}: {mean:.4} ± {se:.4}");
-        assert!(*mean <= 2.0 + 4.0 * se + 0.01, "path tracer, {name}: {mean} > 2");
+    for (object, mean, se) in &truth {
+        println!("{name}, path tracer, {object}: {mean:.4} ± {se:.4}");
+        assert!(*mean <= 2.0 + 4.0 * se + 0.01, "{name}, path tracer, {object}: {mean} > 2");
     }
     for engine in ENGINES {
         let film = render(&scene, &rays, &s, engine, None, &NoProgress).unwrap().0;
-        for ((name, mean, se), (_, want, want_se)) in regions(&film).into_iter().zip(&truth) {
-            println!("{engine:?}, {name}: {mean:.4} ± {se:.4} (path tracer {want:.4})");
-            assert!(mean <= 2.0 + 4.0 * se + 0.01, "{engine:?}, {name}: {mean} > 2");
+        for ((object, mean, se), (_, want, want_se)) in regions(&film).into_iter().zip(&truth) {
+            println!("{name}, {engine:?}, {object}: {mean:.4} ± {se:.4} (path tracer {want:.4})");
+            assert!(mean <= 2.0 + 4.0 * se + 0.01, "{name}, {engine:?}, {object}: {mean} > 2");
             let tol = 4.0 * (se * se + want_se * want_se).sqrt() + 0.015 * want;
-            assert!((mean - want).abs() <= tol, "{engine:?}, {name}: {mean} against the path tracer's {want} ± {tol}");
+            assert!(
+                (mean - want).abs() <= tol,
+                "{name}, {engine:?}, {object}: {mean} against the path tracer's {want} ± {tol}"
+            );
         }
+    }
+    truth.into_iter().map(|(object, mean, _)| (object, mean)).collect()
+}
+
+/// Case 8: a glass slab under water in the white furnace, the boundary between them one face with
+/// `ior` 1.33 and `outside_ior` 1.5 (the documented model: one face per boundary, indices on both
+/// sides). Every surface is lossless, so radiance is 2 wherever the camera looks, through any
+/// number of interfaces (less the depth cut: the tolerance is 2 %; measured 0.6 % at most); nothing
+/// exceeds 2, on both engines and the path tracer (64 bounces). The same slabs
+/// closed each on its own put coincident faces of glass and water at the boundary, which the
+/// loader reports.
+#[test]
+fn nested_dielectrics_conserve_energy() {
+    assert!(hard("nested.toml").scene.warnings.is_empty());
+    let coincident = hard("nested-coincident.toml").scene.warnings;
+    assert!(coincident.iter().any(|w| w.contains("triangle pairs of `glass` and `water`")), "{coincident:?}");
+    let objects = furnace_objects("nested.toml");
+    assert!(objects.iter().any(|(o, _)| o == "water") && objects.iter().any(|(o, _)| o == "glass"), "{objects:?}");
+    for (object, mean) in objects {
+        assert!(mean > 2.0 * 0.98, "{object}: {mean}, not 2");
     }
 }
 
