@@ -99,6 +99,13 @@ def mtl(path, materials):
         for name, body in materials:
             f.write(f"\nnewmtl {name}\n{body.strip()}\n")
 
+def scene_toml(path, comment, mesh, camera, middle="", render_extra=""):
+    """Writes a bundled scene file: the comment, one [[mesh]], the [camera], then `middle` (lights,
+    materials: TOML text that starts with a blank line) and a 32 x 32 [render] table with
+    `render_extra` appended."""
+    with open(path, "w") as f:
+        f.write(f"{comment}\n[[mesh]]\n{mesh}\n\n[camera]\n{camera}\n{middle}\n[render]\nwidth = 32\nheight = 32\n{render_extra}")
+
 INTO_ROOM = None  # sentinel: walls face the room centre
 
 def cornell(obj, blocks=True):
@@ -189,28 +196,17 @@ def grazing(folder):
     for deg in (0, 60, 85, 89):
         t = math.radians(deg)
         d = (math.sin(t), -math.cos(t), 0.0)
-        with open(f"{folder}/grazing-{deg}.toml", "w") as f:
-            f.write(f"""# Grazing light, written by scenes/generate.py: a directional light {deg} degrees from the
+        scene_toml(f"{folder}/grazing-{deg}.toml", f'''# Grazing light, written by scenes/generate.py: a directional light {deg} degrees from the
 # plane's normal. Irradiance on the plane is cos({deg} deg) = {math.cos(t):.6f} of the perpendicular
-# irradiance (1), from light sampling and from photons alike; radiance 0.5 x that / pi.
-[[mesh]]
-file = "grazing.obj"
-
-[camera]
-eye = [0.0, 1.0, 0.0]
+# irradiance (1), from light sampling and from photons alike; radiance 0.5 x that / pi.''', f'file = "grazing.obj"', f'''eye = [0.0, 1.0, 0.0]
 target = [0.0, 0.0, 0.0]
 up = [0.0, 0.0, -1.0]
-fov = 40
-
+fov = 40''', f'''
 [[light]]
 type = "directional"
 direction = [{d[0]:.9f}, {d[1]:.9f}, {d[2]:.1f}]
 irradiance = [1, 1, 1]
-
-[render]
-width = 32
-height = 32
-""")
+''')
 
 grazing("hard")
 
@@ -231,20 +227,9 @@ def degenerate_light(folder):
                 "sampled with probability zero and change nothing") if variant else \
                ("a quad light over a floor; the reference for\n# emitter-degenerate.toml, which must "
                 "render the same image")
-        with open(f"{folder}/{name}.toml", "w") as f:
-            f.write(f"""# Degenerate emitter, written by scenes/generate.py: {what}.
-[[mesh]]
-file = "{name}.obj"
-
-[camera]
-eye = [0.0, 0.5, 1.8]
+        scene_toml(f"{folder}/{name}.toml", f'# Degenerate emitter, written by scenes/generate.py: {what}.', f'file = "{name}.obj"', f'''eye = [0.0, 0.5, 1.8]
 target = [0.0, 0.3, 0.0]
-fov = 50
-
-[render]
-width = 32
-height = 32
-""")
+fov = 50''')
 
 degenerate_light("hard")
 
@@ -272,23 +257,12 @@ def scaled_cornell(folder):
     scaled with it. Radiance does not change under a uniform scale (the light's radiance is fixed),
     so the three images must agree within noise."""
     for label, s in (("1e-4", 1e-4), ("1", 1.0), ("1e5", 1e5)):
-        with open(f"{folder}/scale-{label}.toml", "w") as f:
-            f.write(f"""# Scale, written by scenes/generate.py: the Cornell box with a mirror and a glass sphere,
+        scene_toml(f"{folder}/scale-{label}.toml", f'''# Scale, written by scenes/generate.py: the Cornell box with a mirror and a glass sphere,
 # scaled by {label} (camera too). Ray offsets and search radii are relative to the scene's size, so the
-# image must equal scale-1's within noise: no acne, no black rows, no lost caustic.
-[[mesh]]
-file = "../cornell-spheres.obj"
-scale = {s:.6g}
-
-[camera]
-eye = [0.0, {0.273 * s:.6g}, {1.0796 * s:.6g}]
+# image must equal scale-1's within noise: no acne, no black rows, no lost caustic.''', f'''file = "../cornell-spheres.obj"
+scale = {s:.6g}''', f'''eye = [0.0, {0.273 * s:.6g}, {1.0796 * s:.6g}]
 target = [0.0, {0.273 * s:.6g}, 0.0]
-fov = 39.3
-
-[render]
-width = 32
-height = 32
-""")
+fov = 39.3''')
 
 scaled_cornell("hard")
 
@@ -308,27 +282,16 @@ def ball_lens(folder):
     o.write(f"{folder}/ball-lens.obj")
     mtl(f"{folder}/ball-lens.mtl", [("glass", "illum 7\nNi 1.5"), ("black", "illum 1\nKd 0 0 0"),
                                     ("white", "illum 1\nKd 0.5 0.5 0.5")])
-    with open(f"{folder}/ball-lens.toml", "w") as f:
-        f.write("""# Ball lens, written by scenes/generate.py: a collimated beam (a directional light through a
+    scene_toml(f"{folder}/ball-lens.toml", '''# Ball lens, written by scenes/generate.py: a collimated beam (a directional light through a
 # 0.2 x 0.2 hole in a black plate) through a glass ball (n = 1.5, R = 1) focuses on the axis at
-# n R / (2 (n - 1)) = 1.5 from the centre (paraxial), where it meets the screen lying along the axis.
-[[mesh]]
-file = "ball-lens.obj"
-
-[camera]
-eye = [1.2, 0.8, -1.6]
+# n R / (2 (n - 1)) = 1.5 from the centre (paraxial), where it meets the screen lying along the axis.''', 'file = "ball-lens.obj"', '''eye = [1.2, 0.8, -1.6]
 target = [0.0, 0.0, -1.6]
-fov = 50
-
+fov = 50''', '''
 [[light]]
 type = "directional"
 direction = [0.0, 0.0, -1.0]
 irradiance = [1, 1, 1]
-
-[render]
-width = 32
-height = 32
-""")
+''')
 
 ball_lens("hard")
 
@@ -348,62 +311,40 @@ def total_internal_reflection(folder):
     materials = [("glass", "illum 7\nNi 1.5"), ("white", "illum 1\nKd 0.5 0.5 0.5")]
     mtl(f"{folder}/light-pipe.mtl", materials)
     t = math.radians(30)
-    with open(f"{folder}/light-pipe.toml", "w") as f:
-        f.write(f"""# Light pipe, written by scenes/generate.py: a spot 30 degrees off the axis of a glass rod
+    scene_toml(f"{folder}/light-pipe.toml", f'''# Light pipe, written by scenes/generate.py: a spot 30 degrees off the axis of a glass rod
 # (n = 1.5) lights its near end; inside, the beam meets the side faces at 70.5 degrees, past the
-# critical angle (41.8), and is reflected whole. Flux out of the far end = flux in x T(30)^2 / (1 - R(30)^2).
-[[mesh]]
-file = "light-pipe.obj"
-
-[camera]
-eye = [1.6, 0.9, -0.2]
+# critical angle (41.8), and is reflected whole. Flux out of the far end = flux in x T(30)^2 / (1 - R(30)^2).''', f'file = "light-pipe.obj"', f'''eye = [1.6, 0.9, -0.2]
 target = [0.0, 0.0, -1.9]
-fov = 50
-
+fov = 50''', f'''
 [[light]]
 type = "spot"
 position = [0.0, {0.5 * math.sin(t):.9f}, {1.0 + 0.5 * math.cos(t):.9f}]
 target = [0.0, 0.0, 1.0]
 intensity = [100, 100, 100]
 angle = 2
-
-[render]
-width = 32
-height = 32
-""")
+''')
     o = RawObj("tir-slab.mtl")
     o.box("slab", "glass", (-2, 0, -0.5), (2, 0.2, 0.5))
     o.quad("screen", "white", [(-1.9, 0.21, -0.5), (1.9, 0.21, -0.5), (1.9, 0.21, 0.5), (-1.9, 0.21, 0.5)], (0, -1, 0))
     o.write(f"{folder}/tir-slab.obj")
     mtl(f"{folder}/tir-slab.mtl", materials)
     t = math.radians(50)
-    with open(f"{folder}/tir-slab.toml", "w") as f:
-        f.write(f"""# Total internal reflection, written by scenes/generate.py: a spot inside a glass slab (n = 1.5)
+    scene_toml(f"{folder}/tir-slab.toml", f'''# Total internal reflection, written by scenes/generate.py: a spot inside a glass slab (n = 1.5)
 # aimed at the top face 50 degrees from its normal, past the critical angle (41.8): all of it is
-# reflected, and the screen just above the slab receives nothing.
-[[mesh]]
-file = "tir-slab.obj"
-
-[camera]
-eye = [0.0, 1.5, 2.5]
+# reflected, and the screen just above the slab receives nothing.''', f'file = "tir-slab.obj"', f'''eye = [0.0, 1.5, 2.5]
 target = [0.0, 0.1, 0.0]
-fov = 50
-
+fov = 50''', f'''
 [[light]]
 type = "spot"
 position = [0.0, 0.1, 0.0]
 target = [{math.sin(t):.9f}, {0.1 + math.cos(t):.9f}, 0.0]
 intensity = [100, 100, 100]
 angle = 2
-
-[render]
-width = 32
-height = 32
-# No photon can reach a diffuse surface here, so each photon pass ends at its cap of 256 paths
+''', f'''# No photon can reach a diffuse surface here, so each photon pass ends at its cap of 256 paths
 # per photon asked: small maps keep that short.
 photons = 1000
 caustic_photons = 1000
-""")
+''')
 
 total_internal_reflection("hard")
 
@@ -422,22 +363,11 @@ def furnace_materials(folder):
         ("furnace", "illum 1\nKd 0.5 0.5 0.5\nKe 1 1 1"), ("white", "illum 1\nKd 1 1 1"),
         ("mirror", "illum 3\nKs 1 1 1"), ("glass", "illum 7\nNi 1.5"),
         ("glossy", "illum 2\nKd 0.3 0.3 0.3\nKs 0.7 0.7 0.7\nNs 30")])
-    with open(f"{folder}/furnace-materials.toml", "w") as f:
-        f.write("""# Energy, written by scenes/generate.py: the white furnace (inside a closed sphere that emits
+    scene_toml(f"{folder}/furnace-materials.toml", '''# Energy, written by scenes/generate.py: the white furnace (inside a closed sphere that emits
 # Le = 1 and reflects 0.5) holding a white Lambertian, a mirror, a glass and a glossy sphere.
-# Radiance is 2 wherever every surface is lossless; no surface may return more than it receives.
-[[mesh]]
-file = "furnace-materials.obj"
-
-[camera]
-eye = [0.0, 0.0, 0.6]
+# Radiance is 2 wherever every surface is lossless; no surface may return more than it receives.''', 'file = "furnace-materials.obj"', '''eye = [0.0, 0.0, 0.6]
 target = [0.0, 0.0, -0.35]
-fov = 60
-
-[render]
-width = 32
-height = 32
-""")
+fov = 60''')
 
 furnace_materials("hard")
 
@@ -479,28 +409,17 @@ def watertight(folder):
         o.lines.append("f " + " ".join(str(vertex(p)) for p in f))
     o.write(f"{folder}/watertight.obj")
     mtl(f"{folder}/watertight.mtl", [("white", "illum 1\nKd 0.5 0.5 0.5")])
-    with open(f"{folder}/watertight.toml", "w") as f:
-        f.write("""# Watertight mesh, written by scenes/generate.py: a closed cube of grid-triangulated faces with
+    scene_toml(f"{folder}/watertight.toml", '''# Watertight mesh, written by scenes/generate.py: a closed cube of grid-triangulated faces with
 # a strip of 1e-6-wide sliver triangles and a zero-area triangle per face, lit from inside by a
 # point light. Rays at its shared edges and vertices never slip out, packet and scalar traversal
-# agree, and every photon lands inside.
-[[mesh]]
-file = "watertight.obj"
-
-[camera]
-eye = [0.6, 0.5, 0.7]
+# agree, and every photon lands inside.''', 'file = "watertight.obj"', '''eye = [0.6, 0.5, 0.7]
 target = [-1.0, -1.0, -1.0]
-fov = 70
-
+fov = 70''', '''
 [[light]]
 type = "point"
 position = [0.1, 0.2, 0.05]
 intensity = [1, 1, 1]
-
-[render]
-width = 32
-height = 32
-""")
+''')
 
 watertight("hard")
 
@@ -513,27 +432,16 @@ def corner(folder):
     o.quad("wall", "half", [(0, 0, -1), (0, 2, -1), (0, 2, 1), (0, 0, 1)], (1, 0, 0))
     o.write(f"{folder}/corner.obj")
     mtl(f"{folder}/corner.mtl", [("half", "illum 1\nKd 0.5 0.5 0.5")])
-    with open(f"{folder}/corner.toml", "w") as f:
-        f.write("""# Corner leak, written by scenes/generate.py: a lit floor meets a wall that the light (straight
+    scene_toml(f"{folder}/corner.toml", '''# Corner leak, written by scenes/generate.py: a lit floor meets a wall that the light (straight
 # down, parallel to the wall) never reaches directly. No photon of the floor may be counted on the
-# wall, or the wall's foot would glow with the floor's direct light.
-[[mesh]]
-file = "corner.obj"
-
-[camera]
-eye = [1.8, 1.0, 0.0]
+# wall, or the wall's foot would glow with the floor's direct light.''', 'file = "corner.obj"', '''eye = [1.8, 1.0, 0.0]
 target = [0.0, 0.3, 0.0]
-fov = 60
-
+fov = 60''', '''
 [[light]]
 type = "directional"
 direction = [0.0, -1.0, 0.0]
 irradiance = [1, 1, 1]
-
-[render]
-width = 32
-height = 32
-""")
+''')
 
 corner("hard")
 
@@ -547,23 +455,12 @@ def numerics(folder):
     o.quad("light", "light", [(-0.25, 1, -0.25), (0.25, 1, -0.25), (0.25, 1, 0.25), (-0.25, 1, 0.25)], (0, -1, 0))
     o.write(f"{folder}/numerics.obj")
     mtl(f"{folder}/numerics.mtl", [("half", "illum 1\nKd 0.5 0.5 0.5"), ("light", "illum 1\nKd 0 0 0\nKe 1e38 1e38 1e38")])
-    with open(f"{folder}/numerics.toml", "w") as f:
-        f.write("""# NaN and Inf, written by scenes/generate.py: emitter.toml's floor and light, but every floor vertex
+    scene_toml(f"{folder}/numerics.toml", '''# NaN and Inf, written by scenes/generate.py: emitter.toml's floor and light, but every floor vertex
 # normal has zero length (replaced by the face's normal, counted at load) and the light emits 1e38
 # (a pixel's sum of samples overflows f32 and is averaged sample by sample, counted). The image
-# must be 2.5e37 times emitter.toml's (emission 4), and finite.
-[[mesh]]
-file = "numerics.obj"
-
-[camera]
-eye = [0.0, 0.5, 1.8]
+# must be 2.5e37 times emitter.toml's (emission 4), and finite.''', 'file = "numerics.obj"', '''eye = [0.0, 0.5, 1.8]
 target = [0.0, 0.3, 0.0]
-fov = 50
-
-[render]
-width = 32
-height = 32
-""")
+fov = 50''')
 
 numerics("hard")
 
@@ -613,20 +510,9 @@ outside_ior = 1.5
                 "loader warns; which face a ray meets there is arbitrary") if variant else \
                ("the boundary between them one face with ior 1.33 and outside_ior 1.5: radiance is\n# "
                 "2 through every path, as everywhere in the furnace")
-        with open(f"{folder}/nested{variant}.toml", "w") as f:
-            f.write(f"""# Nested dielectrics, written by scenes/generate.py: in the white furnace (Le = 1, albedo 0.5), a
-# glass slab (n = 1.5) under water (n = 1.33), {what}.
-[[mesh]]
-file = "nested{variant}.obj"
-
-[camera]
-eye = [0.0, 0.55, 0.75]
+        scene_toml(f"{folder}/nested{variant}.toml", f'''# Nested dielectrics, written by scenes/generate.py: in the white furnace (Le = 1, albedo 0.5), a
+# glass slab (n = 1.5) under water (n = 1.33), {what}.''', f'file = "nested{variant}.obj"', f'''eye = [0.0, 0.55, 0.75]
 target = [0.0, -0.1, 0.0]
-fov = 50
-{boundary}
-[render]
-width = 32
-height = 32
-""")
+fov = 50''', f'{boundary}')
 
 nested("hard")
