@@ -220,9 +220,11 @@ fn glossy_diffuse_probability(kd: Vec3, ks: Vec3) -> f32 {
     }
 }
 
-/// Normalised Phong lobe `(n+2)/(2π)·cos^n α` around `r`.
+/// Normalised Phong lobe `(n+2)/(2π)·cos^n α` around `r`. The cosine of two unit vectors can
+/// round above 1; clamped, so that a huge exponent (an MTL's `Ns 1e30`) gives cos^n ≤ 1, not ∞
+/// (and ∞/∞ = NaN sample weights).
 fn phong_lobe(r: Vec3, wi: Vec3, n: f32) -> f32 {
-    let c = r.dot(wi);
+    let c = r.dot(wi).min(1.0);
     if c <= 0.0 {
         0.0
     } else {
@@ -230,9 +232,9 @@ fn phong_lobe(r: Vec3, wi: Vec3, n: f32) -> f32 {
     }
 }
 
-/// Pdf of [`sample_phong`]: `(n+1)/(2π)·cos^n α`.
+/// Pdf of [`sample_phong`]: `(n+1)/(2π)·cos^n α` (the cosine clamped as in [`phong_lobe`]).
 fn phong_pdf(r: Vec3, wi: Vec3, n: f32) -> f32 {
-    let c = r.dot(wi);
+    let c = r.dot(wi).min(1.0);
     if c <= 0.0 {
         0.0
     } else {

@@ -179,3 +179,46 @@ fn rays_through_a_shared_edge_hit_one_side() {
         })
         .unwrap();
 }
+
+/// 20 000 BSDF samples and evaluations of every material kind, with extreme parameters (Phong
+/// exponents 0 to 10³⁰, albedos at their edges, indices of refraction 0.01 to 100), grazing and
+/// exactly tangent directions, and shading normals that are zero, NaN, opposite to or
+/// perpendicular to the geometric normal: a sample is absent (a zero pdf, absorption) or has a
+/// finite direction and a finite, non-negative weight; evaluations are finite and non-negative.
+/// Nothing non-finite can leave a BSDF for the film or a photon map.
+#[test]
+fn bsdf_samples_are_finite_or_absent() {
+    use photonwave::material::{Bsdf, SurfaceFrame, Transport};
+    let unit = || prop::array::uniform3(-1.0f32..1.0).prop_map(|v| Vec3::from(v).normalize_or(Vec3::Y));
+    let exponent = prop_oneof![Just(0.0f32), Just(1.0), Just(1e4), Just(1e30), 0.0f32..1000.0];
+    let albedo = || prop_oneof![Just(0.0f32), Just(1.0), 0.0f32..1.0];
+    let ior = prop_oneof![Just(1.0f32), Just(1.5), Just(0.01), Just(100.0), 0.5f32..3.0];
+    let bsdf = (0u8..4, albedo(), albedo(), exponent, ior).prop_map(|(kind, a, b, exponent, ior)| match kind {
+        0 => Bsdf::Lambert { kd: Vec3::splat(a) },
+        1 => Bsdf::Glossy { kd: Vec3::splat(a * (1.0 - b)), ks: Vec3::splat(b), exponent },
+        2 => Bsdf::Mirror { ks: Vec3::splat(a) },
+        _ => Bsdf::Glass { ior },
+    });
+    let shading = prop_oneof![
+        Just(Vec3::ZERO),
+        Just(Vec3::NAN),
+        unit(),
+        Just(Vec3::X), // perpendicular to ng = Y
+        Just(-Vec3::Y),
+    ];
+    let wo = prop_oneof![unit(), Just(Vec3::X), Just(Vec3::new(1.0, 1e-7, 0.0).normalize())];
+    let u = prop::array::uniform3(prop_oneof![Just(0.0f32), Just(1.0 - f32::EPSILON), 0.0f32..1.0]);
+    runner(20_000, 13)
+        .run(&(bsdf, shading, wo, u, any::<bool>()), |(bsdf, ns, wo, u, power)| {
+            let frame = SurfaceFrame { ng: Vec3::Y, ns };
+            let transport = if power { Transport::Power } else { Transport::Radiance };
+            if let Some(s) = bsdf.sample(&frame, wo, u, transport) {
+                prop_assert!(s.wi.is_finite() && (s.wi.length() - 1.0).abs() < 1e-3, "{bsdf:?}: direction {}", s.wi);
+                prop_assert!(s.weight.is_finite() && s.weight.min_element() >= 0.0, "{bsdf:?}: weight {}", s.weight);
+                let f = bsdf.eval(&frame, wo, s.wi);
+                prop_assert!(f.is_finite() && f.min_element() >= 0.0, "{bsdf:?}: f {f}");
+            }
+            Ok(())
+        })
+        .unwrap();
+}
