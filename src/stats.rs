@@ -80,6 +80,9 @@ pub struct Numerics {
     pub camera_samples: u64,
     /// Film: pixels whose sum of samples overflowed f32, averaged sample by sample instead.
     pub pixel_overflow: u64,
+    /// Photon tracing: rays that hit nothing although the geometry is closed around every light
+    /// (a leak; counted only in such scenes, where missing everything is impossible).
+    pub photon_escaped: u64,
 }
 
 impl std::ops::AddAssign for Numerics {
@@ -89,6 +92,7 @@ impl std::ops::AddAssign for Numerics {
         self.photon_scatter += o.photon_scatter;
         self.camera_samples += o.camera_samples;
         self.pixel_overflow += o.pixel_overflow;
+        self.photon_escaped += o.photon_escaped;
     }
 }
 
@@ -195,7 +199,8 @@ impl RenderStats {
             "summary ({} engine, {} kernels, {} threads)\n{}{}  rays: {} total ({} camera, {} shadow, {} gather, {} photon)\n  \
              time: load {:.2} s, global photons {:.2} s, caustic photons {:.2} s, maps {:.2} s, camera {:.2} s, total {:.2} s\n  \
              non-finite values dropped: {} photon emissions, {} photon bounces, {} camera samples; \
-             {} pixel sums overflowed; {} vertex normals replaced at load\n",
+             {} pixel sums overflowed; {} vertex normals replaced at load; {} photon rays escaped a \
+             closed scene\n",
             self.engine,
             self.kernels,
             self.threads,
@@ -217,6 +222,7 @@ impl RenderStats {
             self.numerics.camera_samples,
             self.numerics.pixel_overflow,
             self.numerics.load_normals,
+            self.numerics.photon_escaped,
         ) + &self.progressive_summary()
             + &self.stage_summary()
     }

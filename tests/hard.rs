@@ -574,3 +574,53 @@ fn huge_emission_and_zero_normals_stay_finite_and_counted() {
         }
     }
 }
+
+/// `--stats` counts photon rays that leave a scene whose closed geometry holds every light (a
+/// leak). Closedness (no edge borders a single triangle) and inside-ness (the parity of a ray's
+/// crossings of each closed piece, for point lights and the front of each emitter) are found at
+/// load: these scenes enclose their lights, and not one of their photon rays escapes on either
+/// engine; open scenes, or a directional light, turn the count off. The counting itself: marking
+/// the open emitter.toml as enclosed, both engines count the same escaping rays.
+#[test]
+fn photon_rays_escaping_a_closed_scene_are_counted() {
+    let s = Settings {
+        width: 8,
+        height: 8,
+        spp: 1,
+        photons: 20_000,
+        caustic_photons: 5_000,
+        gather_rays: 2,
+        ..Default::default()
+    };
+    for (name, enclosed) in [
+        ("watertight.toml", true),
+        ("light-in-glass.toml", true),
+        ("furnace-materials.toml", true),
+        ("nested.toml", true),
+        ("thin-wall.toml", true),
+        ("emitter.toml", false),
+        ("tir-slab.toml", false),
+        ("ball-lens.toml", false),
+    ] {
+        let loaded = hard(name);
+        assert_eq!(loaded.scene.encloses_lights, enclosed, "{name}");
+        if !enclosed {
+            continue;
+        }
+        let rays = loaded.camera.unwrap().prepare(8, 8).unwrap();
+        let scene = Arc::new(loaded.scene);
+        for engine in ENGINES {
+            let (_, stats) = render(&scene, &rays, &s, engine, None, &NoProgress).unwrap();
+            assert_eq!(stats.numerics.photon_escaped, 0, "{name}, {engine:?}");
+        }
+    }
+    let loaded = hard("emitter.toml");
+    let mut scene = loaded.scene;
+    scene.encloses_lights = true;
+    let (scene, rays) = (Arc::new(scene), loaded.camera.unwrap().prepare(8, 8).unwrap());
+    let counts: Vec<u64> = ENGINES
+        .iter()
+        .map(|&e| render(&scene, &rays, &s, e, None, &NoProgress).unwrap().1.numerics.photon_escaped)
+        .collect();
+    assert!(counts[0] > 1_000 && counts[0] == counts[1], "{counts:?}");
+}

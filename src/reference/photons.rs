@@ -220,7 +220,10 @@ pub fn trace_path(
     let s = Sampler::new(settings.seed, domain, index);
     for bounce in 0..settings.max_depth {
         *rays += 1;
-        let Some(hit) = scene.intersect(photon.origin, photon.dir, f32::INFINITY) else { break };
+        let Some(hit) = scene.intersect(photon.origin, photon.dir, f32::INFINITY) else {
+            numerics.photon_escaped += u64::from(scene.encloses_lights);
+            break;
+        };
         let sp = scene.surface(&hit);
         let bsdf = scene.materials[sp.material as usize].bsdf;
         if !bsdf.is_delta() && !deposit_photon(domain, &sp, &photon, bounce, out) {

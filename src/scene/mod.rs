@@ -10,7 +10,7 @@ pub mod validate;
 
 use crate::error::{Error, Result};
 use crate::geometry::bvh::TriangleColumns;
-use crate::geometry::offset::barycentric_error;
+use crate::geometry::offset::{barycentric_error, offset_ray_origin};
 use crate::geometry::{Bvh, Hit};
 use crate::material::{Bsdf, Material, SurfaceFrame};
 use crate::sampling::Distribution1D;
@@ -85,6 +85,10 @@ pub struct Scene {
     pub dropped_degenerate: usize,
     /// Vertex normals given with zero length (their faces use the geometric normal there).
     pub replaced_normals: u64,
+    /// Whether the geometry is closed (no edge borders a single triangle) with
+    /// every light inside it (point and spot lights, and the front of every emitter) and no
+    /// directional light: a photon ray that then hits nothing has leaked through the geometry.
+    pub encloses_lights: bool,
     /// Non-fatal observations made while loading.
     pub warnings: Vec<String>,
     bvh: Bvh,
@@ -268,6 +272,7 @@ impl Scene {
             bounds: (lo, hi),
             dropped_degenerate: dropped,
             replaced_normals,
+            encloses_lights: false,
             warnings,
             bvh,
             kinds: (false, false, false),
@@ -313,7 +318,70 @@ impl Scene {
         scene.delta_lights = (0..scene.lights.len() as u32).filter(|&i| scene.lights[i as usize].is_delta()).collect();
         let area_w: Vec<f64> = scene.area_lights.iter().map(|&i| powers[i as usize]).collect();
         scene.area_power = Distribution1D::try_new(&area_w);
+        scene.encloses_lights = scene.find_enclosure();
         Ok(scene)
+    }
+
+    /// [`Scene::encloses_lights`]: closed (no edge borders one triangle alone), then each light tested for being inside
+    /// one of the closed pieces (connected by shared edges) by the parity of a ray's crossings of
+    /// that piece — per piece, so that a light inside a glass ball inside a room counts.
+    fn find_enclosure(&self) -> bool {
+        if self.p0.is_empty() || self.lights.iter().any(|l| matches!(l, Light::Directional { .. })) {
+            return false;
+        }
+        let n = self.p0.len();
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        fn root(parent: &mut [u32], mut i: u32) -> u32 {
+            while parent[i as usize] != i {
+                parent[i as usize] = parent[parent[i as usize] as usize];
+                i = parent[i as usize];
+            }
+            i
+        }
+        let mut edges: std::collections::HashMap<([u32; 3], [u32; 3]), (u32, u32)> = std::collections::HashMap::new();
+        for i in 0..n {
+            let v = [self.p0[i], self.p1[i], self.p2[i]].map(|p| p.to_array().map(f32::to_bits));
+            for (a, b) in [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])] {
+                let e = edges.entry(if a < b { (a, b) } else { (b, a) }).or_insert((i as u32, 0));
+                e.1 += 1;
+                let (x, y) = (root(&mut parent, e.0), root(&mut parent, i as u32));
+                parent[x as usize] = y;
+            }
+        }
+        // Closed: no edge borders a single triangle (three faces may meet at an edge, as at the
+        // rim of a boundary between two dielectrics).
+        if edges.values().any(|&(_, count)| count < 2) {
+            return false;
+        }
+        let piece: Vec<u32> = (0..n as u32).map(|i| root(&mut parent, i)).collect();
+        self.lights.iter().all(|l| match *l {
+            Light::Point { position, .. } | Light::Spot { position, .. } => self.inside(position, &piece),
+            Light::Area { tri, .. } => {
+                let i = tri as usize;
+                let c = (self.p0[i] + self.p1[i] + self.p2[i]) / 3.0;
+                let lo = c.abs().max_element().max(self.diagonal()) * 1e-5;
+                self.inside(c + self.ng[i] * lo, &piece)
+            }
+            Light::Directional { .. } => false,
+        })
+    }
+
+    /// Whether `p` is inside one of the closed pieces (`piece[triangle]`): an odd number of that
+    /// piece's surfaces along a ray from `p`.
+    fn inside(&self, p: Vec3, piece: &[u32]) -> bool {
+        // A direction unlikely to graze an edge or lie in a face of modelled geometry.
+        let d = Vec3::new(0.536_2, 0.612_7, 0.580_5).normalize();
+        let mut crossings = std::collections::HashMap::<u32, u32>::new();
+        let mut o = p;
+        for _ in 0..100_000 {
+            let Some(hit) = self.intersect(o, d, f32::INFINITY) else {
+                return crossings.values().any(|c| c % 2 == 1);
+            };
+            *crossings.entry(piece[hit.tri as usize]).or_default() += 1;
+            let sp = self.surface(&hit);
+            o = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, d);
+        }
+        false
     }
 
     /// Vertex columns for intersection.

@@ -30,6 +30,9 @@ pub fn classify_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut s
     let t = Instant::now();
     let w = &mut *work;
     classify(&shared.scene, &w.queue.hits, &mut w.classified);
+    if shared.scene.encloses_lights {
+        w.numerics.photon_escaped += w.classified.escaped.len() as u64;
+    }
     stats.record("classify_photons", w.queue.len(), t);
 }
 
