@@ -134,10 +134,17 @@ fn coincident_dielectrics(
         if !faces.iter().any(|&i| glass(mat[i])) || faces.iter().all(|&i| mat[i] == mat[faces[0]]) {
             continue;
         }
-        for (k, &i) in faces.iter().enumerate() {
-            for &j in &faces[k + 1..] {
+        // Each dielectric face against every face of another material in its plane (not all
+        // pairs: a large floor sharing the plane of one glass face stays linear). Planes that
+        // would take more than 10⁷ tests are left unchecked.
+        let dielectric = faces.iter().filter(|&&i| glass(mat[i])).count();
+        if dielectric * faces.len() > 10_000_000 {
+            continue;
+        }
+        for &i in faces.iter().filter(|&&i| glass(mat[i])) {
+            for &j in faces {
                 let (a, b) = (&materials[mat[i] as usize], &materials[mat[j] as usize]);
-                if a.name == b.name || !(glass(mat[i]) || glass(mat[j])) {
+                if a.name == b.name || (glass(mat[j]) && j < i) {
                     continue;
                 }
                 // The centroid and three points toward the corners (a centroid alone can sit on
