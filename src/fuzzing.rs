@@ -57,9 +57,12 @@ pub fn scene_files(dir: &Path, toml: &[u8], obj: &[u8], mtl: &[u8]) -> Result<()
 
 /// Two triangles sharing the edge (a, b), wound as in a closed mesh — (a, b, c1) and (b, a, c2) —
 /// and a ray from `o` toward `target`, a point of the edge, with direction `target − o`
-/// (unnormalised, as shadow rays have) or its unit vector. When `o` lies inside the wedge of the
-/// two triangles, watertight intersection must hit one of them at t > 0; packet and scalar
-/// traversal must return the same hit in any case.
+/// (unnormalised, as shadow rays have) or its unit vector. Packet and scalar traversal must
+/// return the same hit. When the case is well conditioned — `target` in the middle half of the
+/// edge, both wings at least half as long as the edge, `o` inside their wedge and clear of both
+/// faces' planes — watertight intersection must also hit one of them at t > 0. (Two triangles
+/// alone do not close the space: near a vertex, or beside a face seen edge-on that is thinner
+/// than f32 resolves, a ray may rightly pass where a closed mesh has its other faces.)
 pub fn edge_ray(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3, target: Vec3, normalise: bool) -> Result<(), String> {
     let d = if normalise { (target - o).normalize_or_zero() } else { target - o };
     let (p0, p1, p2) = ([a, b], [b, a], [c1, c2]);
@@ -74,17 +77,23 @@ pub fn edge_ray(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3, target: Vec3, nor
     if scalar != packet {
         return Err(format!("{:?}: scalar {:?}, packet {:?}", rays[0], scalar[0], packet[0]));
     }
-    if in_wedge(a, b, c1, c2, o) && !scalar[0].is_some_and(|h| h.t > 0.0) {
+    if well_conditioned(a, b, c1, c2, o, target) && !scalar[0].is_some_and(|h| h.t > 0.0) {
         return Err(format!("{:?} slipped through the edge {a}–{b} (wings {c1}, {c2})", rays[0]));
     }
     Ok(())
 }
 
-/// Whether `o` lies strictly inside the wedge bounded by the half-planes through the line (a, b)
-/// toward `c1` and `c2` (an open dihedral angle below 180°), well away from both.
-fn in_wedge(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3) -> bool {
-    let e = (b - a).normalize_or_zero();
+/// The conditions of [`edge_ray`]'s hit property: `target` in the middle half of the edge, both
+/// wings at least half the edge's length from its line, and `o` inside the wedge they bound (an
+/// open dihedral angle below 180°), with both wing directions weighing at least a tenth in it.
+fn well_conditioned(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3, target: Vec3) -> bool {
+    let edge = b - a;
+    let (len, e) = (edge.length(), edge.normalize_or_zero());
+    let s = (target - a).dot(e) / len;
     let perp = |p: Vec3| (p - a) - e * (p - a).dot(e);
+    if !(0.25..=0.75).contains(&s) || perp(c1).length() < 0.5 * len || perp(c2).length() < 0.5 * len {
+        return false;
+    }
     let (u1, u2, v) = (perp(c1).normalize_or_zero(), perp(c2).normalize_or_zero(), perp(o));
     if u1 == Vec3::ZERO || u2 == Vec3::ZERO || v.length() == 0.0 || u1.dot(u2).abs() > 0.95 {
         return false;
@@ -94,6 +103,6 @@ fn in_wedge(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3) -> bool {
     let (x, y) = (v.dot(u1), v.dot(u2));
     let det = 1.0 - g * g;
     let (alpha, beta) = ((x - g * y) / det, (y - g * x) / det);
-    let margin = 0.01 * v.length();
+    let margin = 0.1 * v.length();
     alpha > margin && beta > margin
 }
