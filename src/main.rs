@@ -206,6 +206,10 @@ struct RenderArgs {
     /// Read the global map directly at the first diffuse hit instead of final gathering.
     #[arg(long)]
     no_final_gather: bool,
+    /// Count only photons visible from each estimate's point (no light through thin walls; one
+    /// short occlusion ray per candidate photon) [off, or the scene file's `visibility`].
+    #[arg(long)]
+    visibility: bool,
     /// Force a part of the effects plan on even where the scene does not need it (repeatable):
     /// caustic_map, global_map, final_gather, refraction, shadow_rays.
     #[arg(long)]
@@ -331,6 +335,7 @@ fn render(args: RenderArgs) -> Result<()> {
     if args.no_final_gather {
         settings.final_gather = false;
     }
+    settings.visibility |= args.visibility;
     settings.validate()?;
     let fov = args.fov.or(loaded.camera.map(|c| c.fov_deg)).unwrap_or(40.0);
     let mut camera = loaded.camera.unwrap_or_else(|| fitted_camera(&scene, fov));

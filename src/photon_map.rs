@@ -540,9 +540,19 @@ impl PhotonMap {
             return Estimate { radius: q.r_max, ..Default::default() };
         }
         self.nearest(set, q, scratch);
-        let (r2, skip) = if scratch.len() == q.k {
+        let Some(r2) = Self::knn_radius2(q, scratch) else {
+            return Estimate { radius: 0.0, ..Default::default() };
+        };
+        self.sum_estimate(set, q, r2, f, scratch)
+    }
+
+    /// The squared radius of a k-nearest estimate over `found` (the k-th photon's distance, that
+    /// photon removed: it lies on the boundary; or `q.r_max`² when fewer were found); `None`
+    /// for a zero radius.
+    fn knn_radius2(q: &Lookup, found: &mut Vec<(f32, u32)>) -> Option<f32> {
+        let (r2, skip) = if found.len() == q.k {
             // The k-th photon defines r and lies on the boundary: sum the other k − 1.
-            let (far_i, far) = scratch
+            let (far_i, far) = found
                 .iter()
                 .enumerate()
                 .max_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
@@ -553,16 +563,58 @@ impl PhotonMap {
             (q.r_max * q.r_max, None)
         };
         if !(r2 > 0.0) {
-            return Estimate { radius: 0.0, ..Default::default() };
+            return None;
         }
         if let Some(j) = skip {
-            scratch.swap_remove(j);
+            found.swap_remove(j);
         }
+        Some(r2)
+    }
+
+    /// The kernel estimate over `found` within squared radius `r2`.
+    fn sum_estimate(&self, set: KernelSet, q: &Lookup, r2: f32, f: Reflectance<'_>, found: &[(f32, u32)]) -> Estimate {
         let sum = match set {
-            KernelSet::Scalar => self.sum_scalar(scratch, r2, q.kernel, f),
-            KernelSet::Simd => self.sum_simd(scratch, r2, q.kernel, f),
+            KernelSet::Scalar => self.sum_scalar(found, r2, q.kernel, f),
+            KernelSet::Simd => self.sum_simd(found, r2, q.kernel, f),
         };
-        Estimate { radiance: sum * q.kernel.normalisation(r2), radius: r2.sqrt(), count: scratch.len() as u32 }
+        Estimate { radiance: sum * q.kernel.normalisation(r2), radius: r2.sqrt(), count: found.len() as u32 }
+    }
+
+    /// [`Self::estimate`] (or, with `q.k == 0`, [`Self::estimate_radius`]) counting only the
+    /// photons for which `visible(position, normal)` holds. The radius is chosen among all
+    /// photons, as without the test: where every photon near a point lies behind a wall, the
+    /// estimate there is zero.
+    pub fn estimate_visible(
+        &self,
+        set: KernelSet,
+        q: &Lookup,
+        f: Reflectance<'_>,
+        scratch: &mut Vec<(f32, u32)>,
+        visible: &dyn Fn(Vec3, Vec3) -> bool,
+    ) -> Estimate {
+        if self.is_empty() {
+            return Estimate { radius: q.r_max, ..Default::default() };
+        }
+        let r2 = if q.k == 0 {
+            // Every photon within the fixed radius (a bound no search reaches).
+            self.nearest(set, &Lookup { k: u32::MAX as usize, ..*q }, scratch);
+            let r2 = q.r_max * q.r_max;
+            if !(r2 > 0.0) || !r2.is_finite() {
+                return Estimate { radius: q.r_max, ..Default::default() };
+            }
+            r2
+        } else {
+            self.nearest(set, q, scratch);
+            let Some(r2) = Self::knn_radius2(q, scratch) else {
+                return Estimate { radius: 0.0, ..Default::default() };
+            };
+            r2
+        };
+        scratch.retain(|&(_, i)| {
+            let key = self.key[i as usize];
+            visible(self.position(i as usize), key_normal(key).normalize_or_zero())
+        });
+        self.sum_estimate(set, q, r2, f, scratch)
     }
 
     /// Reflected radiance at `q.p` from every photon within the fixed radius `q.r_max`.
@@ -744,6 +796,47 @@ mod tests {
 
     fn photon(x: f32, z: f32, power: f32) -> Photon {
         Photon { position: Vec3::new(x, 0.0, z), power: Vec3::splat(power), wi: Vec3::Y, normal: Vec3::Y, flags: 0 }
+    }
+
+    /// `estimate_visible` with every photon visible is the plain estimate (the same photons; the
+    /// fixed-radius sum in another order, so to 1e-6), with none visible it is zero,
+    /// and with half the plane hidden it keeps the radius and loses the hidden photons.
+    #[test]
+    fn visible_estimates_filter_photons_and_keep_the_radius() {
+        let photons: Vec<Photon> =
+            (0..400).map(|i| photon((i % 20) as f32 * 0.05 - 0.5, (i / 20) as f32 * 0.05 - 0.5, 1.0)).collect();
+        let map = PhotonMap::build(photons);
+        let f = Reflectance::Constant(Vec3::ONE);
+        let mut scratch = Vec::new();
+        for set in [KernelSet::Scalar, KernelSet::Simd] {
+            for (k, r) in [(20usize, 0.3f32), (0, 0.2)] {
+                let q = Lookup {
+                    p: Vec3::ZERO,
+                    k,
+                    r_max: r,
+                    kernel: Kernel::Box,
+                    filter: Filter { n: Vec3::Y, flags_mask: 0 },
+                };
+                let plain =
+                    if k == 0 { map.estimate_radius(set, &q, f) } else { map.estimate(set, &q, f, &mut scratch) };
+                let all = map.estimate_visible(set, &q, f, &mut scratch, &|_, _| true);
+                assert_eq!(all.count, plain.count, "{set:?}, k {k}");
+                assert!(
+                    (all.radiance - plain.radiance).abs().max_element() <= 1e-6 * plain.radiance.x,
+                    "{set:?}, k {k}"
+                );
+                let none = map.estimate_visible(set, &q, f, &mut scratch, &|_, _| false);
+                assert_eq!((none.radiance, none.count), (Vec3::ZERO, 0), "{set:?}, k {k}");
+                let half = map.estimate_visible(set, &q, f, &mut scratch, &|p, _| p.x < 0.0);
+                assert_eq!(half.radius, plain.radius, "{set:?}, k {k}");
+                assert!(
+                    half.count > 0 && half.count < plain.count,
+                    "{set:?}, k {k}: {} of {}",
+                    half.count,
+                    plain.count
+                );
+            }
+        }
     }
 
     /// Photons that all carry one power (as Russian roulette makes them) decode, on average, to

@@ -90,6 +90,12 @@ pub struct Settings {
     /// estimate there when final gathering is off; gather and glossy rays use the map's radius.
     /// `false`: one radius per map and pass everywhere.
     pub per_pixel_radii: bool,
+    /// Density estimates count only the photons visible from the query point (one short
+    /// occlusion ray per candidate photon, both lifted off their surfaces), and a precomputed
+    /// irradiance point is read only where visible. No light then reaches through a wall
+    /// thinner than the search radius (scenes/hard/thin-wall.toml), at a cost measured in
+    /// BENCHMARKS.md. Off by default.
+    pub visibility: bool,
     /// Set by the progressive driver for one pass: estimate every photon within these radii
     /// (scene units) instead of the k nearest. Not a user setting.
     #[serde(skip)]
@@ -171,6 +177,7 @@ impl Default for Settings {
             passes: 1,
             alpha: 2.0 / 3.0,
             per_pixel_radii: true,
+            visibility: false,
             fixed_radii: None,
         }
     }

@@ -315,10 +315,26 @@ fn map_estimate(
         Bsdf::Lambert { kd } => Reflectance::Hemisphere { value: kd * std::f32::consts::FRAC_1_PI, ng },
         _ => Reflectance::PerPhoton(&eval),
     };
-    match fixed {
-        Some(r) => map.estimate_radius(ctx.settings.kernels, &Lookup { r_max: r, ..lookup }, f).radiance,
-        None => map.estimate(ctx.settings.kernels, &lookup, f, scratch).radiance,
+    let set = ctx.settings.kernels;
+    match (fixed, ctx.settings.visibility) {
+        (Some(r), false) => map.estimate_radius(set, &Lookup { r_max: r, ..lookup }, f).radiance,
+        (None, false) => map.estimate(set, &lookup, f, scratch).radiance,
+        (fixed, true) => {
+            let lookup = fixed.map_or(lookup, |r| Lookup { r_max: r, k: 0, ..lookup });
+            let visible = photon_visibility(ctx.scene, sp.p, ng, lookup.r_max);
+            map.estimate_visible(set, &lookup, f, scratch, &visible).radiance
+        }
     }
+}
+
+/// Whether a photon (position, normal) is visible from the point `q` (normal `n`, on the side
+/// the estimate looks from), for [`Settings::visibility`]: the segment between them, both lifted
+/// off their surfaces by 10⁻³ of the search radius `r` (far above rounding, far below any wall
+/// worth stopping light), meets nothing.
+pub fn photon_visibility(scene: &Scene, q: Vec3, n: Vec3, r: f32) -> impl Fn(Vec3, Vec3) -> bool + '_ {
+    let lift = 1e-3 * r;
+    let from = q + n * lift;
+    move |p, m| !scene.occluded(from, p + m * lift - from, 1.0)
 }
 
 /// Caustic-map radiance estimate at `sp` toward `wo`; `pixel` when `sp` is a camera path's first
@@ -441,7 +457,11 @@ pub fn map_radiance(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, scr
         };
         irr.nearest(ctx.settings.kernels, &lookup, scratch);
         if let Some(&(_, i)) = scratch.first() {
-            return *kd * std::f32::consts::FRAC_1_PI * irr.power(i as usize);
+            // With visibility on, a point behind a wall is not read: the full estimate below is.
+            let p = irr.photon(i as usize);
+            if !ctx.settings.visibility || photon_visibility(ctx.scene, sp.p, ng, lookup.r_max)(p.position, p.normal) {
+                return *kd * std::f32::consts::FRAC_1_PI * irr.power(i as usize);
+            }
         }
     }
     global_estimate(ctx, sp, bsdf, wo, 0, None, scratch)

@@ -106,7 +106,12 @@ fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings,
                         filter: Filter { n: src.normal, flags_mask: 0 },
                     };
                     let f = Reflectance::Constant(Vec3::ONE);
-                    let e = global.estimate(settings.kernels, &lookup, f, &mut scratch);
+                    let e = if settings.visibility {
+                        let visible = camera::photon_visibility(scene, src.position, src.normal, radius);
+                        global.estimate_visible(settings.kernels, &lookup, f, &mut scratch, &visible)
+                    } else {
+                        global.estimate(settings.kernels, &lookup, f, &mut scratch)
+                    };
                     Photon { position: src.position, power: e.radiance, wi: src.normal, normal: src.normal, flags: 0 }
                 })
                 .collect::<Vec<_>>()
