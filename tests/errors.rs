@@ -182,6 +182,7 @@ fn the_cli_renders_and_writes_stats() {
         "2000",
         "--caustic-photons",
         "2000",
+        "--visibility",
     ]);
     assert_eq!(code, 0, "{e}");
     assert!(e.contains("caustic map   on") && e.contains("summary"), "{e}");
