@@ -81,6 +81,20 @@ pub struct Estimate {
     pub radius: f32,
     /// Photons summed.
     pub count: u32,
+    /// Photons within the search radius (as it stood when each was examined) that the normal
+    /// test of the [`Filter`] turned away: another surface's photons, around a corner or through
+    /// a thin wall.
+    pub rejected: u32,
+}
+
+/// What a [`Filter`] made of one photon.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Test {
+    Accepted,
+    /// Carries a masked flag.
+    Flags,
+    /// Lies on a surface facing another way.
+    Normal,
 }
 
 /// Which photons a lookup may use: those whose surface normal lies within ~45° of `n` (no leaks
@@ -422,17 +436,22 @@ impl PhotonMap {
         }
     }
 
-    /// True if photon `key` passes `filter`: flags, and the normal test n·m > 0.7·|m| evaluated as
-    /// n·m > 0 ∧ (n·m)² > 0.49·|m|² (no square root), the same operations as the 8-wide form.
+    /// Whether photon `key` passes `filter`: flags, and the normal test n·m > 0.7·|m| evaluated as
+    /// n·m > 0 ∧ (n·m)² > 0.49·|m|² (no square root), the same operations as the 8-wide form;
+    /// a rejection says which test failed.
     #[inline]
-    fn accepts(key: u32, filter: &Filter) -> bool {
+    fn test(key: u32, filter: &Filter) -> Test {
         if key_flags(key) & filter.flags_mask != 0 {
-            return false;
+            return Test::Flags;
         }
         let m = key_normal(key);
         let dot = m.x * filter.n.x + m.y * filter.n.y + m.z * filter.n.z;
         let len2 = m.x * m.x + m.y * m.y + m.z * m.z;
-        dot > 0.0 && dot * dot > 0.49 * len2
+        if dot > 0.0 && dot * dot > 0.49 * len2 {
+            Test::Accepted
+        } else {
+            Test::Normal
+        }
     }
 
     /// The 8 keys from `base`.
@@ -447,16 +466,17 @@ impl PhotonMap {
         u32x8::from(<[u32; 8]>::try_from(&self.power[base..base + 8]).expect("padded column"))
     }
 
-    /// Lanes of the 8 photons from `base` that lie within `r2` of `p` and pass `filter`.
+    /// Lanes of the 8 photons from `base` that lie within `r2` of `p` and pass `filter`, and the
+    /// lanes within `r2` that pass its flags but fail its normal test.
     #[inline]
-    fn accepts8(&self, base: usize, p: Vec3, r2: f32, filter: &Filter) -> (u32, f32x8) {
+    fn accepts8(&self, base: usize, p: Vec3, r2: f32, filter: &Filter) -> (u32, u32, f32x8) {
         let load = |c: &[f32]| f32x8::from(<[f32; 8]>::try_from(&c[base..base + 8]).expect("padded column"));
         let (dx, dy, dz) =
             (load(&self.x) - f32x8::splat(p.x), load(&self.y) - f32x8::splat(p.y), load(&self.z) - f32x8::splat(p.z));
         let d2 = dx * dx + dy * dy + dz * dz;
         let near = d2.simd_lt(f32x8::splat(r2));
         if !near.any() {
-            return (0, d2);
+            return (0, 0, d2);
         }
         let key = self.key8(base);
         let flags = (key >> 12_u32) & u32x8::splat(3);
@@ -470,16 +490,24 @@ impl PhotonMap {
         let normal_ok = dot.simd_gt(f32x8::ZERO) & (dot * dot).simd_gt(f32x8::splat(0.49) * len2);
         let inside = near & normal_ok;
         let flags_bits = flags_ok.to_bitmask();
-        (inside.to_bitmask() & flags_bits, d2)
+        let turned = (near & !normal_ok).to_bitmask() & flags_bits;
+        (inside.to_bitmask() & flags_bits, turned, d2)
     }
 
     /// The `k` nearest photons to `q.p` within `q.r_max` that pass `q.filter`, as
     /// (distance², index), unordered, into `out`.
     pub fn nearest(&self, set: KernelSet, q: &Lookup, out: &mut Vec<(f32, u32)>) {
+        self.nearest_counted(set, q, out);
+    }
+
+    /// [`Self::nearest`], returning how many photons the normal test turned away (see
+    /// [`Estimate::rejected`]); both kernel sets count the same photons.
+    fn nearest_counted(&self, set: KernelSet, q: &Lookup, out: &mut Vec<(f32, u32)>) -> u32 {
         out.clear();
         if q.k == 0 || self.is_empty() {
-            return;
+            return 0;
         }
+        let mut rejected = 0u32;
         let k = q.k;
         // Candidates gather unsorted in `out`; when 2k have gathered, the k nearest are selected
         // (O(k)) and r² shrinks to the k-th distance. Amortised O(1) per candidate, no heap.
@@ -505,24 +533,34 @@ impl PhotonMap {
         self.walk(q.p, &mut r2, |lo, hi, simd_ok, r2| {
             if simd_ok && set == KernelSet::Simd {
                 for base in (lo..hi).step_by(8) {
-                    let (mut m, d2) = self.accepts8(base, q.p, *r2, &q.filter);
-                    m &= (1u32 << (hi - base).min(8)) - 1;
+                    let (m, turned, d2) = self.accepts8(base, q.p, *r2, &q.filter);
+                    let valid = (1u32 << (hi - base).min(8)) - 1;
+                    let (m, turned) = (m & valid, turned & valid);
                     let d2 = d2.to_array();
-                    while m != 0 {
-                        let l = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        // r² may have shrunk since the 8-wide test: re-check, as the scalar
-                        // twin does at this photon.
+                    // Lane order, as the scalar twin walks them: r² may have shrunk since the
+                    // 8-wide test, so each lane is re-checked at its turn.
+                    let mut all = m | turned;
+                    while all != 0 {
+                        let l = all.trailing_zeros() as usize;
+                        all &= all - 1;
                         if d2[l] < *r2 {
-                            offer(out, r2, d2[l], base + l);
+                            if m >> l & 1 == 1 {
+                                offer(out, r2, d2[l], base + l);
+                            } else {
+                                rejected += 1;
+                            }
                         }
                     }
                 }
             } else {
                 for i in lo..hi {
                     let d2 = self.d2(i, q.p);
-                    if d2 < *r2 && Self::accepts(self.key[i], &q.filter) {
-                        offer(out, r2, d2, i);
+                    if d2 < *r2 {
+                        match Self::test(self.key[i], &q.filter) {
+                            Test::Accepted => offer(out, r2, d2, i),
+                            Test::Normal => rejected += 1,
+                            Test::Flags => {}
+                        }
                     }
                 }
             }
@@ -531,6 +569,7 @@ impl PhotonMap {
             out.select_nth_unstable_by_key(k - 1, by_distance);
             out.truncate(k);
         }
+        rejected
     }
 
     /// Reflected radiance at `q.p` from its k nearest photons: Σ f(wi_p)·Φ_p·K over the
@@ -539,11 +578,11 @@ impl PhotonMap {
         if self.is_empty() {
             return Estimate { radius: q.r_max, ..Default::default() };
         }
-        self.nearest(set, q, scratch);
+        let rejected = self.nearest_counted(set, q, scratch);
         let Some(r2) = Self::knn_radius2(q, scratch) else {
-            return Estimate { radius: 0.0, ..Default::default() };
+            return Estimate { radius: 0.0, rejected, ..Default::default() };
         };
-        self.sum_estimate(set, q, r2, f, scratch)
+        Estimate { rejected, ..self.sum_estimate(set, q, r2, f, scratch) }
     }
 
     /// The squared radius of a k-nearest estimate over `found` (the k-th photon's distance, that
@@ -577,7 +616,12 @@ impl PhotonMap {
             KernelSet::Scalar => self.sum_scalar(found, r2, q.kernel, f),
             KernelSet::Simd => self.sum_simd(found, r2, q.kernel, f),
         };
-        Estimate { radiance: sum * q.kernel.normalisation(r2), radius: r2.sqrt(), count: found.len() as u32 }
+        Estimate {
+            radiance: sum * q.kernel.normalisation(r2),
+            radius: r2.sqrt(),
+            count: found.len() as u32,
+            rejected: 0,
+        }
     }
 
     /// [`Self::estimate`] (or, with `q.k == 0`, [`Self::estimate_radius`]) counting only the
@@ -595,26 +639,26 @@ impl PhotonMap {
         if self.is_empty() {
             return Estimate { radius: q.r_max, ..Default::default() };
         }
-        let r2 = if q.k == 0 {
+        let (r2, rejected) = if q.k == 0 {
             // Every photon within the fixed radius (a bound no search reaches).
-            self.nearest(set, &Lookup { k: u32::MAX as usize, ..*q }, scratch);
+            let rejected = self.nearest_counted(set, &Lookup { k: u32::MAX as usize, ..*q }, scratch);
             let r2 = q.r_max * q.r_max;
             if !(r2 > 0.0) || !r2.is_finite() {
                 return Estimate { radius: q.r_max, ..Default::default() };
             }
-            r2
+            (r2, rejected)
         } else {
-            self.nearest(set, q, scratch);
+            let rejected = self.nearest_counted(set, q, scratch);
             let Some(r2) = Self::knn_radius2(q, scratch) else {
-                return Estimate { radius: 0.0, ..Default::default() };
+                return Estimate { radius: 0.0, rejected, ..Default::default() };
             };
-            r2
+            (r2, rejected)
         };
         scratch.retain(|&(_, i)| {
             let key = self.key[i as usize];
             visible(self.position(i as usize), key_normal(key).normalize_or_zero())
         });
-        self.sum_estimate(set, q, r2, f, scratch)
+        Estimate { rejected, ..self.sum_estimate(set, q, r2, f, scratch) }
     }
 
     /// Reflected radiance at `q.p` from every photon within the fixed radius `q.r_max`.
@@ -623,15 +667,17 @@ impl PhotonMap {
         if self.is_empty() || !(r2 > 0.0) || !r2.is_finite() {
             return Estimate { radius: q.r_max, ..Default::default() };
         }
-        let mut count = 0u32;
+        let (mut count, mut rejected) = (0u32, 0u32);
         let mut sum = Vec3::ZERO;
         let mut sum8 = [f32x8::ZERO; 3];
         let mut r2_walk = r2;
         self.walk(q.p, &mut r2_walk, |lo, hi, simd_ok, _| {
             if simd_ok && set == KernelSet::Simd {
                 for base in (lo..hi).step_by(8) {
-                    let (mut m, d2) = self.accepts8(base, q.p, r2, &q.filter);
-                    m &= (1u32 << (hi - base).min(8)) - 1;
+                    let (mut m, turned, d2) = self.accepts8(base, q.p, r2, &q.filter);
+                    let valid = (1u32 << (hi - base).min(8)) - 1;
+                    m &= valid;
+                    rejected += (turned & valid).count_ones();
                     if m == 0 {
                         continue;
                     }
@@ -651,15 +697,21 @@ impl PhotonMap {
             } else {
                 for i in lo..hi {
                     let d2 = self.d2(i, q.p);
-                    if d2 < r2 && Self::accepts(self.key[i], &q.filter) {
-                        sum += self.contribution(i, d2, r2, q.kernel, f);
-                        count += 1;
+                    if d2 < r2 {
+                        match Self::test(self.key[i], &q.filter) {
+                            Test::Accepted => {
+                                sum += self.contribution(i, d2, r2, q.kernel, f);
+                                count += 1;
+                            }
+                            Test::Normal => rejected += 1,
+                            Test::Flags => {}
+                        }
                     }
                 }
             }
         });
         let simd = Vec3::new(sum8[0].reduce_add(), sum8[1].reduce_add(), sum8[2].reduce_add());
-        Estimate { radiance: (sum + simd) * q.kernel.normalisation(r2), radius: q.r_max, count }
+        Estimate { radiance: (sum + simd) * q.kernel.normalisation(r2), radius: q.r_max, count, rejected }
     }
 
     /// f(wi)·Φ·weight of photon `i` at squared distance `d2` (scalar twin of [`Self::contribution8`]).

@@ -83,6 +83,9 @@ pub struct Numerics {
     /// Photon tracing: rays that hit nothing although the geometry is closed around every light
     /// (a leak; counted only in such scenes, where missing everything is impossible).
     pub photon_escaped: u64,
+    /// Density estimates: photons within the search radius that the normal filter turned away
+    /// (another surface's photons, around a corner or across a thin wall), at shading points.
+    pub photons_filtered: u64,
 }
 
 impl std::ops::AddAssign for Numerics {
@@ -93,6 +96,7 @@ impl std::ops::AddAssign for Numerics {
         self.camera_samples += o.camera_samples;
         self.pixel_overflow += o.pixel_overflow;
         self.photon_escaped += o.photon_escaped;
+        self.photons_filtered += o.photons_filtered;
     }
 }
 
@@ -200,7 +204,8 @@ impl RenderStats {
              time: load {:.2} s, global photons {:.2} s, caustic photons {:.2} s, maps {:.2} s, camera {:.2} s, total {:.2} s\n  \
              non-finite values dropped: {} photon emissions, {} photon bounces, {} camera samples; \
              {} pixel sums overflowed; {} vertex normals replaced at load; {} photon rays escaped a \
-             closed scene\n",
+             closed scene; \
+             {} photons turned away by the normal filter\n",
             self.engine,
             self.kernels,
             self.threads,
@@ -223,6 +228,7 @@ impl RenderStats {
             self.numerics.pixel_overflow,
             self.numerics.load_normals,
             self.numerics.photon_escaped,
+            self.numerics.photons_filtered,
         ) + &self.progressive_summary()
             + &self.stage_summary()
     }

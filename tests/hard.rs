@@ -468,6 +468,22 @@ fn nested_dielectrics_conserve_energy() {
     }
 }
 
+/// `--stats` counts the photons the normal filter turns away in density estimates at shading
+/// points (here the global map read at the first hit; precomputed irradiance reads make none): on
+/// the corner, many, and the same number on both engines (they make the same estimates).
+fn photons_turned_away_are_counted_alike() {
+    let loaded = hard("corner.toml");
+    let rays = loaded.camera.unwrap().prepare(16, 16).unwrap();
+    let scene = Arc::new(loaded.scene);
+    let s = Settings { width: 16, height: 16, spp: 2, photons: 20_000, final_gather: false, ..Default::default() };
+    let counts: Vec<u64> = ENGINES
+        .iter()
+        .map(|&e| render(&scene, &rays, &s, e, None, &NoProgress).unwrap().1.numerics.photons_filtered)
+        .collect();
+    println!("photons turned away: {counts:?}");
+    assert!(counts[0] > 100 && counts[0] == counts[1], "{counts:?}");
+}
+
 /// Case 9 (the ray-level half is in tests/packet.rs): a point light inside the closed cube of
 /// grid-triangulated faces with sliver strips and zero-area triangles. Every photon path lands
 /// inside, so the first-hit photons of both engines' global maps carry the light's whole power
@@ -502,6 +518,7 @@ fn no_photon_leaves_a_watertight_mesh() {
 /// both kernel sets, and the same on the floor's side of the corner.
 #[test]
 fn no_photon_crosses_a_corner() {
+    photons_turned_away_are_counted_alike();
     use photonwave::kernels::KernelSet;
     use photonwave::photon_map::{Filter, Lookup, PhotonMap, Reflectance};
     use photonwave::settings::Kernel;
@@ -534,6 +551,12 @@ fn no_photon_crosses_a_corner() {
                 let e_own = own.estimate_radius(set, &fixed, Reflectance::Constant(Vec3::ONE));
                 println!("{name}, {side}, {set:?}: {} photons nearby on the other surface; irradiance {} from {} photons, own map {} from {}", others, e.radiance, e.count, e_own.radiance, e_own.count);
                 assert_eq!(e.count, e_own.count, "{name}, {side}, {set:?}");
+                // Every one of the other surface's photons in the disk was counted as turned away.
+                assert_eq!(e.rejected as usize, others, "{name}, {side}, {set:?}");
+                // The k-nearest search counts those it met while its radius shrank, alike in both
+                // kernel sets.
+                let knn = |set| map.estimate(set, &q, Reflectance::Constant(Vec3::ONE), &mut Vec::new()).rejected;
+                assert_eq!(knn(KernelSet::Simd), knn(KernelSet::Scalar), "{name}, {side}");
                 assert!(
                     (e.radiance - e_own.radiance).abs().max_element() <= 1e-5 * e_own.radiance.max_element(),
                     "{name}, {side}, {set:?}"

@@ -45,6 +45,9 @@ pub struct Context<'a> {
     pub fixed: Option<crate::settings::FixedRadii>,
     /// What to simulate.
     pub effects: Effects,
+    /// Photons the normal filter turned away in this context's estimates
+    /// ([`Numerics::photons_filtered`](crate::stats::Numerics::photons_filtered)).
+    pub filtered: std::sync::atomic::AtomicU64,
 }
 
 impl<'a> Context<'a> {
@@ -60,7 +63,14 @@ impl<'a> Context<'a> {
             caustic_radius: settings.caustic_radius * d,
             fixed: settings.fixed_radii.clone(),
             effects: Effects::plan(scene, settings),
+            filtered: std::sync::atomic::AtomicU64::new(0),
         }
+    }
+
+    /// Photons the normal filter has turned away in this context's estimates so far.
+    #[must_use]
+    pub fn filtered(&self) -> u64 {
+        self.filtered.load(std::sync::atomic::Ordering::Relaxed)
     }
 }
 
@@ -74,9 +84,12 @@ pub fn render_image(
     progress: &dyn Progress,
 ) -> (Film, RayCounts, Numerics) {
     let ctx = Context::new(scene, maps, settings);
-    render_pixels(settings, camera, threads, progress, |pixel, o, d, s, rays, scratch| {
-        trace_camera_path(&ctx, pixel, o, d, s, rays, scratch)
-    })
+    let (film, rays, mut numerics) =
+        render_pixels(settings, camera, threads, progress, |pixel, o, d, s, rays, scratch| {
+            trace_camera_path(&ctx, pixel, o, d, s, rays, scratch)
+        });
+    numerics.photons_filtered += ctx.filtered();
+    (film, rays, numerics)
 }
 
 /// The pixel loop shared by the photon mapper and the path tracer: rows in parallel, each pixel
@@ -316,15 +329,19 @@ fn map_estimate(
         _ => Reflectance::PerPhoton(&eval),
     };
     let set = ctx.settings.kernels;
-    match (fixed, ctx.settings.visibility) {
-        (Some(r), false) => map.estimate_radius(set, &Lookup { r_max: r, ..lookup }, f).radiance,
-        (None, false) => map.estimate(set, &lookup, f, scratch).radiance,
+    let e = match (fixed, ctx.settings.visibility) {
+        (Some(r), false) => map.estimate_radius(set, &Lookup { r_max: r, ..lookup }, f),
+        (None, false) => map.estimate(set, &lookup, f, scratch),
         (fixed, true) => {
             let lookup = fixed.map_or(lookup, |r| Lookup { r_max: r, k: 0, ..lookup });
             let visible = photon_visibility(ctx.scene, sp.p, ng, lookup.r_max);
-            map.estimate_visible(set, &lookup, f, scratch, &visible).radiance
+            map.estimate_visible(set, &lookup, f, scratch, &visible)
         }
+    };
+    if e.rejected > 0 {
+        ctx.filtered.fetch_add(u64::from(e.rejected), std::sync::atomic::Ordering::Relaxed);
     }
+    e.radiance
 }
 
 /// Whether a photon (position, normal) is visible from the point `q` (normal `n`, on the side

@@ -60,6 +60,7 @@ fn estimate_at_diffuse_hits(
     for &(sample, s, v) in &out {
         add_term(&mut work.terms[sample as usize], s, v);
     }
+    work.numerics.photons_filtered += ctx.filtered();
     lanes.len()
 }
 
