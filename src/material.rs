@@ -46,6 +46,10 @@ pub struct Material {
     pub emission: Vec3,
 }
 
+/// A BSDF sample whose pdf came out zero (see [`Bsdf::sample_checked`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ZeroPdf;
+
 /// A sampled direction and its weight `f·|cos θi| / pdf` (for delta lobes, the lobe's weight).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BsdfSample {
@@ -159,10 +163,22 @@ impl Bsdf {
     }
 
     /// Samples the whole BSDF with three uniform numbers. `None` when the sample is absorbed
-    /// (below the surface, zero weight).
+    /// (below the surface, zero weight) or its pdf is zero.
     #[must_use]
     pub fn sample(&self, frame: &SurfaceFrame, wo: Vec3, u: [f32; 3], transport: Transport) -> Option<BsdfSample> {
-        match *self {
+        self.sample_checked(frame, wo, u, transport).ok().flatten()
+    }
+
+    /// [`Bsdf::sample`], telling a sample whose pdf is zero (`Err`: dividing by it would give ∞
+    /// or NaN, so it is dropped; callers count it) from an absorbed one (`Ok(None)`).
+    pub fn sample_checked(
+        &self,
+        frame: &SurfaceFrame,
+        wo: Vec3,
+        u: [f32; 3],
+        transport: Transport,
+    ) -> Result<Option<BsdfSample>, ZeroPdf> {
+        Ok(match *self {
             Bsdf::Lambert { kd } => {
                 let (ng, ns) = frame.oriented(wo);
                 let wi = Frame::new(ns).to_world(cosine_hemisphere([u[0], u[1]]));
@@ -180,11 +196,14 @@ impl Bsdf {
                 };
                 let cos = wi.dot(ns);
                 if wi.dot(ng) <= 0.0 || cos <= 0.0 {
-                    return None;
+                    return Ok(None);
                 }
                 let pdf = p_diffuse * cos / PI + (1.0 - p_diffuse) * phong_pdf(r, wi, exponent);
+                if !(pdf > 0.0) {
+                    return Err(ZeroPdf);
+                }
                 let f = kd / PI + ks * phong_lobe(r, wi, exponent);
-                (pdf > 0.0).then(|| BsdfSample { wi, weight: f * cos / pdf, delta: false })
+                Some(BsdfSample { wi, weight: f * cos / pdf, delta: false })
             }
             Bsdf::Mirror { ks } => {
                 let (ng, ns) = frame.oriented(wo);
@@ -192,7 +211,7 @@ impl Bsdf {
                 (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: ks, delta: true })
             }
             Bsdf::Glass { ior } => sample_glass(frame, wo, ior, u[0], transport),
-        }
+        })
     }
 
     /// Samples the glossy lobe alone: weight `ks·(n+2)/(n+1)·cos θi`. `None` for other materials.

@@ -76,6 +76,9 @@ pub struct Numerics {
     pub photon_emission: u64,
     /// Photon scattering: paths whose power stopped being finite at a bounce, dropped there.
     pub photon_scatter: u64,
+    /// Photon scattering: paths whose BSDF sample had zero pdf (a glossy lobe too narrow for
+    /// f32), dropped there.
+    pub photon_zero_pdf: u64,
     /// Camera: samples with a NaN or infinite term, dropped before the film.
     pub camera_samples: u64,
     /// Film: pixels whose sum of samples overflowed f32, averaged sample by sample instead.
@@ -93,6 +96,7 @@ impl std::ops::AddAssign for Numerics {
         self.load_normals += o.load_normals;
         self.photon_emission += o.photon_emission;
         self.photon_scatter += o.photon_scatter;
+        self.photon_zero_pdf += o.photon_zero_pdf;
         self.camera_samples += o.camera_samples;
         self.pixel_overflow += o.pixel_overflow;
         self.photon_escaped += o.photon_escaped;
@@ -202,7 +206,8 @@ impl RenderStats {
         format!(
             "summary ({} engine, {} kernels, {} threads)\n{}{}  rays: {} total ({} camera, {} shadow, {} gather, {} photon)\n  \
              time: load {:.2} s, global photons {:.2} s, caustic photons {:.2} s, maps {:.2} s, camera {:.2} s, total {:.2} s\n  \
-             non-finite values dropped: {} photon emissions, {} photon bounces, {} camera samples; \
+             non-finite values dropped: {} photon emissions, {} photon bounces ({} more with a zero pdf), \
+             {} camera samples; \
              {} pixel sums overflowed; {} vertex normals replaced at load; {} photon rays escaped a \
              closed scene; \
              {} photons turned away by the normal filter\n",
@@ -224,6 +229,7 @@ impl RenderStats {
             t.total_s,
             self.numerics.photon_emission,
             self.numerics.photon_scatter,
+            self.numerics.photon_zero_pdf,
             self.numerics.camera_samples,
             self.numerics.pixel_overflow,
             self.numerics.load_normals,

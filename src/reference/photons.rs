@@ -173,6 +173,8 @@ pub enum Scattered {
     Absorbed,
     /// Its power stopped being finite; dropped and counted.
     NonFinite,
+    /// The BSDF's sample had zero pdf; dropped and counted.
+    ZeroPdf,
 }
 
 /// Scatters a photon at `sp` (BSDF sample, shading-normal correction, Russian roulette) with the
@@ -181,7 +183,11 @@ pub enum Scattered {
 pub fn scatter_photon(s: &Sampler, sp: &SurfacePoint, bsdf: &Bsdf, photon: &PhotonRay, bounce: u32) -> Scattered {
     let wo = -photon.dir;
     let u = [s.get(bounce + 1, 0), s.get(bounce + 1, 1), s.get(bounce + 1, 2)];
-    let Some(bs) = bsdf.sample(&sp.frame, wo, u, Transport::Power) else { return Scattered::Absorbed };
+    let bs = match bsdf.sample_checked(&sp.frame, wo, u, Transport::Power) {
+        Ok(Some(bs)) => bs,
+        Ok(None) => return Scattered::Absorbed,
+        Err(_) => return Scattered::ZeroPdf,
+    };
     // Photons carry power, the adjoint of radiance: with shading normals the BSDF is not
     // symmetric, and Veach's correction |wo·ns||wi·ng| / (|wo·ng||wi·ns|) makes photon
     // transport agree with camera paths (Veach 1997 §5.3; pbrt-v4 CorrectShadingNormal).
@@ -234,6 +240,10 @@ pub fn trace_path(
             Scattered::Absorbed => break,
             Scattered::NonFinite => {
                 numerics.photon_scatter += 1;
+                break;
+            }
+            Scattered::ZeroPdf => {
+                numerics.photon_zero_pdf += 1;
                 break;
             }
         }

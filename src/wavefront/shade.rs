@@ -17,8 +17,9 @@ use crate::sampling::{cosine_hemisphere, Frame};
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
-/// Scatters the photon lanes `lanes` into `next`; returns the count of non-finite drops.
-fn scatter_lanes(shared: &Shared, work: &PhotonWork, lanes: &[u32], next: &mut PhotonQueue) -> u64 {
+/// Scatters the photon lanes `lanes` into `next`; returns the paths dropped (the photon fields of
+/// [`Numerics`](crate::stats::Numerics)).
+fn scatter_lanes(shared: &Shared, work: &PhotonWork, lanes: &[u32], next: &mut PhotonQueue) -> crate::stats::Numerics {
     let scene = &*shared.scene;
     let domain = work.domain.unwrap_or(Domain::GlobalPhoton);
     let q = &work.queue;
@@ -38,17 +39,18 @@ fn scatter_lanes(shared: &Shared, work: &PhotonWork, lanes: &[u32], next: &mut P
         })
         .collect()
     });
-    let mut non_finite = 0;
+    let mut dropped = crate::stats::Numerics::default();
     for (i, r) in results {
         match r {
             Scattered::Continue(p) if q.bounce[i] + 1 < shared.settings.max_depth => {
                 next.push(p.origin, p.dir, q.path[i], q.bounce[i] + 1, p.power, p.specular_only);
             }
-            Scattered::NonFinite => non_finite += 1,
+            Scattered::NonFinite => dropped.photon_scatter += 1,
+            Scattered::ZeroPdf => dropped.photon_zero_pdf += 1,
             _ => {}
         }
     }
-    non_finite
+    dropped
 }
 
 /// Photons at mirrors and surviving diffuse photons scatter into the next queue.
@@ -56,7 +58,8 @@ pub fn scatter_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
     let t = Instant::now();
     let lanes: Vec<u32> = work.classified.mirror.iter().chain(&work.survivors).copied().collect();
     let mut next = std::mem::take(&mut work.next);
-    work.numerics.photon_scatter += scatter_lanes(&shared, &work, &lanes, &mut next);
+    let dropped = scatter_lanes(&shared, &work, &lanes, &mut next);
+    work.numerics += dropped;
     work.next = next;
     stats.record("scatter_photons", lanes.len(), t);
 }
@@ -66,7 +69,8 @@ pub fn refract_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
     let t = Instant::now();
     let lanes = work.classified.glass.clone();
     let mut next = std::mem::take(&mut work.next);
-    work.numerics.photon_scatter += scatter_lanes(&shared, &work, &lanes, &mut next);
+    let dropped = scatter_lanes(&shared, &work, &lanes, &mut next);
+    work.numerics += dropped;
     work.next = next;
     stats.record("refract_photons", lanes.len(), t);
 }
