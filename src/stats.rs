@@ -187,7 +187,7 @@ impl RenderStats {
             threads,
             kernels: format!("{:?}", settings.kernels).to_lowercase(),
             seed: settings.seed,
-            numerics: Numerics { load_normals: scene.replaced_normals, ..Default::default() },
+            numerics: Numerics { load_normals: scene.zero_normals, ..Default::default() },
             ..Default::default()
         }
     }

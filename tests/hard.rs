@@ -658,8 +658,8 @@ fn photon_rays_escaping_a_closed_scene_are_counted() {
 
 /// The contrast to `thin_wall_lets_nothing_through`: without `visibility`, light reaches the
 /// dark half on both engines (the leak measured there). And where nothing is thin, visibility
-/// changes little: the Cornell box's indirect and caustic layers keep their means within 2 %
-/// (photons just behind the blocks' edges are no longer counted; measured below 1 %).
+/// changes little: the mirror-and-glass Cornell box's indirect and caustic layers keep their means within 2 %
+/// (photons just past the spheres' edges are no longer counted; measured below 0.3 %).
 #[test]
 fn visibility_is_what_stops_the_leak() {
     let loaded = hard("thin-wall.toml");

@@ -58,7 +58,7 @@ pub fn render_path_traced_with_stats(
         seed: settings.seed,
         passes: vec!["path tracing with next-event estimation".into()],
         rays,
-        numerics: crate::stats::Numerics { load_normals: scene.replaced_normals, ..numerics },
+        numerics: crate::stats::Numerics { load_normals: scene.zero_normals, ..numerics },
         times: crate::stats::PhaseTimes {
             camera_s: t.elapsed().as_secs_f64(),
             total_s: t.elapsed().as_secs_f64(),

@@ -84,7 +84,7 @@ pub struct Scene {
     /// Degenerate (zero-area) triangles dropped at load.
     pub dropped_degenerate: usize,
     /// Vertex normals given with zero length (their faces use the geometric normal there).
-    pub replaced_normals: u64,
+    pub zero_normals: u64,
     /// Whether the geometry is closed (no edge borders a single triangle) with
     /// every light inside it (point and spot lights, and the front of every emitter) and no
     /// directional light: a photon ray that then hits nothing has leaked through the geometry.
@@ -99,7 +99,7 @@ pub struct Scene {
 /// A warning when faces of two different materials, at least one a dielectric, overlap in one
 /// plane: which of them a ray meets is arbitrary, and the ratio of indices across the boundary
 /// is lost. Nested dielectrics are modelled with one face per boundary instead. Faces are grouped
-/// by plane (normal up to sign and offset, rounded to 10⁻⁵ of the scene's size); within a plane
+/// by plane (normal up to sign and offset, rounded to 10⁻⁵ of the scene's size `size`); within a plane
 /// that holds a dielectric and another material, a face overlaps another when one of four points
 /// inside either lies inside the other.
 fn coincident_dielectrics(
@@ -108,14 +108,12 @@ fn coincident_dielectrics(
     p2: &[Vec3],
     mat: &[u32],
     materials: &[Material],
+    size: f32,
 ) -> Option<String> {
     let glass = |m: u32| matches!(materials[m as usize].bsdf, Bsdf::Glass { .. });
     if !mat.iter().any(|&m| glass(m)) {
         return None;
     }
-    let (lo, hi) =
-        p0.iter().chain(p1).chain(p2).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| (l.min(*p), h.max(*p)));
-    let size = (hi - lo).length().max(f32::MIN_POSITIVE);
     let mut planes: std::collections::HashMap<[i64; 4], Vec<usize>> = std::collections::HashMap::new();
     for i in 0..p0.len() {
         let n = (p1[i] - p0[i]).cross(p2[i] - p0[i]).normalize_or_zero();
@@ -182,7 +180,7 @@ impl Scene {
     ) -> Result<Scene> {
         let (mut p0, mut p1, mut p2, mut vn, mut mat) = (vec![], vec![], vec![], vec![], vec![]);
         let mut dropped = 0usize;
-        let replaced_normals = meshes.iter().map(|m| m.zero_normals).sum();
+        let zero_normals = meshes.iter().map(|m| m.zero_normals).sum();
         // Emissive area per material, to refuse lights whose every triangle is degenerate.
         let mut emitter_area = vec![0.0f64; materials.len()];
         let mut emitter_seen = vec![false; materials.len()];
@@ -229,7 +227,14 @@ impl Scene {
             return Err(Error::scene("the scene has no triangles"));
         }
 
-        if let Some(w) = coincident_dielectrics(&p0, &p1, &p2, &mat, &materials) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for p in p0.iter().chain(&p1).chain(&p2) {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        let size = (hi - lo).length().max(f32::MIN_POSITIVE);
+        if let Some(w) = coincident_dielectrics(&p0, &p1, &p2, &mat, &materials, size) {
             warnings.push(w);
         }
         let (bvh, order) = Bvh::build(&p0, &p1, &p2);
@@ -240,12 +245,6 @@ impl Scene {
         let ng: Vec<Vec3> = (0..p0.len()).map(|i| (p1[i] - p0[i]).cross(p2[i] - p0[i]).normalize()).collect();
         let area: Vec<f32> = (0..p0.len()).map(|i| 0.5 * (p1[i] - p0[i]).cross(p2[i] - p0[i]).length()).collect();
 
-        let mut lo = Vec3::splat(f32::INFINITY);
-        let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        for p in p0.iter().chain(&p1).chain(&p2) {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
         let mut lights: Vec<Light> = (0..p0.len())
             .filter(|&i| materials[material[i] as usize].emission != Vec3::ZERO)
             .map(|i| Light::Area { tri: i as u32, radiance: materials[material[i] as usize].emission })
@@ -278,7 +277,7 @@ impl Scene {
             delta_lights: vec![],
             bounds: (lo, hi),
             dropped_degenerate: dropped,
-            replaced_normals,
+            zero_normals,
             encloses_lights: false,
             warnings,
             bvh,
@@ -361,13 +360,14 @@ impl Scene {
             return false;
         }
         let piece: Vec<u32> = (0..n as u32).map(|i| root(&mut parent, i)).collect();
+        let diagonal = self.diagonal();
         self.lights.iter().all(|l| match *l {
             Light::Point { position, .. } | Light::Spot { position, .. } => self.inside(position, &piece),
             Light::Area { tri, .. } => {
                 let i = tri as usize;
                 let c = (self.p0[i] + self.p1[i] + self.p2[i]) / 3.0;
-                let lo = c.abs().max_element().max(self.diagonal()) * 1e-5;
-                self.inside(c + self.ng[i] * lo, &piece)
+                let lift = c.abs().max_element().max(diagonal) * 1e-5;
+                self.inside(c + self.ng[i] * lift, &piece)
             }
             Light::Directional { .. } => false,
         })
