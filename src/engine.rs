@@ -67,6 +67,12 @@ pub fn render(
     budget: Option<Budget>,
     progress: &dyn Progress,
 ) -> Result<(Film, RenderStats)> {
+    // Refuse what would exhaust memory before any of it is allocated.
+    if let Some((available, total)) = crate::memory::machine() {
+        let plan = crate::effects::Effects::plan(scene, settings);
+        let maps = engine != Engine::Path;
+        crate::memory::check(settings, maps && plan.global_map.on, maps && plan.caustic_map.on, available, total)?;
+    }
     if !is_progressive(settings, budget) {
         return render_once(scene, rays, settings, engine, progress);
     }

@@ -151,19 +151,14 @@ impl Film {
         }
         let layer =
             Layer::new(size, LayerAttributes::default(), Encoding::FAST_LOSSLESS, AnyChannels::sort(channels.into()));
-        Image::from_layer(layer).write().to_file(path).map_err(|e| PwError::output(path, e))
+        let image = Image::from_layer(layer);
+        crate::files::replace(path, |tmp| image.write().to_file(tmp).map_err(|e| PwError::output(path, e)))
     }
 
     /// Writes a tone-mapped 8-bit sRGB PNG of the beauty image (exposure 1, clamped).
     pub fn write_png(&self, path: &Path) -> Result<()> {
-        let file = std::fs::File::create(path).map_err(|e| PwError::output(path, e))?;
-        let mut enc = png::Encoder::new(std::io::BufWriter::new(file), self.width, self.height);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut w = enc.write_header().map_err(|e| PwError::output(path, e))?;
         let bytes: Vec<u8> = self.beauty().iter().flat_map(|c| c.to_array().map(srgb8)).collect();
-        w.write_image_data(&bytes).map_err(|e| PwError::output(path, e))?;
-        w.finish().map_err(|e| PwError::output(path, e))
+        crate::files::write_png(path, self.width, self.height, &bytes)
     }
 }
 
@@ -186,10 +181,67 @@ pub struct ExrLayers {
     pub layers: Vec<(String, Vec<Vec3>)>,
 }
 
-/// Reads every RGB layer of the first part of the EXR at `path`.
+/// The most decoded bytes an EXR may claim per byte of file. No OpenEXR compression that the
+/// `exr` crate reads packs more: RLE stores at most 128 bytes in 2, deflate (ZIP, PXR24) at
+/// most about 1 032 in 1, B44 32 in 14; PIZ's run-length Huffman codes stay below 4 096.
+pub const MAX_EXR_RATIO: u64 = 4096;
+
+/// Refuses, before anything is decoded, an EXR whose header claims more pixels than its length
+/// could hold at any compression ([`MAX_EXR_RATIO`]) or than the machine's memory could hold
+/// while decoding (the samples, then the RGB layers built from them: about 3 times the samples).
+fn check_exr_size(path: &Path) -> Result<()> {
+    let len = crate::files::read_input_len(path, "an image (EXR)")?;
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| PwError::parse(path, 0, e.to_string()))?;
+    let (mut pixels, mut samples) = (0u64, 0u64);
+    for h in &meta.headers {
+        let px = h.layer_size.0 as u64 * h.layer_size.1 as u64;
+        pixels = pixels.max(px);
+        samples = samples.saturating_add(px.saturating_mul(h.channels.list.len() as u64));
+    }
+    let decoded = samples.saturating_mul(4);
+    let first = &meta.headers[0].layer_size;
+    if decoded > len.saturating_mul(MAX_EXR_RATIO) {
+        return Err(PwError::parse(
+            path,
+            0,
+            format!(
+                "damaged EXR: its header claims {}×{} pixels ({} of samples), more than its {} could hold \
+                 at any compression",
+                first.0,
+                first.1,
+                crate::files::bytes(decoded),
+                crate::files::bytes(len)
+            ),
+        ));
+    }
+    if let Some((available, total)) = crate::memory::machine() {
+        if decoded.saturating_mul(3) > available {
+            return Err(PwError::parse(
+                path,
+                0,
+                format!(
+                    "its {}×{} pixels need about {} to read, but the machine has {} available of {}",
+                    first.0,
+                    first.1,
+                    crate::files::bytes(decoded.saturating_mul(3)),
+                    crate::files::bytes(available),
+                    crate::files::bytes(total)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Reads every RGB layer of the first part of the EXR at `path`. A damaged file is an error
+/// naming it, never a crash: sizes are checked before decoding ([`check_exr_size`]), and a
+/// panic inside the decoder is caught and reported as damage.
 pub fn read_exr(path: &Path) -> Result<ExrLayers> {
     use exr::prelude::*;
-    let image = read_all_flat_layers_from_file(path).map_err(|e| PwError::io(path, e))?;
+    check_exr_size(path)?;
+    let image = std::panic::catch_unwind(|| read_all_flat_layers_from_file(path))
+        .map_err(|_| PwError::parse(path, 0, "damaged EXR: the decoder failed on it"))?
+        .map_err(|e| PwError::parse(path, 0, format!("not a readable EXR: {e}")))?;
     let l = image.layer_data.first().ok_or_else(|| PwError::parse(path, 0, "EXR has no layer"))?;
     let (w, h) = (l.size.0, l.size.1);
     let channel = |name: &str| {

@@ -6,6 +6,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use photonwave::effects::Effects;
 use photonwave::engine::{Budget, Engine};
 use photonwave::error::{Error, Result};
+use photonwave::files::{check_outputs, Output};
 use photonwave::progressive::PerPass;
 use photonwave::reference::Progress;
 use photonwave::scene::file::{fitted_camera, load_scene};
@@ -301,24 +302,15 @@ fn significant(x: f32) -> String {
     }
 }
 
-/// Refuses an output path whose extension names another format than the one written there.
-fn check_extension(flag: &str, path: &std::path::Path, ext: &str, hint: &str) -> Result<()> {
-    match path.extension().and_then(|e| e.to_str()) {
-        Some(e) if e.eq_ignore_ascii_case(ext) => Ok(()),
-        _ => Err(Error::setting(
-            flag,
-            format!("writes {ext} only, so {} must end in .{}{hint}", path.display(), ext.to_lowercase()),
-        )),
-    }
-}
-
 fn render(args: RenderArgs) -> Result<()> {
     let t0 = Instant::now();
-    check_extension("--output", &args.output, "EXR", " (for a PNG preview add --png FILE.png)")?;
-    if let Some(p) = &args.png {
-        check_extension("--png", p, "PNG", "")?;
-    }
+    let mut outputs = vec![Output { flag: "--output", path: &args.output, ext: "exr" }];
+    outputs.extend(args.png.as_deref().map(|path| Output { flag: "--png", path, ext: "png" }));
+    outputs.extend(args.stats.as_deref().map(|path| Output { flag: "--stats", path, ext: "json" }));
+    // Every output is checked before any work, and again against every file the scene read.
+    check_outputs(&outputs, std::slice::from_ref(&args.scene))?;
     let loaded = load_scene(&args.scene)?;
+    check_outputs(&outputs, &loaded.inputs)?;
     let scene = std::sync::Arc::new(loaded.scene);
     let mut settings = loaded.settings;
     let preset_per_pass = args.preset.map(|p| p.apply(&mut settings)).unwrap_or_default();
@@ -408,7 +400,7 @@ fn render(args: RenderArgs) -> Result<()> {
     eprint!("{}", stats.summary());
     if let Some(p) = &args.stats {
         let json = serde_json::to_string_pretty(&stats).map_err(|e| Error::output(p, e))?;
-        std::fs::write(p, json).map_err(|e| Error::output(p, e))?;
+        photonwave::files::write_bytes(p, json.as_bytes())?;
         eprintln!("wrote {}", p.display());
     }
     Ok(())
@@ -512,15 +504,20 @@ fn sweep(args: SweepArgs) -> Result<()> {
         ));
     }
     let loaded = load_scene(&args.scene)?;
+    let mut inputs = loaded.inputs;
+    inputs.push(args.reference.clone());
     let scene = std::sync::Arc::new(loaded.scene);
     let mut base = loaded.settings;
     let given = args.preset.map(|p| p.apply(&mut base)).unwrap_or_default();
     (base.width, base.height) = (reference.width, reference.height);
     base.validate()?;
     let sweep = Sweep::new(&base, given, args.knobs, args.time, args.engine)?;
+    // The input is checked; the output folder now, before any render.
+    std::fs::create_dir_all(&args.output).map_err(|e| Error::output(&args.output, e))?;
+    let csv = args.output.join("sweep.csv");
+    check_outputs(&[Output { flag: "--output", path: &csv, ext: "csv" }], &inputs)?;
     let camera = loaded.camera.unwrap_or_else(|| fitted_camera(&scene, 40.0));
     let rays = camera.prepare(base.width, base.height)?;
-    std::fs::create_dir_all(&args.output).map_err(|e| Error::output(&args.output, e))?;
 
     for w in &scene.warnings {
         eprintln!("warning: {w}");
@@ -554,7 +551,6 @@ fn sweep(args: SweepArgs) -> Result<()> {
             err
         );
     }
-    let csv = args.output.join("sweep.csv");
     photonwave::sweep::write_csv(&csv, &sweep.knobs, &rows)?;
     eprintln!("wrote {}", csv.display());
     let name = args.scene.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());

@@ -167,8 +167,12 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> std:
 /// Writes `fig` as an SVG file.
 pub fn write_svg(fig: &Figure, path: &Path) -> Result<()> {
     register_font();
-    let root = SVGBackend::new(path, SIZE).into_drawing_area();
-    draw(&root, fig).map_err(|e| Error::output(path, e))
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        draw(&root, fig).map_err(|e| Error::output(path, e))?;
+    }
+    crate::files::write_bytes(path, svg.as_bytes())
 }
 
 /// Writes `fig` as an 8-bit RGB PNG file.
@@ -180,13 +184,7 @@ pub fn write_png(fig: &Figure, path: &Path) -> Result<()> {
         let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
         draw(&root, fig).map_err(|e| Error::output(path, e))?;
     }
-    let file = std::fs::File::create(path).map_err(|e| Error::output(path, e))?;
-    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), w, h);
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
-    let mut writer = enc.write_header().map_err(|e| Error::output(path, e))?;
-    writer.write_image_data(&rgb).map_err(|e| Error::output(path, e))?;
-    writer.finish().map_err(|e| Error::output(path, e))
+    crate::files::write_png(path, w, h, &rgb)
 }
 
 #[cfg(test)]

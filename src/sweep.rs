@@ -390,5 +390,5 @@ pub fn csv(knobs: &[Knob], rows: &[Row]) -> String {
 
 /// Writes [`csv`] to `path`.
 pub fn write_csv(path: &Path, knobs: &[Knob], rows: &[Row]) -> Result<()> {
-    std::fs::write(path, csv(knobs, rows)).map_err(|e| Error::output(path, e))
+    crate::files::write_bytes(path, csv(knobs, rows).as_bytes())
 }

@@ -31,6 +31,7 @@ use super::light::Light;
 use super::obj::{load_obj, MaterialTable};
 use super::{MeshInput, Scene};
 use crate::error::{Error, Result};
+use crate::files::{read_text, MAX_SCENE_FILE};
 use crate::material::{Bsdf, Material};
 use crate::settings::Settings;
 use glam::Vec3;
@@ -149,6 +150,8 @@ pub struct LoadedScene {
     pub camera: Option<Camera>,
     /// Settings from the file's `[render]` table (defaults otherwise).
     pub settings: Settings,
+    /// Every file read: the scene file, its OBJ and MTL files (outputs must not overwrite them).
+    pub inputs: Vec<PathBuf>,
 }
 
 fn finite3(field: &str, v: [f32; 3]) -> Result<Vec3> {
@@ -254,13 +257,13 @@ impl MaterialEntry {
 pub fn load_scene(path: &Path) -> Result<LoadedScene> {
     let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if is_obj {
-        let mut table = MaterialTable::default();
-        let mut warnings = Vec::new();
-        let mesh = load_obj(path, (1.0, Vec3::ZERO), &mut table, &mut warnings)?;
+        let (mut table, mut warnings, mut inputs) = (MaterialTable::default(), Vec::new(), Vec::new());
+        let mesh = load_obj(path, (1.0, Vec3::ZERO), &mut table, &mut warnings, &mut inputs)?;
         let scene = Scene::build(vec![mesh], table.materials, vec![], warnings)?;
-        return Ok(LoadedScene { scene, camera: None, settings: Settings::default() });
+        return Ok(LoadedScene { scene, camera: None, settings: Settings::default(), inputs });
     }
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = read_text(path, "a scene file", MAX_SCENE_FILE)?;
+    let mut inputs = vec![path.to_path_buf()];
     let file: SceneFile = toml::from_str(&text).map_err(|e| {
         let line = e.span().map_or(0, |s| text[..s.start.min(text.len())].lines().count().max(1));
         Error::parse(path, line, e.message().to_string())
@@ -277,13 +280,12 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene> {
             return Err(Error::setting(format!("mesh[{i}].scale"), "must be a positive number"));
         }
         let translate = finite3(&format!("mesh[{i}].translate"), m.translate)?;
-        meshes.push(load_obj(&dir.join(&m.file), (m.scale, translate), &mut table, &mut warnings)?);
+        meshes.push(load_obj(&dir.join(&m.file), (m.scale, translate), &mut table, &mut warnings, &mut inputs)?);
     }
     for (name, entry) in &file.materials {
-        if !table.by_name.contains_key(name) {
+        if table.replace_named(name, &entry.to_material(name)?) == 0 {
             return Err(Error::setting(format!("materials.{name}"), "no mesh uses a material of that name"));
         }
-        table.insert(entry.to_material(name)?);
     }
     let lights = file.light.iter().enumerate().map(|(i, l)| l.to_light(i)).collect::<Result<Vec<_>>>()?;
     let camera = file.camera.map(|c| Camera {
@@ -295,7 +297,7 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene> {
     let settings = file.render.unwrap_or_default();
     settings.validate()?;
     let scene = Scene::build(meshes, table.materials, lights, warnings)?;
-    Ok(LoadedScene { scene, camera, settings })
+    Ok(LoadedScene { scene, camera, settings, inputs })
 }
 
 /// A camera that frames the scene's bounding sphere from +z, looking down −z.

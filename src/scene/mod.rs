@@ -5,6 +5,7 @@ pub mod camera;
 pub mod file;
 pub mod generated;
 pub mod light;
+pub mod mtl;
 pub mod obj;
 pub mod validate;
 

@@ -1,119 +1,151 @@
-//! OBJ and MTL input through tobj, and the MTL → material mapping (documented in README):
+//! OBJ input through tobj, with materials from the MTL files it names ([`super::mtl`]).
 //!
-//! | MTL | material |
-//! |---|---|
-//! | `Ke` ≠ 0 | area emitter with radiance `Ke` from the front (counter-clockwise) face, plus the scattering below |
-//! | `illum` 3 or 5 | perfect mirror, reflectance `Ks` (1 if absent) |
-//! | `illum` 4, 6 or 7 | smooth clear dielectric, IOR `Ni` (1.5 if absent), exact Fresnel |
-//! | `illum` 2 with `Ks` > 0 | Lambertian `Kd` + normalised Phong lobe `Ks`, exponent `Ns`; scaled so Kd + Ks ≤ 1 |
-//! | otherwise | Lambertian `Kd` (0.8 grey if absent) |
+//! The text is read by [`crate::files::read_text`] (regular files only, bounded size, no
+//! byte-order mark, any line ends), checked line by line ([`check_obj`]) and handed to tobj.
+//! `mtllib` may name several files on one line, as the spec allows (a name with spaces is taken
+//! whole when such a file exists). Materials are kept per MTL file: two files may each define
+//! `floor`, and each mesh gets its own file's.
 
-use super::validate::{check_mtl, check_obj};
+use super::mtl::{material_from_mtl, parse_mtl, MtlMaterial};
+use super::validate::{check_obj, MtlLib};
 use super::MeshInput;
 use crate::error::{Error, Result};
+use crate::files::{read_text, MAX_MATERIAL_FILE, MAX_MESH_FILE};
 use crate::material::{Bsdf, Material};
 use glam::Vec3;
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// Materials of all loaded files, by name (later files' materials of the same name win).
+/// Materials of all loaded files, kept apart per MTL file.
 #[derive(Default, Debug)]
 pub struct MaterialTable {
     /// The table.
     pub materials: Vec<Material>,
-    /// Name → index.
-    pub by_name: HashMap<String, u32>,
+    /// (MTL file, name) → index.
+    by_key: HashMap<(PathBuf, String), u32>,
 }
 
 impl MaterialTable {
-    /// Adds or replaces a material by name; returns its index.
-    pub fn insert(&mut self, m: Material) -> u32 {
-        if let Some(&i) = self.by_name.get(&m.name) {
+    /// Adds the material `m` of the file `source`, or replaces the one of that name from that
+    /// file; returns its index. When another file defines a different material of the same
+    /// name, `warnings` says that each mesh keeps its own file's.
+    pub fn insert(&mut self, source: &Path, m: Material, warnings: &mut Vec<String>) -> u32 {
+        let key = (source.to_path_buf(), m.name.clone());
+        if let Some(&i) = self.by_key.get(&key) {
             self.materials[i as usize] = m;
-            i
-        } else {
-            let i = self.materials.len() as u32;
-            self.by_name.insert(m.name.clone(), i);
-            self.materials.push(m);
-            i
+            return i;
         }
+        let clash = self
+            .by_key
+            .iter()
+            .find(|((file, name), &i)| name == &m.name && file != source && self.materials[i as usize] != m);
+        if let Some(((file, _), _)) = clash {
+            warnings.push(format!(
+                "material `{}` is defined differently in {} and {}: each mesh uses its own MTL file's                  (a [materials.{}] override in the scene file replaces both)",
+                m.name,
+                file.display(),
+                source.display(),
+                m.name
+            ));
+        }
+        let i = self.materials.len() as u32;
+        self.by_key.insert(key, i);
+        self.materials.push(m);
+        i
+    }
+
+    /// Replaces every material called `name`, from any file, by `m`; returns how many there were.
+    pub fn replace_named(&mut self, name: &str, m: &Material) -> usize {
+        let mut n = 0;
+        for slot in self.materials.iter_mut().filter(|x| x.name == name) {
+            *slot = m.clone();
+            n += 1;
+        }
+        n
     }
 
     /// Index of the grey Lambertian used for faces without a material.
     pub fn default_material(&mut self) -> u32 {
-        if let Some(&i) = self.by_name.get(DEFAULT_MATERIAL) {
-            return i;
-        }
-        self.insert(Material {
+        let grey = Material {
             name: DEFAULT_MATERIAL.into(),
             bsdf: Bsdf::Lambert { kd: Vec3::splat(0.8) },
             emission: Vec3::ZERO,
-        })
+        };
+        match self.by_key.get(&(PathBuf::new(), DEFAULT_MATERIAL.to_string())) {
+            Some(&i) => i,
+            None => self.insert(Path::new(""), grey, &mut Vec::new()),
+        }
     }
 }
 
 /// Name of the material given to faces with no `usemtl` (or an unknown one).
 pub const DEFAULT_MATERIAL: &str = "(default grey)";
 
-fn rgb(v: Option<[f32; 3]>) -> Option<Vec3> {
-    v.map(Vec3::from_array)
+/// The files an `mtllib` statement names: its whole text when a file of that name exists
+/// (names with spaces), else each word.
+fn mtllib_files(dir: &Path, lib: &MtlLib) -> Vec<PathBuf> {
+    if dir.join(&lib.names).is_file() {
+        vec![PathBuf::from(&lib.names)]
+    } else {
+        lib.names.split_whitespace().map(PathBuf::from).collect()
+    }
 }
 
-/// Maps one MTL material onto photonwave's materials; warnings go to `warnings`.
-#[must_use]
-pub fn material_from_mtl(m: &tobj::Material, warnings: &mut Vec<String>) -> Material {
-    let kd = rgb(m.diffuse).unwrap_or(Vec3::splat(0.8));
-    let ks = rgb(m.specular).unwrap_or(Vec3::ZERO);
-    let emission = rgb(m.emissive).unwrap_or(Vec3::ZERO);
-    let illum = m.illumination_model.unwrap_or(2);
-    let bsdf = match illum {
-        3 | 5 => Bsdf::Mirror { ks: rgb(m.specular).unwrap_or(Vec3::ONE).min(Vec3::ONE) },
-        4 | 6 | 7 => Bsdf::Glass { ior: m.optical_density.unwrap_or(1.5) },
-        2 if ks.max_element() > 0.0 => {
-            let sum = (kd + ks).max_element();
-            let scale = if sum > 1.0 {
-                warnings.push(format!("material `{}`: Kd + Ks = {sum:.3} > 1, scaled down to conserve energy", m.name));
-                1.0 / sum
-            } else {
-                1.0
-            };
-            Bsdf::Glossy { kd: kd * scale, ks: ks * scale, exponent: m.shininess.unwrap_or(10.0).max(0.0) }
+/// `e` with "(named by OBJ:LINE)" added, for an MTL file that cannot be read.
+fn named_by(e: Error, obj: &Path, line: usize) -> Error {
+    match e {
+        Error::Io { path, message } => {
+            Error::Io { path, message: format!("{message} (named by `mtllib` at {}:{line})", obj.display()) }
         }
-        _ => {
-            if kd.max_element() > 1.0 {
-                warnings.push(format!("material `{}`: Kd > 1 clamped to 1 to conserve energy", m.name));
-            }
-            Bsdf::Lambert { kd: kd.min(Vec3::ONE) }
-        }
-    };
-    Material { name: m.name.clone(), bsdf, emission }
+        other => other,
+    }
 }
+
+/// The name tobj is given for the one material library photonwave hands it (all of the OBJ's
+/// MTL files, already read and checked).
+const ALL_MATERIALS: &str = "\u{1}photonwave-materials";
 
 /// Loads an OBJ file (and the MTL files it names) into a mesh; materials go into `table`.
 /// `transform` scales then translates every position.
+/// Every file read is added to `inputs`.
 pub fn load_obj(
     path: &Path,
     transform: (f32, Vec3),
     table: &mut MaterialTable,
     warnings: &mut Vec<String>,
+    inputs: &mut Vec<PathBuf>,
 ) -> Result<MeshInput> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    let mtllibs = check_obj(path, &text)?;
+    let text = read_text(path, "a mesh (OBJ)", MAX_MESH_FILE)?;
+    inputs.push(path.to_path_buf());
     let dir = path.parent().unwrap_or(Path::new("."));
-    for lib in &mtllibs {
-        let mtl_path = dir.join(lib);
-        let mtl_text = std::fs::read_to_string(&mtl_path).map_err(|e| Error::io(&mtl_path, e))?;
-        check_mtl(&mtl_path, &mtl_text)?;
+    let mut mtl: Vec<(PathBuf, MtlMaterial)> = Vec::new();
+    for lib in check_obj(path, &text)? {
+        for file in mtllib_files(dir, &lib) {
+            let mtl_path = dir.join(file);
+            let mtl_text = read_text(&mtl_path, "a material file (MTL)", MAX_MATERIAL_FILE)
+                .map_err(|e| named_by(e, path, lib.line))?;
+            inputs.push(mtl_path.clone());
+            mtl.extend(parse_mtl(&mtl_path, &mtl_text, warnings)?.into_iter().map(|m| (mtl_path.clone(), m)));
+        }
     }
+    // tobj is given the checked text and one material library holding every MTL file's
+    // materials in order (a later file's material of the same name wins, as in tobj).
+    let names: Vec<tobj::Material> =
+        mtl.iter().map(|(_, m)| tobj::Material { name: m.name.clone(), ..Default::default() }).collect();
+    let index: HashMap<String, usize> = mtl.iter().enumerate().map(|(i, (_, m))| (m.name.clone(), i)).collect();
     let options = tobj::LoadOptions { single_index: true, triangulate: true, ..Default::default() };
-    let (models, mtl) = tobj::load_obj(path, &options).map_err(|e| Error::parse(path, 0, format!("OBJ: {e}")))?;
-    let mtl = match mtl {
-        Ok(m) => m,
-        // tobj reports "no material file" as an error; an OBJ without `mtllib` simply has none.
-        Err(_) if mtllibs.is_empty() => Vec::new(),
-        Err(e) => return Err(Error::parse(&dir.join(&mtllibs[0]), 0, format!("MTL: {e}"))),
-    };
-    let ids: Vec<u32> = mtl.iter().map(|m| table.insert(material_from_mtl(m, warnings))).collect();
+    let header = format!("mtllib {ALL_MATERIALS}\n");
+    let mut reader = std::io::Read::chain(header.as_bytes(), text.as_bytes());
+    let (models, _) = tobj::load_obj_buf(&mut reader, &options, |lib| {
+        if lib == Path::new(ALL_MATERIALS) {
+            Ok((names.clone(), index.clone()))
+        } else {
+            Ok((Vec::new(), HashMap::new()))
+        }
+    })
+    .map_err(|e| Error::parse(path, 0, format!("OBJ: {e}")))?;
+    let ids: Vec<u32> =
+        mtl.iter().map(|(file, m)| table.insert(file, material_from_mtl(m, warnings), warnings)).collect();
 
     let (scale, translate) = transform;
     let mut mesh = MeshInput { source: path.display().to_string(), ..Default::default() };

@@ -1,9 +1,9 @@
-//! Line-by-line checks of OBJ and MTL text before tobj parses it, so that every malformed
+//! Line-by-line checks of OBJ text before tobj parses it, so that every malformed
 //! statement is reported with its file and line (tobj reports only a kind of error), and so that
 //! non-finite numbers, which Rust's float parser accepts as "nan" or "inf", are refused.
 
 use crate::error::{Error, Result};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn floats(path: &Path, line_no: usize, what: &str, words: &[&str], min: usize, max: usize) -> Result<Vec<f32>> {
     if words.len() < min || words.len() > max {
@@ -24,8 +24,17 @@ fn floats(path: &Path, line_no: usize, what: &str, words: &[&str], min: usize, m
         .collect()
 }
 
-/// Checks an OBJ file's text; returns the `mtllib` files it names (relative to the OBJ's folder).
-pub fn check_obj(path: &Path, text: &str) -> Result<Vec<PathBuf>> {
+/// An `mtllib` statement: its line and what follows the keyword (one or more file names).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MtlLib {
+    /// 1-based line.
+    pub line: usize,
+    /// The rest of the line, trimmed.
+    pub names: String,
+}
+
+/// Checks an OBJ file's text; returns its `mtllib` statements.
+pub fn check_obj(path: &Path, text: &str) -> Result<Vec<MtlLib>> {
     let mut n_v = 0i64;
     let mut n_vt = 0i64;
     let mut n_vn = 0i64;
@@ -96,7 +105,7 @@ pub fn check_obj(path: &Path, text: &str) -> Result<Vec<PathBuf>> {
                 if name.is_empty() {
                     return Err(Error::parse(path, line_no, "`mtllib` names no file"));
                 }
-                mtllibs.push(PathBuf::from(name));
+                mtllibs.push(MtlLib { line: line_no, names: name.to_string() });
             }
             "usemtl" | "o" | "g" | "s" | "l" | "p" | "vp" | "cstype" | "deg" | "curv" | "surf" | "parm" | "end"
             | "usemap" | "maplib" | "mg" | "lod" | "bevel" | "c_interp" | "d_interp" | "shadow_obj" | "trace_obj"
@@ -112,55 +121,6 @@ pub fn check_obj(path: &Path, text: &str) -> Result<Vec<PathBuf>> {
     Ok(mtllibs)
 }
 
-/// Checks an MTL file's text: numbers where numbers belong, finite and non-negative colours.
-pub fn check_mtl(path: &Path, text: &str) -> Result<()> {
-    let mut current: Option<String> = None;
-    for (i, raw) in text.lines().enumerate() {
-        let line_no = i + 1;
-        let line = raw.split('#').next().unwrap_or("").trim();
-        let mut it = line.split_whitespace();
-        let Some(kw) = it.next() else { continue };
-        let words: Vec<&str> = it.collect();
-        if kw == "newmtl" {
-            if words.is_empty() {
-                return Err(Error::parse(path, line_no, "`newmtl` needs a name"));
-            }
-            current = Some(words.join(" "));
-            continue;
-        }
-        if kw.starts_with("map_") || matches!(kw, "bump" | "disp" | "decal" | "refl" | "norm") {
-            continue;
-        }
-        if current.is_none() {
-            return Err(Error::parse(path, line_no, format!("`{kw}` before any `newmtl`")));
-        }
-        match kw {
-            "Ka" | "Kd" | "Ks" | "Ke" | "Tf" => {
-                let v = floats(path, line_no, kw, &words, 3, 3)?;
-                if v.iter().any(|&c| c < 0.0) {
-                    return Err(Error::parse(path, line_no, format!("`{kw}` must not be negative")));
-                }
-            }
-            "Ns" | "d" | "Tr" | "Pr" | "Pm" | "Ps" | "Pc" | "Pcr" | "aniso" | "anisor" => {
-                floats(path, line_no, kw, &words, 1, 1)?;
-            }
-            "Ni" => {
-                let v = floats(path, line_no, kw, &words, 1, 1)?;
-                if v[0] <= 0.0 {
-                    return Err(Error::parse(path, line_no, "`Ni` (index of refraction) must be positive"));
-                }
-            }
-            "illum" => {
-                if words.len() != 1 || words[0].parse::<u8>().is_err() {
-                    return Err(Error::parse(path, line_no, "`illum` needs one integer 0–10"));
-                }
-            }
-            other => return Err(Error::parse(path, line_no, format!("unknown MTL statement `{other}`"))),
-        }
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -171,7 +131,5 @@ mod tests {
         assert!(e.to_string().starts_with("a.obj:2:"), "{e}");
         let e = check_obj(Path::new("a.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 3\n").unwrap_err();
         assert!(e.to_string().contains("a.obj:3:") && e.to_string().contains("vertex 3"), "{e}");
-        let e = check_mtl(Path::new("m.mtl"), "newmtl a\nKd 1 x 0\n").unwrap_err();
-        assert!(e.to_string().starts_with("m.mtl:2:"), "{e}");
     }
 }

@@ -1,0 +1,338 @@
+//! Files in and out, so that hostile input cannot exhaust memory and a failed write never loses
+//! a file.
+//!
+//! Reads: [`read_input`] takes regular files only (not `/dev/zero`, a FIFO or a directory) and
+//! at most a stated number of bytes; [`read_text`] also decodes UTF-8, drops a byte-order mark
+//! and turns CR LF and lone CR line ends into LF, as exporters on every platform write them.
+//!
+//! Writes: [`replace`] writes a file under a temporary name beside its destination, syncs it
+//! to disk and renames it into place, so a full disk, a crash or Ctrl-C leaves the previous
+//! file intact. [`check_outputs`] checks every output path of a command before any work: the
+//! extension, a writable folder, no input file of the scene and no two outputs the same file.
+
+use crate::error::{Error, Result};
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+/// The largest scene file (TOML) read: 16 MiB.
+pub const MAX_SCENE_FILE: u64 = 16 << 20;
+/// The largest OBJ file read: 2 GiB (about 30 million triangles).
+pub const MAX_MESH_FILE: u64 = 2 << 30;
+/// The largest MTL file read: 64 MiB.
+pub const MAX_MATERIAL_FILE: u64 = 64 << 20;
+
+/// The bytes of the regular file at `path`, refusing anything else and anything over `limit`
+/// bytes (`what` names the kind of file in the message: `a mesh (OBJ)`).
+pub fn read_input(path: &Path, what: &str, limit: u64) -> Result<Vec<u8>> {
+    let len = read_input_len(path, what)?;
+    if len > limit {
+        return Err(Error::io(path, too_large(what, len, limit)));
+    }
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    // The length can change between the look and the read: never take more than the limit.
+    let mut bytes = Vec::with_capacity(len as usize);
+    file.take(limit + 1).read_to_end(&mut bytes).map_err(|e| Error::io(path, e))?;
+    if bytes.len() as u64 > limit {
+        return Err(Error::io(path, too_large(what, bytes.len() as u64, limit)));
+    }
+    Ok(bytes)
+}
+
+/// The length of the regular file at `path`, refusing anything else (for inputs that a
+/// decoder reads itself).
+pub fn read_input_len(path: &Path, what: &str) -> Result<u64> {
+    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+    if !meta.is_file() {
+        let kind = if meta.is_dir() { "a directory" } else { "not a regular file (a device, pipe or socket)" };
+        return Err(Error::io(path, format!("is {kind}; only a regular file can be read as {what}")));
+    }
+    Ok(meta.len())
+}
+
+fn too_large(what: &str, len: u64, limit: u64) -> String {
+    format!("{} is larger than the {} accepted for {what}", bytes(len), bytes(limit))
+}
+
+/// A byte count for messages: `512 B`, `3.0 MiB`, `1.5 GiB`.
+#[must_use]
+pub fn bytes(n: u64) -> String {
+    const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = n as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u + 1 < UNITS.len() {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{n} B")
+    } else {
+        format!("{v:.1} {}", UNITS[u])
+    }
+}
+
+/// The text of the regular file at `path` (at most `limit` bytes): UTF-8 without a leading
+/// byte-order mark, with every line ending as LF. Invalid UTF-8 is an error naming the line.
+pub fn read_text(path: &Path, what: &str, limit: u64) -> Result<String> {
+    let raw = read_input(path, what, limit)?;
+    if raw.starts_with(&[0xFF, 0xFE]) || raw.starts_with(&[0xFE, 0xFF]) {
+        return Err(Error::parse(path, 1, "the file is UTF-16; save it as UTF-8"));
+    }
+    let body = raw.strip_prefix(&[0xEF, 0xBB, 0xBF][..]).unwrap_or(&raw);
+    let text = std::str::from_utf8(body).map_err(|e| {
+        let line = body[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
+        Error::parse(path, line, "not UTF-8 text")
+    })?;
+    Ok(normalise_line_ends(text))
+}
+
+/// `text` with CR LF and lone CR line ends turned into LF.
+#[must_use]
+pub fn normalise_line_ends(text: &str) -> String {
+    if text.contains('\r') {
+        text.replace("\r\n", "\n").replace('\r', "\n")
+    } else {
+        text.to_string()
+    }
+}
+
+/// Writes `path` through `write`, which is given a temporary path beside it (same folder and
+/// extension, so that writers choosing a format by extension still work). The temporary file is
+/// synced and renamed over `path` only when `write` succeeded; otherwise it is removed and the
+/// previous `path`, if any, is untouched.
+pub fn replace(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let tmp = temporary_beside(path);
+    let result = write(&tmp).and_then(|()| {
+        // Sync before the rename: a crash after it must not leave an empty file in place.
+        let f = std::fs::File::open(&tmp).map_err(|e| Error::output(path, e))?;
+        f.sync_all().map_err(|e| Error::output(path, e))?;
+        std::fs::rename(&tmp, path).map_err(|e| Error::output(path, e))
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Writes `path` through a buffered writer, by way of [`replace`].
+pub fn write_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<()> {
+    replace(path, |tmp| {
+        let file = std::fs::File::create(tmp).map_err(|e| Error::output(path, e))?;
+        let mut w = std::io::BufWriter::new(file);
+        write(&mut w).and_then(|()| w.flush()).map_err(|e| Error::output(path, e))
+    })
+}
+
+/// Writes `bytes` to `path`, by way of [`replace`].
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_with(path, |w| w.write_all(bytes))
+}
+
+/// Writes an 8-bit RGB PNG of `width × height` pixels (`rgb` row-major), by way of [`replace`].
+pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<()> {
+    write_with(path, |w| {
+        let mut enc = png::Encoder::new(w, width, height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut writer = enc.write_header().map_err(std::io::Error::other)?;
+        writer.write_image_data(rgb).map_err(std::io::Error::other)?;
+        writer.finish().map_err(std::io::Error::other)
+    })
+}
+
+/// `.NAME.partial-PID-N.EXT` in `path`'s folder.
+fn temporary_beside(path: &Path) -> PathBuf {
+    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let name = path.file_name().map_or("output".into(), |s| s.to_string_lossy().into_owned());
+    let ext = path.extension().map_or(String::new(), |e| format!(".{}", e.to_string_lossy()));
+    path.with_file_name(format!(".{name}.partial-{}-{n}{ext}", std::process::id()))
+}
+
+/// One output file of a command: the flag that names it, its path and the extension its format
+/// needs (`exr`, `png`, `json`, …; compared without case).
+#[derive(Clone, Copy, Debug)]
+pub struct Output<'a> {
+    /// The flag, as the user wrote it (`--png`).
+    pub flag: &'a str,
+    /// Where it goes.
+    pub path: &'a Path,
+    /// The format's extension, without the dot.
+    pub ext: &'a str,
+}
+
+/// Checks every output of a command before any work is done: each has its format's extension,
+/// is not a directory, lies in an existing folder where a file can be created, is none of
+/// `inputs` (the scene's files, a reference image), and no two name the same file.
+pub fn check_outputs(outputs: &[Output], inputs: &[PathBuf]) -> Result<()> {
+    let inputs: Vec<(PathBuf, &PathBuf)> = inputs.iter().map(|p| (identity(p), p)).collect();
+    let mut seen: Vec<(PathBuf, &Output)> = Vec::new();
+    for out in outputs {
+        let (flag, path) = (out.flag, out.path);
+        match path.extension().and_then(|e| e.to_str()) {
+            Some(e) if e.eq_ignore_ascii_case(out.ext) => {}
+            given => {
+                let hint = match given {
+                    Some(e) if e.eq_ignore_ascii_case("png") => " (for a PNG preview add --png FILE.png)",
+                    _ => "",
+                };
+                return Err(Error::setting(
+                    flag,
+                    format!(
+                        "writes {} only, so `{}` must end in .{}{hint}",
+                        out.ext.to_uppercase(),
+                        path.display(),
+                        out.ext.to_lowercase()
+                    ),
+                ));
+            }
+        }
+        if path.is_dir() {
+            return Err(Error::setting(flag, format!("`{}` is a directory; name a file in it", path.display())));
+        }
+        check_folder(flag, path)?;
+        let id = identity(path);
+        if let Some((_, input)) = inputs.iter().find(|(i, _)| *i == id) {
+            return Err(Error::setting(
+                flag,
+                format!("`{}` is an input ({}); writing it would destroy it", path.display(), input.display()),
+            ));
+        }
+        if let Some((_, other)) = seen.iter().find(|(i, _)| *i == id) {
+            return Err(Error::setting(
+                flag,
+                format!("`{}` is also the file of {}; give each output its own file", path.display(), other.flag),
+            ));
+        }
+        seen.push((id, out));
+    }
+    Ok(())
+}
+
+/// The folder of `path` exists and a file can be created in it (a probe file is created and
+/// removed: permission bits alone do not tell, e.g. on a read-only mount or as root).
+fn check_folder(flag: &str, path: &Path) -> Result<()> {
+    let dir = folder_of(path);
+    if !dir.is_dir() {
+        return Err(Error::setting(
+            flag,
+            format!("cannot write `{}`: the folder `{}` does not exist", path.display(), dir.display()),
+        ));
+    }
+    let probe = temporary_beside(path);
+    match std::fs::OpenOptions::new().write(true).create_new(true).open(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => Err(Error::setting(
+            flag,
+            format!("cannot write `{}`: the folder `{}` is not writable ({e})", path.display(), dir.display()),
+        )),
+    }
+}
+
+/// The folder a file path lies in (`.` for a bare name).
+fn folder_of(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// A path that is the same for every way of naming one file: the canonical path where the
+/// file exists (links resolved), else the canonical folder joined with the name.
+fn identity(path: &Path) -> PathBuf {
+    if let Ok(p) = path.canonicalize() {
+        return p;
+    }
+    let dir = folder_of(path);
+    let dir = dir.canonicalize().unwrap_or(dir);
+    match path.file_name() {
+        Some(name) => dir.join(name),
+        None => dir,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("photonwave-files-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn a_failed_write_leaves_the_previous_file_and_no_temporary() {
+        let d = scratch("failed");
+        let p = d.join("out.json");
+        std::fs::write(&p, "good").unwrap();
+        // A writer that fails half-way, as a full disk does.
+        let e = write_with(&p, |w| {
+            w.write_all(b"half")?;
+            Err(std::io::Error::new(std::io::ErrorKind::StorageFull, "No space left on device"))
+        })
+        .unwrap_err();
+        assert!(e.to_string().contains("out.json") && e.to_string().contains("No space"), "{e}");
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "good");
+        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1, "a temporary file was left behind");
+        write_bytes(&p, b"new").unwrap();
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "new");
+        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn text_loses_its_bom_and_carriage_returns() {
+        let d = scratch("text");
+        let p = d.join("a.obj");
+        std::fs::write(&p, b"\xEF\xBB\xBFv 0 0 0\rv 1 0 0\r\nf 1 2 3\r").unwrap();
+        assert_eq!(read_text(&p, "a mesh", 1000).unwrap(), "v 0 0 0\nv 1 0 0\nf 1 2 3\n");
+        std::fs::write(&p, b"ok\n\xFF\xFE").unwrap();
+        assert!(read_text(&p, "a mesh", 1000).unwrap_err().to_string().contains("a.obj:2:"));
+        std::fs::write(&p, b"\xFF\xFEv\x00").unwrap();
+        assert!(read_text(&p, "a mesh", 1000).unwrap_err().to_string().contains("UTF-16"));
+    }
+
+    #[test]
+    fn devices_folders_and_large_files_are_refused() {
+        let d = scratch("refuse");
+        let e = read_input(Path::new("/dev/zero"), "a mesh", MAX_MESH_FILE).unwrap_err().to_string();
+        assert!(e.contains("/dev/zero") && e.contains("not a regular file"), "{e}");
+        assert!(read_input(&d, "a mesh", 10).unwrap_err().to_string().contains("directory"));
+        let p = d.join("big.mtl");
+        std::fs::write(&p, [b'#'; 2048]).unwrap();
+        let e = read_input(&p, "a material file", 1024).unwrap_err().to_string();
+        assert!(e.contains("2.0 KiB") && e.contains("1.0 KiB"), "{e}");
+    }
+
+    fn out<'a>(flag: &'a str, path: &'a Path, ext: &'a str) -> Output<'a> {
+        Output { flag, path, ext }
+    }
+
+    #[test]
+    fn outputs_are_checked_before_work() {
+        let d = scratch("outputs");
+        let scene = d.join("scene.toml");
+        std::fs::write(&scene, "").unwrap();
+        let exr = d.join("a.exr");
+        let e = check_outputs(&[out("--stats", &scene, "json")], std::slice::from_ref(&scene)).unwrap_err().to_string();
+        assert!(e.contains("--stats") && e.contains(".json"), "{e}");
+        let json = d.join("scene.json");
+        std::fs::write(&json, "{}").unwrap();
+        let e = check_outputs(&[out("--stats", &json, "json")], std::slice::from_ref(&json)).unwrap_err().to_string();
+        assert!(e.contains("is an input"), "{e}");
+        // The same file named two ways.
+        let again = d.join(".").join("a.exr");
+        let e = check_outputs(&[out("-o", &exr, "exr"), out("--png", &again, "exr")], &[]).unwrap_err().to_string();
+        assert!(e.contains("also the file of -o"), "{e}");
+        let missing = d.join("nodir").join("x.exr");
+        let e = check_outputs(&[out("-o", &missing, "exr")], &[]).unwrap_err().to_string();
+        assert!(e.contains("does not exist") && e.contains("nodir"), "{e}");
+        let under_file = scene.join("x.exr");
+        assert!(check_outputs(&[out("-o", &under_file, "exr")], &[]).is_err());
+        check_outputs(&[out("-o", &exr, "exr"), out("--stats", &json, "JSON")], &[scene]).unwrap();
+        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 2, "the writability probe was left behind");
+    }
+}

@@ -1,0 +1,92 @@
+//! What a render will need in memory, estimated before any work, and what the machine has.
+//!
+//! The costs were measured with `/usr/bin/time -f %M` (peak resident set) on the bundled
+//! Cornell box, every engine (BENCHMARKS.md, "Memory"): about 147 bytes per pixel (film terms,
+//! per-pixel sums and radii, camera queues and the EXR's channels while it is written) and
+//! about 81 bytes per stored photon (the map's columns, the kd-tree and the deposits sorted
+//! before they are stored), over a base of about 12 MiB. The estimate rounds each up.
+
+use crate::error::{Error, Result};
+use crate::files::bytes;
+use crate::settings::Settings;
+
+/// Bytes per pixel of the image (measured 147).
+pub const BYTES_PER_PIXEL: u64 = 160;
+/// Bytes per stored photon (measured 81).
+pub const BYTES_PER_PHOTON: u64 = 96;
+/// Bytes of everything else (measured 12 MiB; the scene itself is already loaded).
+pub const BASE_BYTES: u64 = 16 << 20;
+
+/// A render's estimated peak memory, in bytes.
+#[must_use]
+pub fn estimate(settings: &Settings, global_map: bool, caustic_map: bool) -> u64 {
+    let pixels = u64::from(settings.width) * u64::from(settings.height);
+    let photons = u64::from(settings.photons) * u64::from(global_map)
+        + u64::from(settings.caustic_photons) * u64::from(caustic_map);
+    BASE_BYTES + pixels * BYTES_PER_PIXEL + photons * BYTES_PER_PHOTON
+}
+
+/// The machine's memory available to a new allocation and in all (Linux `/proc/meminfo`'s
+/// `MemAvailable` and `MemTotal`), in bytes; `None` where it cannot be read.
+#[must_use]
+pub fn machine() -> Option<(u64, u64)> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let field = |name: &str| -> Option<u64> {
+        let line = text.lines().find(|l| l.starts_with(name))?;
+        let kib: u64 = line[name.len()..].trim().trim_end_matches("kB").trim().parse().ok()?;
+        Some(kib * 1024)
+    };
+    Some((field("MemAvailable:")?, field("MemTotal:")?))
+}
+
+/// Refuses a render whose estimate exceeds `available` bytes (of `total`), saying what it would
+/// need, what the machine has, and what to lower.
+pub fn check(settings: &Settings, global_map: bool, caustic_map: bool, available: u64, total: u64) -> Result<()> {
+    let need = estimate(settings, global_map, caustic_map);
+    if need <= available {
+        return Ok(());
+    }
+    let pixels = u64::from(settings.width) * u64::from(settings.height);
+    let photons = u64::from(settings.photons) * u64::from(global_map)
+        + u64::from(settings.caustic_photons) * u64::from(caustic_map);
+    Err(Error::setting(
+        if pixels * BYTES_PER_PIXEL >= photons * BYTES_PER_PHOTON { "width" } else { "photons" },
+        format!(
+            "this render needs about {} ({}×{} pixels at ~{BYTES_PER_PIXEL} B, {photons} photons at \
+             ~{BYTES_PER_PHOTON} B), but the machine has {} available of {}; lower the image size or \
+             the photon counts (README, \"Limits\")",
+            bytes(need),
+            settings.width,
+            settings.height,
+            bytes(available),
+            bytes(total)
+        ),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_huge_image_is_refused_with_the_estimate_and_the_machine() {
+        let s = Settings { width: 16384, height: 16384, ..Settings::default() };
+        let e = check(&s, true, false, 20 << 30, 24 << 30).unwrap_err().to_string();
+        assert!(
+            e.starts_with("setting `width`") && e.contains("40.0 GiB") && e.contains("20.0 GiB available of 24.0 GiB"),
+            "{e}"
+        );
+        check(&Settings::default(), true, true, 1 << 30, 1 << 30).unwrap();
+        let many = Settings { photons: 100_000_000, caustic_photons: 100_000_000, ..Settings::default() };
+        let e = check(&many, true, true, 8 << 30, 8 << 30).unwrap_err().to_string();
+        assert!(e.starts_with("setting `photons`") && e.contains("200000000 photons"), "{e}");
+        check(&many, false, false, 8 << 30, 8 << 30).unwrap();
+    }
+
+    #[test]
+    fn this_machine_reports_its_memory() {
+        if let Some((available, total)) = machine() {
+            assert!(available > 0 && available <= total, "{available} of {total}");
+        }
+    }
+}

@@ -1,0 +1,298 @@
+//! MTL files as the spec (Wavefront's, with the PBR extension's keys) and real exporters write
+//! them, and their mapping onto photonwave's materials (documented in README):
+//!
+//! | MTL | material |
+//! |---|---|
+//! | `Ke` ≠ 0 | area emitter with radiance `Ke` from the front (counter-clockwise) face, plus the scattering below |
+//! | `illum` 3, 5 or 8 | perfect mirror, reflectance `Ks` (1 if absent) |
+//! | `illum` 4, 6, 7 or 9 | smooth clear dielectric, IOR `Ni` (1.5 if absent), exact Fresnel |
+//! | `illum` 2 with `Ks` > 0 | Lambertian `Kd` + normalised Phong lobe `Ks`, exponent `Ns`; scaled so Kd + Ks ≤ 1 |
+//! | otherwise (`illum` 0, 1, 10, or 2 without `Ks`) | Lambertian `Kd` (0.8 grey if absent) |
+//!
+//! Colours take three numbers, one (grey), or `xyz X [Y Z]` (CIE XYZ, converted to linear sRGB).
+//! Statements the spec defines but photonwave does not simulate (texture maps with their
+//! options, `d`/`Tr` transparency, `sharpness`, `Km`, the PBR keys, spectral colours) are read,
+//! checked where they hold numbers, and reported in one warning per material. Anything else is
+//! an error naming the file and line.
+
+use crate::error::{Error, Result};
+use crate::material::{Bsdf, Material};
+use glam::Vec3;
+use std::path::Path;
+
+/// One `newmtl` block as read from the file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MtlMaterial {
+    /// Its name.
+    pub name: String,
+    /// The line of its `newmtl`.
+    pub line: usize,
+    /// `Kd`.
+    pub kd: Option<Vec3>,
+    /// `Ks`.
+    pub ks: Option<Vec3>,
+    /// `Ke`.
+    pub ke: Option<Vec3>,
+    /// `Ns`.
+    pub ns: Option<f32>,
+    /// `Ni`.
+    pub ni: Option<f32>,
+    /// `illum`.
+    pub illum: Option<u8>,
+    /// Statements read but not simulated, in order of first appearance (`map_Kd`, `d`, …).
+    pub ignored: Vec<String>,
+}
+
+fn number(path: &Path, line: usize, what: &str, w: &str) -> Result<f32> {
+    let v: f32 = w.parse().map_err(|_| Error::parse(path, line, format!("`{what}`: `{w}` is not a number")))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(Error::parse(path, line, format!("`{what}`: `{w}` is not finite")))
+    }
+}
+
+/// A colour statement's value: `r g b`, `r` (grey), or `xyz X [Y Z]`. `None` for `spectral`.
+fn colour(path: &Path, line: usize, kw: &str, words: &[&str]) -> Result<Option<Vec3>> {
+    let nums = |ws: &[&str]| ws.iter().map(|w| number(path, line, kw, w)).collect::<Result<Vec<f32>>>();
+    let v = match words.first().copied() {
+        Some("spectral") => return Ok(None),
+        Some("xyz") => {
+            let xyz = nums(&words[1..])?;
+            let xyz = match xyz.len() {
+                1 => Vec3::splat(xyz[0]),
+                3 => Vec3::from_slice(&xyz),
+                n => return Err(Error::parse(path, line, format!("`{kw} xyz` needs 1 or 3 numbers, found {n}"))),
+            };
+            // CIE XYZ (D65 white) to linear sRGB; out-of-gamut negatives clip to 0.
+            Vec3::new(
+                3.240_97 * xyz.x - 1.537_38 * xyz.y - 0.498_61 * xyz.z,
+                -0.969_24 * xyz.x + 1.875_97 * xyz.y + 0.041_56 * xyz.z,
+                0.055_63 * xyz.x - 0.203_98 * xyz.y + 1.056_97 * xyz.z,
+            )
+            .max(Vec3::ZERO)
+        }
+        _ => {
+            let v = nums(words)?;
+            match v.len() {
+                1 => Vec3::splat(v[0]),
+                3 => Vec3::from_slice(&v),
+                n => {
+                    return Err(Error::parse(path, line, format!("`{kw}` needs 3 numbers (or 1 for grey), found {n}")))
+                }
+            }
+        }
+    };
+    if v.min_element() < 0.0 {
+        return Err(Error::parse(path, line, format!("`{kw}` must not be negative")));
+    }
+    Ok(Some(v))
+}
+
+/// The image file of a texture statement's words: the spec's options (`-o 1 1 1`, `-bm 0.5`,
+/// `-clamp on`, …) with their arguments come first, the file name (which may hold spaces) last.
+fn texture_file(words: &[&str]) -> Option<String> {
+    let mut i = 0;
+    while let Some(opt) = words.get(i).filter(|w| w.starts_with('-')) {
+        i += 1;
+        let (min, max) = match *opt {
+            "-o" | "-s" | "-t" => (1, 3),
+            "-mm" => (2, 2),
+            _ => (1, 1), // -blendu -blendv -bm -boost -cc -clamp -imfchan -texres -type
+        };
+        let mut taken = 0;
+        while taken < max && i < words.len() && (taken < min || words[i].parse::<f32>().is_ok()) {
+            i += 1;
+            taken += 1;
+        }
+    }
+    (i < words.len()).then(|| words[i..].join(" "))
+}
+
+/// Reads the text of an MTL file. Non-fatal findings (a material defined twice, statements that
+/// are not simulated) go to `warnings`, once per material.
+pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<Vec<MtlMaterial>> {
+    let mut out: Vec<MtlMaterial> = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let stmt = raw.split('#').next().unwrap_or("").trim();
+        let mut it = stmt.split_whitespace();
+        let Some(kw) = it.next() else { continue };
+        let words: Vec<&str> = it.collect();
+        if kw == "newmtl" {
+            let name = stmt["newmtl".len()..].trim();
+            if name.is_empty() {
+                return Err(Error::parse(path, line, "`newmtl` needs a name"));
+            }
+            if let Some(k) = out.iter().position(|m| m.name == name) {
+                warnings.push(format!(
+                    "{}:{line}: material `{name}` is defined again (first at line {}); this later definition is used",
+                    path.display(),
+                    out[k].line
+                ));
+                out.remove(k);
+            }
+            out.push(MtlMaterial { name: name.to_string(), line, ..Default::default() });
+            continue;
+        }
+        let Some(m) = out.last_mut() else {
+            return Err(Error::parse(path, line, format!("`{kw}` before any `newmtl`")));
+        };
+        let one = |what: &str| -> Result<f32> {
+            match words.as_slice() {
+                [w] => number(path, line, what, w),
+                _ => Err(Error::parse(path, line, format!("`{what}` needs 1 number, found {}", words.len()))),
+            }
+        };
+        let ignore = |m: &mut MtlMaterial, what: &str| {
+            if !m.ignored.iter().any(|s| s == what) {
+                m.ignored.push(what.to_string());
+            }
+        };
+        match kw {
+            "Kd" => m.kd = colour(path, line, kw, &words)?.or(m.kd),
+            "Ks" => m.ks = colour(path, line, kw, &words)?.or(m.ks),
+            "Ke" => m.ke = colour(path, line, kw, &words)?.or(m.ke),
+            "Ka" | "Tf" => {
+                colour(path, line, kw, &words)?;
+            }
+            "Ns" => {
+                let v = one(kw)?;
+                if v < 0.0 {
+                    return Err(Error::parse(path, line, "`Ns` (Phong exponent) must not be negative"));
+                }
+                m.ns = Some(v);
+            }
+            "Ni" => {
+                let v = one(kw)?;
+                if v <= 0.0 {
+                    return Err(Error::parse(path, line, "`Ni` (index of refraction) must be positive"));
+                }
+                m.ni = Some(v);
+            }
+            "illum" => match words.as_slice() {
+                [w] if w.parse::<u8>().is_ok_and(|v| v <= 10) => m.illum = w.parse().ok(),
+                _ => return Err(Error::parse(path, line, "`illum` needs one integer 0–10 (the MTL spec's models)")),
+            },
+            "d" | "Tr" => {
+                // `d -halo 0.5` is the spec's other form.
+                let v = match words.as_slice() {
+                    ["-halo", w] => number(path, line, kw, w)?,
+                    _ => one(kw)?,
+                };
+                if !(0.0..=1.0).contains(&v) {
+                    return Err(Error::parse(path, line, format!("`{kw}` must be in [0, 1]")));
+                }
+                let opaque = if kw == "d" { v == 1.0 } else { v == 0.0 };
+                if !opaque {
+                    ignore(m, kw);
+                }
+            }
+            "sharpness" | "Pr" | "Pm" | "Ps" | "Pc" | "Pcr" | "aniso" | "anisor" => {
+                one(kw)?;
+                ignore(m, kw);
+            }
+            "Km" => {
+                colour(path, line, kw, &words)?;
+                ignore(m, kw);
+            }
+            _ if kw.starts_with("map_") || matches!(kw, "bump" | "disp" | "decal" | "refl" | "norm") => {
+                if texture_file(&words).is_none() {
+                    return Err(Error::parse(path, line, format!("`{kw}` names no image file")));
+                }
+                ignore(m, kw);
+            }
+            other => return Err(Error::parse(path, line, format!("unknown MTL statement `{other}`"))),
+        }
+    }
+    for m in &out {
+        if !m.ignored.is_empty() {
+            warnings.push(format!(
+                "{}:{}: material `{}`: {} not simulated yet (texture maps, transparency and the PBR keys are \
+                 ignored); it renders with its constant colours",
+                path.display(),
+                m.line,
+                m.name,
+                m.ignored.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", ")
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// Maps one MTL material onto photonwave's materials; warnings go to `warnings`.
+#[must_use]
+pub fn material_from_mtl(m: &MtlMaterial, warnings: &mut Vec<String>) -> Material {
+    let kd = m.kd.unwrap_or(Vec3::splat(0.8));
+    let ks = m.ks.unwrap_or(Vec3::ZERO);
+    let emission = m.ke.unwrap_or(Vec3::ZERO);
+    let bsdf = match m.illum.unwrap_or(2) {
+        3 | 5 | 8 => Bsdf::Mirror { ks: m.ks.unwrap_or(Vec3::ONE).min(Vec3::ONE) },
+        4 | 6 | 7 | 9 => Bsdf::Glass { ior: m.ni.unwrap_or(1.5) },
+        2 if ks.max_element() > 0.0 => {
+            let sum = (kd + ks).max_element();
+            let scale = if sum > 1.0 {
+                warnings.push(format!("material `{}`: Kd + Ks = {sum:.3} > 1, scaled down to conserve energy", m.name));
+                1.0 / sum
+            } else {
+                1.0
+            };
+            Bsdf::Glossy { kd: kd * scale, ks: ks * scale, exponent: m.ns.unwrap_or(10.0) }
+        }
+        _ => {
+            if kd.max_element() > 1.0 {
+                warnings.push(format!("material `{}`: Kd > 1 clamped to 1 to conserve energy", m.name));
+            }
+            Bsdf::Lambert { kd: kd.min(Vec3::ONE) }
+        }
+    };
+    Material { name: m.name.clone(), bsdf, emission }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> (Result<Vec<MtlMaterial>>, Vec<String>) {
+        let mut w = Vec::new();
+        (parse_mtl(Path::new("m.mtl"), text, &mut w), w)
+    }
+
+    #[test]
+    fn colours_take_one_three_or_xyz_numbers() {
+        let (m, _) = parse("newmtl a\nKd 0.5\nKs 0.1 0.2 0.3\nKe xyz 0.9505 1 1.089\n");
+        let m = &m.unwrap()[0];
+        assert_eq!(m.kd, Some(Vec3::splat(0.5)));
+        assert_eq!(m.ks, Some(Vec3::new(0.1, 0.2, 0.3)));
+        assert!((m.ke.unwrap() - Vec3::ONE).abs().max_element() < 2e-3, "D65 white is (1, 1, 1): {:?}", m.ke);
+        let e = parse("newmtl a\nKd 0.5 0.5\n").0.unwrap_err().to_string();
+        assert!(e.starts_with("m.mtl:2:") && e.contains("3 numbers (or 1"), "{e}");
+    }
+
+    #[test]
+    fn spec_statements_are_accepted_and_reported_once_per_material() {
+        let text = "newmtl a\nKd 1 0 0\nsharpness 60\nKm 0.5\nmap_Kd -o 1 1 1 -s 2 2 2 tex.png\nbump -bm 0.5 b.png\n\
+                    d 0.5\nd -halo 1\nmap_Ks spec.png\nnewmtl b\nd 1\nTr 0\n";
+        let (m, w) = parse(text);
+        let m = m.unwrap();
+        assert_eq!(m[0].ignored, ["sharpness", "Km", "map_Kd", "bump", "d", "map_Ks"]);
+        assert!(m[1].ignored.is_empty(), "opaque `d 1` and `Tr 0` change nothing");
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(w[0].starts_with("m.mtl:1: material `a`") && w[0].contains("`map_Kd`"), "{w:?}");
+    }
+
+    #[test]
+    fn silent_mistakes_are_errors_or_warnings() {
+        let e = parse("newmtl a\nNs -5\n").0.unwrap_err().to_string();
+        assert!(e.starts_with("m.mtl:2:") && e.contains("negative"), "{e}");
+        let e = parse("newmtl a\nillum 99\n").0.unwrap_err().to_string();
+        assert!(e.starts_with("m.mtl:2:") && e.contains("0–10"), "{e}");
+        let e = parse("newmtl a\nmap_Kd -clamp on\n").0.unwrap_err().to_string();
+        assert!(e.contains("no image file"), "{e}");
+        let (m, w) = parse("newmtl a\nKd 1 0 0\nnewmtl b\nnewmtl a\nKd 0 1 0\n");
+        let m = m.unwrap();
+        assert_eq!(m.iter().map(|m| m.name.as_str()).collect::<Vec<_>>(), ["b", "a"]);
+        assert_eq!(m[1].kd, Some(Vec3::Y));
+        assert!(w[0].starts_with("m.mtl:4: material `a` is defined again (first at line 1)"), "{w:?}");
+    }
+}

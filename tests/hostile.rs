@@ -1,0 +1,216 @@
+//! A hostile new user's inputs (issue 13): nothing of theirs is lost, nothing crashes or exhausts
+//! memory, MTL and OBJ files are read as their spec and real exporters write them, and what is
+//! not simulated is said. Each data-loss case checks that the earlier file is intact afterwards.
+
+mod common;
+
+use common::*;
+use photonwave::material::Material;
+use photonwave::scene::file::load_scene;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn write(dir: &Path, name: &str, text: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn cli(args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_photonwave")).args(args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    (out.status.code().unwrap_or(-1), stderr)
+}
+
+/// A copy of the bundled Cornell box in its own folder, with a previous render's outputs.
+fn workspace(test: &str) -> PathBuf {
+    let d = scratch_dir(test);
+    for f in ["cornell-box.toml", "cornell-box.obj", "cornell-box.mtl"] {
+        std::fs::copy(bundled(f), d.join(f)).unwrap();
+    }
+    for f in ["a.exr", "p.png", "s.json", "out.exr"] {
+        write(&d, f, format!("previous {f}"));
+    }
+    d
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+const SMALL: [&str; 8] = ["--width", "4", "--height", "4", "--spp", "1", "--photons", "500"];
+
+#[test]
+fn outputs_never_overwrite_inputs_or_each_other() {
+    let d = workspace("no-loss");
+    let scene = d.join("cornell-box.toml");
+    let before = std::fs::read(&scene).unwrap();
+    let (a, p, obj) = (d.join("a.exr"), d.join("p.png"), d.join("cornell-box.obj"));
+    let cases: [(&[&str], &str); 5] = [
+        (&["--stats", s(&scene)], "--stats"),
+        (&["-o", s(&a), "--stats", s(&a)], "--stats"),
+        (&["--png", s(&p), "--stats", s(&p)], "--stats"),
+        (&["-o", s(&a), "--png", s(&a)], "--png"),
+        (&["-o", s(&obj)], "--output"),
+    ];
+    for (extra, flag) in cases {
+        let mut args = vec!["render", s(&scene), "-q"];
+        args.extend_from_slice(&SMALL);
+        args.extend_from_slice(extra);
+        let (code, e) = cli(&args);
+        assert!(code != 0 && e.contains(flag), "{extra:?}: {e}");
+    }
+    assert_eq!(std::fs::read(&scene).unwrap(), before, "the scene file was changed");
+    for f in ["a.exr", "p.png", "s.json", "out.exr"] {
+        assert_eq!(std::fs::read_to_string(d.join(f)).unwrap(), format!("previous {f}"), "{f} was changed");
+    }
+}
+
+/// A missing folder for any output is found before the render, and the previous `-o` file is
+/// left as it was (it used to be overwritten before `--stats` failed).
+#[test]
+fn a_missing_output_folder_fails_before_rendering() {
+    let d = workspace("no-dir");
+    let (scene, out) = (d.join("cornell-box.toml"), d.join("out.exr"));
+    let missing = |name: &str| d.join("nodir").join(name).to_str().unwrap().to_string();
+    for extra in [
+        vec!["-o".to_string(), s(&out).into(), "--stats".into(), missing("s.json")],
+        vec!["-o".to_string(), s(&out).into(), "--png".into(), missing("p.png")],
+        vec!["-o".to_string(), missing("x.exr"), "--time".into(), "5s".into()],
+    ] {
+        let mut args = vec!["render", s(&scene), "-q"];
+        args.extend_from_slice(&SMALL);
+        args.extend(extra.iter().map(String::as_str));
+        let t = std::time::Instant::now();
+        let (code, e) = cli(&args);
+        assert!(code != 0 && e.contains("nodir") && e.contains("does not exist"), "{extra:?}: {e}");
+        // A five-second budget would have run out before the error; the check comes first.
+        assert!(t.elapsed().as_secs_f64() < 4.0, "{extra:?} rendered before failing");
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "previous out.exr");
+    }
+}
+
+#[test]
+fn devices_are_not_read_as_meshes_or_materials() {
+    let d = scratch_dir("devices");
+    let obj = write(&d, "a.obj", "mtllib /dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let e = load_scene(&obj).err().unwrap().to_string();
+    assert!(e.contains("/dev/zero") && e.contains("not a regular file") && e.contains("a.obj:1"), "{e}");
+    let toml = write(&d, "s.toml", "[[mesh]]\nfile = \"/dev/zero\"\n");
+    let e = load_scene(&toml).err().unwrap().to_string();
+    assert!(e.contains("/dev/zero") && e.contains("not a regular file"), "{e}");
+}
+
+#[test]
+fn huge_images_are_refused_with_the_estimate() {
+    let (code, e) = cli(&["render", s(&bundled("cornell-box.toml")), "--width", "16384", "--height", "16384"]);
+    // On a machine with 40 GiB free this would render; CI machines have 24 GiB.
+    let free = photonwave::memory::machine().map_or(0, |m| m.0);
+    if free < 41 << 30 {
+        assert!(code != 0 && e.contains("needs about 40.0 GiB") && e.contains("available of"), "{e}");
+    }
+}
+
+/// `compare` on an EXR whose header claims 60000² pixels: refused from its length before any
+/// allocation (it aborted allocating 14.4 GB).
+#[test]
+fn an_exr_header_cannot_claim_more_than_the_file_holds() {
+    let d = scratch_dir("exr-header");
+    let small = d.join("small.exr");
+    photonwave::film::Film { width: 8, height: 4, pixels: vec![Default::default(); 32] }.write_exr(&small).unwrap();
+    let mut bytes = std::fs::read(&small).unwrap();
+    let key = b"dataWindow\0box2i\0";
+    let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+    for (k, v) in [0i32, 0, 59_999, 59_999].iter().enumerate() {
+        bytes[at + 4 * k..at + 4 * k + 4].copy_from_slice(&v.to_le_bytes());
+    }
+    let huge = write(&d, "huge.exr", &bytes);
+    let (code, e) = cli(&["compare", s(&huge), s(&small)]);
+    assert!(code != 0 && e.contains("huge.exr") && e.contains("60000×60000"), "{e}");
+    let (code, e) = cli(&["compare", "/dev/zero", s(&small)]);
+    assert!(code != 0 && e.contains("not a regular file"), "{e}");
+}
+
+const MTL: &str = "newmtl light\nKd 0.5 0.5 0.5\nKe 1 1 1\nnewmtl white\nKd 0.5\n";
+const OBJ: &str = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nusemtl light\nf 1 3 2\nusemtl white\nf 1 2 4\n";
+
+fn material<'a>(materials: &'a [Material], name: &str) -> &'a Material {
+    materials.iter().find(|m| m.name == name).unwrap_or_else(|| panic!("no material `{name}`"))
+}
+
+/// A byte-order mark, CR-only and CR LF line ends, a one-number colour, and several MTL files
+/// on one `mtllib` line all load as they mean.
+#[test]
+fn exporters_files_load_as_the_spec_writes_them() {
+    let d = scratch_dir("spec");
+    write(&d, "m.mtl", [&b"\xEF\xBB\xBF"[..], MTL.replace('\n', "\r").as_bytes()].concat());
+    let obj = write(&d, "a.obj", [&b"\xEF\xBB\xBF"[..], OBJ.replace('\n', "\r\n").as_bytes()].concat());
+    let scene = load_scene(&obj).unwrap().scene;
+    assert_eq!(scene.triangle_count(), 2);
+    let white = material(&scene.materials, "white");
+    assert_eq!(white.bsdf, photonwave::material::Bsdf::Lambert { kd: glam::Vec3::splat(0.5) });
+    let cr_only = write(&d, "cr.obj", OBJ.replace('\n', "\r"));
+    assert_eq!(load_scene(&cr_only).unwrap().scene.triangle_count(), 2);
+    // Two libraries on one line, the second defining what the first does not.
+    write(&d, "lights.mtl", "newmtl light\nKe 1 1 1\n");
+    write(&d, "walls.mtl", "newmtl white\nKd 0.25 0.25 0.25\n");
+    let two = write(&d, "two.obj", OBJ.replace("mtllib m.mtl", "mtllib lights.mtl walls.mtl"));
+    let scene = load_scene(&two).unwrap().scene;
+    assert_eq!(
+        material(&scene.materials, "white").bsdf,
+        photonwave::material::Bsdf::Lambert { kd: glam::Vec3::splat(0.25) }
+    );
+    // A file name with a space, named whole.
+    write(&d, "my walls.mtl", "newmtl white\nKd 0.125 0.125 0.125\nnewmtl light\nKe 2 2 2\n");
+    let spaced = write(&d, "spaced.obj", OBJ.replace("mtllib m.mtl", "mtllib my walls.mtl"));
+    let white = load_scene(&spaced).unwrap().scene;
+    assert_eq!(
+        material(&white.materials, "white").bsdf,
+        photonwave::material::Bsdf::Lambert { kd: glam::Vec3::splat(0.125) }
+    );
+}
+
+/// Two OBJ files whose MTL files both define `floor`: each mesh gets its own file's (the second
+/// used to get the first's, a grey floor rendering red), and a warning says so.
+#[test]
+fn materials_are_kept_apart_per_file() {
+    let d = scratch_dir("namespace");
+    write(&d, "red.mtl", "newmtl floor\nKd 0.8 0 0\nnewmtl light\nKe 1 1 1\n");
+    write(&d, "grey.mtl", "newmtl floor\nKd 0.5 0.5 0.5\n");
+    write(&d, "red.obj", "mtllib red.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl floor\nf 1 2 3\nusemtl light\nf 1 3 2\n");
+    write(&d, "grey.obj", "mtllib grey.mtl\nv 0 0 1\nv 1 0 1\nv 0 1 1\nusemtl floor\nf 1 2 3\n");
+    let toml = write(&d, "s.toml", "[[mesh]]\nfile = \"red.obj\"\n[[mesh]]\nfile = \"grey.obj\"\n");
+    let loaded = load_scene(&toml).unwrap();
+    let scene = &loaded.scene;
+    let floors: Vec<_> = scene.materials.iter().filter(|m| m.name == "floor").collect();
+    assert_eq!(floors.len(), 2);
+    let kd_at_z = |z: f32| {
+        let t = (0..scene.triangle_count()).find(|&t| scene.p0[t].z == z && scene.ng[t].z > 0.0).unwrap();
+        scene.materials[scene.material[t] as usize].bsdf
+    };
+    assert_eq!(kd_at_z(0.0), photonwave::material::Bsdf::Lambert { kd: glam::Vec3::new(0.8, 0.0, 0.0) });
+    assert_eq!(kd_at_z(1.0), photonwave::material::Bsdf::Lambert { kd: glam::Vec3::splat(0.5) });
+    assert!(scene.warnings.iter().any(|w| w.contains("`floor` is defined differently")), "{:?}", scene.warnings);
+    assert_eq!(loaded.inputs.len(), 5, "scene, two OBJ and two MTL files: {:?}", loaded.inputs);
+}
+
+/// Texture and transparency statements are read and said to be ignored, once per material;
+/// `Ns -5`, `illum 99` and a file that is not UTF-8 are errors with their line.
+#[test]
+fn what_is_not_simulated_is_said() {
+    let d = scratch_dir("said");
+    write(&d, "m.mtl", format!("{MTL}map_Kd -s 2 2 2 wood.png\nbump -bm 0.3 wood-bump.png\nd 0.4\nsharpness 60\n"));
+    let scene = load_scene(&write(&d, "a.obj", OBJ)).unwrap().scene;
+    let w: Vec<_> = scene.warnings.iter().filter(|w| w.contains("not simulated")).collect();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].contains("m.mtl:4: material `white`") && w[0].contains("`map_Kd`, `bump`, `d`, `sharpness`"));
+    for (bad, what) in [("Ns -5", "negative"), ("illum 99", "0–10")] {
+        write(&d, "m.mtl", format!("{MTL}{bad}\n"));
+        let e = load_scene(&d.join("a.obj")).err().unwrap().to_string();
+        assert!(e.contains("m.mtl:6:") && e.contains(what), "{e}");
+    }
+    write(&d, "m.mtl", [MTL.as_bytes(), b"Kd \xFF\n"].concat());
+    let e = load_scene(&d.join("a.obj")).err().unwrap().to_string();
+    assert!(e.contains("m.mtl:6:") && e.contains("UTF-8"), "{e}");
+}
