@@ -6,7 +6,7 @@ use crate::engine::{render, Engine};
 use crate::geometry::bvh::TriangleColumns;
 use crate::geometry::packet::closest_packets;
 use crate::geometry::traverse::closest_rays;
-use crate::geometry::{Bvh, RayQuery};
+use crate::geometry::{Bvh, RayQuery, MAX_COORDINATE};
 use crate::reference::NoProgress;
 use crate::scene::file::load_scene;
 use crate::settings::Settings;
@@ -17,6 +17,30 @@ use std::sync::Arc;
 /// Most work a fuzzed scene may ask for before it is only loaded, not rendered.
 const MAX_PIXELS: u32 = 64;
 const MAX_PHOTONS: u32 = 5_000;
+
+/// The cargo-fuzz target `scene_files`'s input: TOML, OBJ and MTL text separated by 0xFF bytes,
+/// checked by [`scene_files`] in `dir`.
+pub fn scene_files_input(dir: &Path, data: &[u8]) -> Result<(), String> {
+    let mut parts = data.split(|&b| b == 0xff);
+    let mut next = || parts.next().unwrap_or_default();
+    let (toml, obj, mtl) = (next(), next(), next());
+    scene_files(dir, toml, obj, mtl)
+}
+
+/// The cargo-fuzz target `edge_rays`'s input: 18 floats — the edge's ends `a`, `b`, the wings
+/// `c1`, `c2`, the ray origin (3 each), where on the edge the ray aims (in [0, 1]), a scale for
+/// every point, and whether the direction is normalised (> 0) — checked by [`edge_ray`].
+/// Inputs that are not finite, aim off the edge or have no positive scale are skipped.
+pub fn edge_rays_input(data: [f32; 18]) -> Result<(), String> {
+    let v = |i: usize| Vec3::new(data[i], data[i + 1], data[i + 2]);
+    let (a, b, c1, c2, o) = (v(0), v(3), v(6), v(9), v(12));
+    let (s, scale, normalise) = (data[15], data[16], data[17] > 0.0);
+    if !data.iter().all(|x| x.is_finite()) || !(0.0..=1.0).contains(&s) || !(scale > 0.0) {
+        return Ok(());
+    }
+    let target = (a + (b - a) * s) * scale;
+    edge_ray(a * scale, b * scale, c1 * scale, c2 * scale, o * scale, target, normalise)
+}
 
 /// Writes `s.toml`, `a.obj` and `m.mtl` into `dir` and loads `s.toml`. An error must be a short,
 /// non-empty message; a scene that loads (with a camera and a modest amount of work) must render
@@ -63,7 +87,13 @@ pub fn scene_files(dir: &Path, toml: &[u8], obj: &[u8], mtl: &[u8]) -> Result<()
 /// faces' planes — watertight intersection must also hit one of them at t > 0. (Two triangles
 /// alone do not close the space: near a vertex, or beside a face seen edge-on that is thinner
 /// than f32 resolves, a ray may rightly pass where a closed mesh has its other faces.)
+///
+/// Points outside ±[`MAX_COORDINATE`] are skipped: the loader refuses such scenes, because the
+/// f32 test's products overflow there.
 pub fn edge_ray(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3, target: Vec3, normalise: bool) -> Result<(), String> {
+    if [a, b, c1, c2, o, target].iter().any(|p| !(p.abs().max_element() <= MAX_COORDINATE)) {
+        return Ok(());
+    }
     let d = if normalise { (target - o).normalize_or_zero() } else { target - o };
     let (p0, p1, p2) = ([a, b], [b, a], [c1, c2]);
     let (bvh, order) = Bvh::build(&p0, &p1, &p2);

@@ -123,10 +123,9 @@ struct BenchArgs {
 
 fn parse_duration(s: &str) -> std::result::Result<std::time::Duration, String> {
     let t = s.trim();
-    let (num, unit) = match t.find(|c: char| c.is_ascii_alphabetic()) {
-        Some(i) => t.split_at(i),
-        None => (t, "s"),
-    };
+    // The unit is the trailing run of letters, so that `1e9s` reads as 1e9 seconds.
+    let at = t.trim_end_matches(|c: char| c.is_ascii_alphabetic()).len();
+    let (num, unit) = if at == t.len() { (t, "s") } else { t.split_at(at) };
     let scale = match unit {
         "ms" => 1e-3,
         "s" => 1.0,
@@ -137,7 +136,9 @@ fn parse_duration(s: &str) -> std::result::Result<std::time::Duration, String> {
     let v: f64 = num.trim().parse().map_err(|_| format!("`{s}` is not a duration such as 30s, 500ms or 2m"))?;
     let secs = v * scale;
     if !(secs > 0.0 && secs <= 1e7) {
-        return Err(format!("`{s}`: the budget must be positive and at most 10 000 000 s"));
+        return Err(format!(
+            "`{s}`: a budget must be positive and at most 10 000 000 s (about 115 days), the largest accepted"
+        ));
     }
     Ok(std::time::Duration::from_secs_f64(secs))
 }

@@ -180,6 +180,32 @@ fn rays_through_a_shared_edge_hit_one_side() {
         .unwrap();
 }
 
+/// Every input a cargo-fuzz target ever failed on, kept in `fuzz/regressions/TARGET/` (README,
+/// "Fuzzing"), passes its property now.
+#[test]
+fn inputs_the_fuzzers_found_stay_fixed() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions");
+    let dir = scratch_dir("fuzz-regressions");
+    let mut count = 0;
+    for target in ["edge_rays", "scene_files"] {
+        let Ok(entries) = std::fs::read_dir(root.join(target)) else { continue };
+        for entry in entries {
+            let path = entry.unwrap().path();
+            let data = std::fs::read(&path).unwrap();
+            let result = if target == "edge_rays" {
+                let floats: Vec<f32> =
+                    data.chunks_exact(4).take(18).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+                fuzzing::edge_rays_input(floats.try_into().expect("an edge_rays input has 72 bytes"))
+            } else {
+                fuzzing::scene_files_input(&dir, &data)
+            };
+            assert!(result.is_ok(), "{}: {result:?}", path.display());
+            count += 1;
+        }
+    }
+    assert!(count > 0, "no regression inputs found under {}", root.display());
+}
+
 /// 20 000 BSDF samples and evaluations of every material kind, with extreme parameters (Phong
 /// exponents 0 to 10³⁰, albedos at their edges, indices of refraction 0.01 to 100), grazing and
 /// exactly tangent directions, and shading normals that are zero, NaN, opposite to or

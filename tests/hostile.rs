@@ -214,3 +214,37 @@ fn what_is_not_simulated_is_said() {
     let e = load_scene(&d.join("a.obj")).err().unwrap().to_string();
     assert!(e.contains("m.mtl:6:") && e.contains("UTF-8"), "{e}");
 }
+
+/// Each misleading message now says what is wrong: coordinates beyond the supported range (they
+/// were reported as a camera fault or a zero-area emitter), a directional light with nothing to
+/// light (reported as an overflowing power), and an over-long budget (an "unknown unit `e9s`").
+#[test]
+fn messages_say_what_is_actually_wrong() {
+    let d = scratch_dir("messages");
+    write(&d, "m.mtl", MTL);
+    let far = write(&d, "far.obj", OBJ.replace("v 1 0 0", "v 3e38 0 0").replace("v 0 1 0", "v 0 -3e38 0"));
+    let e = load_scene(&far).err().unwrap().to_string();
+    assert!(e.contains("far.obj:3:") && e.contains("outside ±1e10"), "{e}");
+    let big = write(&d, "big.obj", OBJ.replace("v 1 0 0", "v 3e19 0 0"));
+    let e = load_scene(&big).err().unwrap().to_string();
+    assert!(e.contains("big.obj:3:") && e.contains("[30000000000000000000, 0, 0]"), "{e}");
+    write(&d, "a.obj", OBJ);
+    let scaled = write(&d, "scaled.toml", "[[mesh]]\nfile = \"a.obj\"\nscale = 1e30\n");
+    let e = load_scene(&scaled).err().unwrap().to_string();
+    assert!(e.contains("a.obj:3:") && e.contains("after scale and translate"), "{e}");
+    let sun =
+        write(&d, "sun.toml", "[[light]]\ntype = \"directional\"\ndirection = [0, -1, 0]\nirradiance = [1, 1, 1]\n");
+    let e = load_scene(&sun).err().unwrap().to_string();
+    assert!(e.contains("a directional light needs geometry to light"), "{e}");
+    // Triangles a billion units across keep their area (the f32 cross product's squared
+    // length overflowed, and they were dropped as degenerate).
+    let huge = write(&d, "huge.obj", OBJ.replace("v 1 0 0", "v 5e9 0 0").replace("v 0 1 0", "v 0 5e9 0"));
+    let scene = load_scene(&huge).unwrap().scene;
+    assert_eq!(scene.triangle_count(), 2);
+    assert!((scene.area.iter().sum::<f32>() / 1.25e19 - 1.0).abs() < 1e-5, "{:?}", scene.area);
+    let scene = bundled("cornell-box.toml");
+    let (code, e) = cli(&["render", s(&scene), "--time", "1e9s"]);
+    assert!(code != 0 && e.contains("at most 10 000 000 s") && !e.contains("unknown unit"), "{e}");
+    let (code, e) = cli(&["render", s(&scene), "--time", "10 fortnights"]);
+    assert!(code != 0 && e.contains("unknown unit `fortnights`"), "{e}");
+}

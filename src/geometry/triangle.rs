@@ -9,6 +9,36 @@
 use super::offset::gamma;
 use glam::Vec3;
 
+/// The largest coordinate magnitude, in scene units, for which intersection is guaranteed
+/// watertight: every vertex, light position and camera must lie within ±`MAX_COORDINATE`, and
+/// scenes beyond it are refused at load. The test's f32 products stay finite there with a wide
+/// margin: edge functions grow as R² (≤ 3.2·10²¹), t·det as R³ times 1/|d.z| (≤ 2·10³⁰·/|d.z|).
+/// Far beyond it they overflow — the cargo-fuzz target `edge_rays` found a ray slipping
+/// between two triangles at coordinates of 10¹⁷ with wings of 10¹⁹ — and a fallback in f64 for
+/// one of two triangles sharing an edge would round that edge differently from the other,
+/// which is itself a crack. Scale such scenes down (`scale` in the scene file).
+pub const MAX_COORDINATE: f32 = 1e10;
+
+/// The unit normal (counter-clockwise) and area of a triangle: in f32 as everywhere else, and in
+/// f64 where the f32 cross product's squared length overflows (edges longer than about 10⁹) or
+/// leaves the normal range (edges shorter than about 10⁻¹⁹), so that large and tiny triangles
+/// within ±[`MAX_COORDINATE`] keep their area. (0, 0) for a degenerate triangle.
+#[must_use]
+pub fn normal_and_area(p0: Vec3, p1: Vec3, p2: Vec3) -> (Vec3, f32) {
+    let c = (p1 - p0).cross(p2 - p0);
+    let len2 = c.length_squared();
+    if len2.is_finite() && len2 >= f32::MIN_POSITIVE {
+        return (c.normalize(), 0.5 * c.length());
+    }
+    let c = (p1 - p0).as_dvec3().cross((p2 - p0).as_dvec3());
+    let len = c.length();
+    if len > 0.0 && len.is_finite() {
+        ((c / len).as_vec3(), (0.5 * len) as f32)
+    } else {
+        (Vec3::ZERO, 0.0)
+    }
+}
+
 /// A ray/triangle hit: distance and barycentrics (b0 weights p0, …).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TriangleHit {
@@ -45,11 +75,14 @@ pub fn dominant_axis(d: Vec3) -> usize {
     }
 }
 
-/// True for a zero-area triangle (never hit).
+/// True for a zero-area triangle (never hit): its edges' cross product is exactly zero.
+/// Its components are compared, not its squared length, which underflows for edges shorter
+/// than about 10⁻¹¹: a closed mesh of triangles that small leaked where the fuzzer aimed
+/// (fuzz/regressions/edge_rays/tiny-edge-1e-12-at-2e-7).
 #[inline]
 #[must_use]
 pub fn is_degenerate(p0: Vec3, p1: Vec3, p2: Vec3) -> bool {
-    (p2 - p0).cross(p1 - p0).length_squared() == 0.0
+    (p2 - p0).cross(p1 - p0) == Vec3::ZERO
 }
 
 /// Intersects the ray `o + t·d`, 0 < t < `t_max`, with the triangle (p0, p1, p2).
@@ -104,10 +137,20 @@ fn intersect_f32(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> 
     let mut e0 = p1t.x * p2t.y - p1t.y * p2t.x;
     let mut e1 = p2t.x * p0t.y - p2t.y * p0t.x;
     let mut e2 = p0t.x * p1t.y - p0t.y * p1t.x;
-    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        let f = |ax: f32, ay: f32, bx: f32, by: f32| (ax as f64 * by as f64 - ay as f64 * bx as f64) as f32;
+    // Only the edge functions that are exactly zero are recomputed in f64. pbrt-v4 recomputes
+    // all three when any is zero, but then a triangle whose *other* edge is zero rounds the
+    // edge it shares with a neighbour differently from that neighbour (f64 against f32), and
+    // where the f32 value's sign is wrong both can refuse a ray through it (found by the
+    // cargo-fuzz target `edge_rays`: fuzz/regressions/edge_rays/). A shared edge's f32 value is
+    // exactly the negation of its neighbour's, so it is zero for both or for neither.
+    let f = |ax: f32, ay: f32, bx: f32, by: f32| (ax as f64 * by as f64 - ay as f64 * bx as f64) as f32;
+    if e0 == 0.0 {
         e0 = f(p1t.x, p1t.y, p2t.x, p2t.y);
+    }
+    if e1 == 0.0 {
         e1 = f(p2t.x, p2t.y, p0t.x, p0t.y);
+    }
+    if e2 == 0.0 {
         e2 = f(p0t.x, p0t.y, p1t.x, p1t.y);
     }
     if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {

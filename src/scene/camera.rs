@@ -1,6 +1,7 @@
 //! A pinhole camera: eye, target, up and vertical field of view.
 
 use crate::error::{Error, Result};
+use crate::geometry::MAX_COORDINATE;
 use glam::Vec3;
 
 /// Where the camera is and where it looks.
@@ -33,6 +34,12 @@ impl Camera {
         let bad = |f: &str, m: &str| Err(Error::setting(f, m));
         if !(self.eye.is_finite() && self.target.is_finite() && self.up.is_finite()) {
             return bad("camera", "eye, target and up must be finite");
+        }
+        if !(self.eye.abs().max_element() <= MAX_COORDINATE) {
+            return Err(Error::setting(
+                "camera.eye",
+                format!("{} is outside ±{MAX_COORDINATE:e}, the range photonwave supports", self.eye),
+            ));
         }
         let Some(forward) = (self.target - self.eye).try_normalize() else {
             return bad("camera.target", "target must differ from eye");

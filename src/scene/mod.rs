@@ -12,7 +12,8 @@ pub mod validate;
 use crate::error::{Error, Result};
 use crate::geometry::bvh::TriangleColumns;
 use crate::geometry::offset::{barycentric_error, offset_ray_origin};
-use crate::geometry::{Bvh, Hit};
+use crate::geometry::triangle::is_degenerate;
+use crate::geometry::{normal_and_area, Bvh, Hit, MAX_COORDINATE};
 use crate::material::{Bsdf, Material, SurfaceFrame};
 use crate::sampling::Distribution1D;
 pub use camera::Camera;
@@ -186,25 +187,36 @@ impl Scene {
         let mut emitter_area = vec![0.0f64; materials.len()];
         let mut emitter_seen = vec![false; materials.len()];
         for m in &meshes {
+            if let Some(k) = m.positions.iter().position(|p| !(p.abs().max_element() <= MAX_COORDINATE)) {
+                return Err(Error::scene(format!(
+                    "{}: vertex {} lies at {} (after scale and translate), outside ±{MAX_COORDINATE:e}, the \
+                     range in which photonwave's f32 geometry is exact enough to be watertight; scale the \
+                     scene down (`scale` in the scene file; README, \"Limits\")",
+                    m.source,
+                    k + 1,
+                    m.positions[k]
+                )));
+            }
             for (t, tri) in m.triangles.iter().enumerate() {
                 let v = tri.map(|i| m.positions[i as usize]);
                 let material = m.material[t];
                 let emissive = materials[material as usize].emission != Vec3::ZERO;
-                let area2 = (v[1] - v[0]).cross(v[2] - v[0]).length();
+                let (gn, area) = normal_and_area(v[0], v[1], v[2]);
                 if emissive {
                     emitter_seen[material as usize] = true;
                 }
-                if !(area2 > 0.0) || !area2.is_finite() {
+                // Also what the intersection test takes as degenerate (its f32 cross product
+                // underflows): such a triangle could never be hit, nor lit if it emitted.
+                if !(area > 0.0) || is_degenerate(v[0], v[1], v[2]) {
                     dropped += 1;
                     continue;
                 }
                 if emissive {
-                    emitter_area[material as usize] += 0.5 * area2 as f64;
+                    emitter_area[material as usize] += f64::from(area);
                 }
                 p0.push(v[0]);
                 p1.push(v[1]);
                 p2.push(v[2]);
-                let gn = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
                 vn.push(if m.normals.is_empty() {
                     [gn; 3]
                 } else {
@@ -224,8 +236,23 @@ impl Scene {
         if dropped > 0 {
             warnings.push(format!("{dropped} degenerate (zero-area) triangles were skipped"));
         }
-        if p0.is_empty() && extra_lights.is_empty() {
-            return Err(Error::scene("the scene has no triangles"));
+        if p0.is_empty() {
+            let directional = extra_lights.iter().any(|l| matches!(l, Light::Directional { .. }));
+            return Err(Error::scene(if directional {
+                "the scene has no triangles: a directional light needs geometry to light (add a [[mesh]])"
+            } else {
+                "the scene has no triangles to light (add a [[mesh]])"
+            }));
+        }
+        for (i, l) in extra_lights.iter().enumerate() {
+            if let Light::Point { position, .. } | Light::Spot { position, .. } = *l {
+                if !(position.abs().max_element() <= MAX_COORDINATE) {
+                    return Err(Error::setting(
+                        format!("light[{i}].position"),
+                        format!("{position} is outside ±{MAX_COORDINATE:e}, the range photonwave supports"),
+                    ));
+                }
+            }
         }
 
         let mut lo = Vec3::splat(f32::INFINITY);
@@ -243,8 +270,7 @@ impl Scene {
         let (p0, p1, p2) = (pick(&p0), pick(&p1), pick(&p2));
         let vn: Vec<[Vec3; 3]> = order.iter().map(|&i| vn[i as usize]).collect();
         let material: Vec<u32> = order.iter().map(|&i| mat[i as usize]).collect();
-        let ng: Vec<Vec3> = (0..p0.len()).map(|i| (p1[i] - p0[i]).cross(p2[i] - p0[i]).normalize()).collect();
-        let area: Vec<f32> = (0..p0.len()).map(|i| 0.5 * (p1[i] - p0[i]).cross(p2[i] - p0[i]).length()).collect();
+        let (ng, area): (Vec<Vec3>, Vec<f32>) = (0..p0.len()).map(|i| normal_and_area(p0[i], p1[i], p2[i])).unzip();
 
         let mut lights: Vec<Light> = (0..p0.len())
             .filter(|&i| materials[material[i] as usize].emission != Vec3::ZERO)

@@ -11,6 +11,7 @@ use super::validate::{check_obj, MtlLib};
 use super::MeshInput;
 use crate::error::{Error, Result};
 use crate::files::{read_text, MAX_MATERIAL_FILE, MAX_MESH_FILE};
+use crate::geometry::MAX_COORDINATE;
 use crate::material::{Bsdf, Material};
 use glam::Vec3;
 use std::collections::HashMap;
@@ -101,6 +102,34 @@ fn named_by(e: Error, obj: &Path, line: usize) -> Error {
     }
 }
 
+fn in_range(p: Vec3) -> bool {
+    p.abs().max_element() <= MAX_COORDINATE
+}
+
+/// The error for the first `v` statement of `text` that lies outside ±[`MAX_COORDINATE`] once
+/// scaled and translated (tobj reorders vertices, so the file is read again for its line).
+fn out_of_range(path: &Path, text: &str, (scale, translate): (f32, Vec3)) -> Error {
+    let first = text.lines().enumerate().find_map(|(i, line)| {
+        let mut words = line.split_whitespace();
+        if words.next() != Some("v") {
+            return None;
+        }
+        let xyz: Vec<f32> = words.take(3).filter_map(|w| w.parse().ok()).collect();
+        let p = Vec3::from_slice(&xyz) * scale + translate;
+        (!in_range(p)).then_some((i + 1, p))
+    });
+    let (line, p) = first.unwrap_or((0, Vec3::splat(f32::INFINITY)));
+    Error::parse(
+        path,
+        line,
+        format!(
+            "the vertex lies at {p} (after scale and translate), outside ±{MAX_COORDINATE:e}, the range in \
+             which photonwave's f32 geometry stays watertight; scale the scene down (`scale` in the scene \
+             file; README, \"Limits\")"
+        ),
+    )
+}
+
 /// The name tobj is given for the one material library photonwave hands it (all of the OBJ's
 /// MTL files, already read and checked).
 const ALL_MATERIALS: &str = "\u{1}photonwave-materials";
@@ -184,6 +213,9 @@ pub fn load_obj(
     }
     if !any_normals {
         mesh.normals.clear();
+    }
+    if mesh.positions.iter().any(|p| !in_range(*p)) {
+        return Err(out_of_range(path, &text, transform));
     }
     if mesh.zero_normals > 0 {
         warnings.push(format!(
