@@ -131,6 +131,16 @@ pub fn compare_files(image: &Path, reference: &Path) -> Result<Comparison> {
     })
 }
 
+/// `x` in scientific notation with four decimals (`1.2346e-3`), and an exact zero as `0`.
+#[must_use]
+pub fn sci(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else {
+        format!("{x:.4e}")
+    }
+}
+
 impl Comparison {
     /// A text table, one row per layer.
     #[must_use]
@@ -151,8 +161,13 @@ impl Comparison {
         for l in &self.layers {
             let ratio = l.mean_ratio.map_or("-".to_string(), |r| format!("{r:.5}"));
             s += &format!(
-                "{:<10} {:>12.4e} {:>12.4e} {:>10} {:>12.4e} {:>12.4e}\n",
-                l.layer, l.rmse, l.rel_mse, ratio, l.mean, l.reference_mean
+                "{:<10} {:>12} {:>12} {:>10} {:>12} {:>12}\n",
+                l.layer,
+                sci(l.rmse),
+                sci(l.rel_mse),
+                ratio,
+                sci(l.mean),
+                sci(l.reference_mean)
             );
         }
         s

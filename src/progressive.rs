@@ -296,6 +296,12 @@ impl Progressive {
         stats.times.caustic_photons_s += old.times.caustic_photons_s;
         stats.times.map_build_s += old.times.map_build_s;
         stats.times.camera_s += old.times.camera_s;
+        // Photon counts and per-system work are totals over the passes, like the rays.
+        stats.global_map += &old.global_map;
+        stats.caustic_map += &old.caustic_map;
+        if let (Some(s), Some(o)) = (stats.stages.as_mut(), old.stages.as_ref()) {
+            *s += o;
+        }
         stats.seed = self.settings.seed;
         self.stats = stats;
         self.progress.passes += 1;
@@ -458,7 +464,7 @@ pub fn render_passes(
     let mut prog = p.progress;
     prog.budget_s = budget.map(|b| b.limit.as_secs_f64());
     prog.elapsed_s = start.elapsed().as_secs_f64();
-    stats.passes.push(format!("{} progressive passes", prog.passes));
+    stats.phases.push(format!("{} progressive passes", prog.passes));
     stats.spp = settings.spp * prog.passes;
     stats.progressive = Some(prog);
     stats.times.total_s = t.elapsed().as_secs_f64();

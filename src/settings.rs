@@ -39,9 +39,10 @@ pub struct Settings {
     pub height: u32,
     /// Jittered samples per pixel.
     pub spp: u32,
-    /// Photons to store in the global map (emission stops at the first batch that reaches it).
+    /// Photons stored in the global map: exactly this many (emission stops at the path that
+    /// stores the last one), unless the cap of paths per photon is reached first.
     pub photons: u32,
-    /// Photons to store in the caustic map.
+    /// Photons stored in the caustic map, exactly as `photons`.
     pub caustic_photons: u32,
     /// Nearest photons per global-map estimate.
     pub k: u32,

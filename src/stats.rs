@@ -45,6 +45,14 @@ pub struct MapStats {
     pub stored: u64,
 }
 
+impl std::ops::AddAssign<&MapStats> for MapStats {
+    /// Adds another pass's counts (progressive renders report totals over their passes).
+    fn add_assign(&mut self, o: &MapStats) {
+        self.emitted += o.emitted;
+        self.stored += o.stored;
+    }
+}
+
 impl MapStats {
     /// A warning when the map holds fewer photons than `asked` because its photon pass hit the
     /// cap of [`MAX_PATHS_PER_PHOTON`](crate::reference::photons::MAX_PATHS_PER_PHOTON) paths per
@@ -144,7 +152,9 @@ pub struct RenderStats {
     pub kernels: String,
     /// Seed.
     pub seed: u64,
-    /// The effects plan: each part with whether it ran and why.
+    /// The effects plan: each part with whether it ran and why (photon-mapping engines only;
+    /// absent from the JSON for the path tracer).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub effects: Option<crate::effects::Effects>,
     /// Global photon map.
     pub global_map: MapStats,
@@ -152,8 +162,9 @@ pub struct RenderStats {
     pub caustic_map: MapStats,
     /// Points with precomputed irradiance (0 when not used).
     pub irradiance_points: u64,
-    /// Passes that ran: photon passes, final gather or direct global-map reading.
-    pub passes: Vec<String>,
+    /// Phases that ran: photon passes, final gather or direct global-map reading, progressive
+    /// passes (their count is `progressive.passes`).
+    pub phases: Vec<String>,
     /// Rays traced.
     pub rays: RayCounts,
     /// Values caught and dropped (or replaced), per stage.
@@ -192,13 +203,14 @@ impl RenderStats {
         }
     }
 
-    /// A human-readable summary.
+    /// A human-readable summary (without the per-system table: [`RenderStats::stage_summary`]).
     #[must_use]
     pub fn summary(&self) -> String {
         let t = &self.times;
+        let over = self.progressive.as_ref().map_or(String::new(), |p| format!(" in all {} passes", p.passes));
         let map = |name: &str, m: &MapStats| {
             if m.built {
-                format!("  {name:<8} map: {} photons stored from {} emitted paths\n", m.stored, m.emitted)
+                format!("  {name:<8} map: {} photons stored from {} emitted paths{over}\n", m.stored, m.emitted)
             } else {
                 format!("  {name:<8} map: not built — {}\n", m.reason)
             }
@@ -236,7 +248,6 @@ impl RenderStats {
             self.numerics.photon_escaped,
             self.numerics.photons_filtered,
         ) + &self.progressive_summary()
-            + &self.stage_summary()
     }
 
     /// The progressive line: passes, radii, budget.

@@ -248,3 +248,104 @@ fn messages_say_what_is_actually_wrong() {
     let (code, e) = cli(&["render", s(&scene), "--time", "10 fortnights"]);
     assert!(code != 0 && e.contains("unknown unit `fortnights`"), "{e}");
 }
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+/// `-q` prints nothing but errors, the per-system table needs `-v`, and the path engine's output
+/// has no empty fields and no photon-mapping plan.
+#[test]
+fn the_cli_prints_what_is_asked() {
+    let d = scratch_dir("verbosity");
+    let (scene, out, stats) = (bundled("cornell-box.toml"), d.join("o.exr"), d.join("s.json"));
+    let base = ["render", s(&scene), "-o", s(&out), "--stats", s(&stats)];
+    let run = |extra: &[&str]| cli(&[&base[..], &SMALL[..], extra].concat());
+    let (code, e) = run(&["-q"]);
+    assert!(code == 0 && e.is_empty(), "-q printed: {e}");
+    let (_, e) = run(&[]);
+    assert!(e.contains("summary") && !e.contains("stages (runs"), "{e}");
+    let (_, e) = run(&["-v"]);
+    assert!(e.contains("stages (runs") && e.contains("gather_global"), "{e}");
+    let (code, e) = run(&["--engine", "path"]);
+    assert_eq!(code, 0, "{e}");
+    assert!(e.contains("plan: path tracing") && !e.contains("global map    on"), "{e}");
+    assert!(e.contains("(path engine, simd kernels") && !e.contains("not built — \n"), "{e}");
+    let v = json(&stats);
+    assert_eq!(v["kernels"], "simd");
+    assert!(v.get("effects").is_none(), "{v}");
+    assert!(v["global_map"]["reason"].as_str().unwrap().contains("path tracer"));
+}
+
+/// `--photons N` stores exactly N photons, on both engines alike (20 000 stored 29 999 and 1
+/// stored about 26 600: whole batches of paths); progressive stats total the passes.
+#[test]
+fn a_map_holds_the_photons_asked_for() {
+    let d = scratch_dir("exact-photons");
+    let (scene, out, stats) = (bundled("cornell-spheres.toml"), d.join("o.exr"), d.join("s.json"));
+    for n in ["1", "20000"] {
+        let mut emitted = Vec::new();
+        for engine in ["wavefront", "reference"] {
+            let args =
+                ["render", s(&scene), "-q", "-o", s(&out), "--stats", s(&stats), "--width", "4", "--height", "4"];
+            let (code, e) =
+                cli(&[&args[..], &["--spp", "1", "--engine", engine, "--photons", n, "--caustic-photons", n]].concat());
+            assert_eq!(code, 0, "{e}");
+            let v = json(&stats);
+            for map in ["global_map", "caustic_map"] {
+                assert_eq!(v[map]["stored"].to_string(), n, "{engine} {map}: {}", v[map]);
+            }
+            emitted.push((v["global_map"]["emitted"].clone(), v["caustic_map"]["emitted"].clone()));
+        }
+        assert_eq!(emitted[0], emitted[1], "the engines cut at the same path");
+    }
+    let args = ["render", s(&scene), "-q", "-o", s(&out), "--stats", s(&stats), "--width", "4", "--height", "4"];
+    let (code, e) = cli(&[&args[..], &["--passes", "3", "--photons", "3000", "--caustic-photons", "2000"]].concat());
+    assert_eq!(code, 0, "{e}");
+    let v = json(&stats);
+    assert_eq!(v["progressive"]["passes"], 3);
+    assert_eq!(v["global_map"]["stored"], 9000, "totals over the passes");
+    assert_eq!(v["caustic_map"]["stored"], 6000);
+    assert!(v["phases"].as_array().unwrap().iter().any(|p| p == "3 progressive passes"), "{}", v["phases"]);
+}
+
+/// A bare mesh with no light is lit from the command line, and its fitted camera frames it at
+/// any aspect ratio.
+#[test]
+fn bare_meshes_can_be_lit_and_framed() {
+    let d = scratch_dir("bare");
+    write(&d, "m.mtl", "newmtl white\nKd 0.8 0.8 0.8\n");
+    let obj = write(&d, "a.obj", "mtllib m.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nusemtl white\nf 1 2 3 4\n");
+    let (out, stats) = (d.join("o.exr"), d.join("s.json"));
+    let base = ["render", s(&obj), "-o", s(&out), "--stats", s(&stats), "--spp", "1", "--photons", "500"];
+    let (code, e) = cli(&[&base[..], &["--width", "4", "--height", "4"]].concat());
+    assert!(code != 0 && e.contains("--light headlight"), "{e}");
+    for light in ["headlight", "sun"] {
+        let (code, e) = cli(&[&base[..], &["--width", "4", "--height", "8", "--light", light]].concat());
+        assert_eq!(code, 0, "{e}");
+        let mean = json(&stats)["mean_rgb"][0].as_f64().unwrap();
+        assert!(mean > 0.05, "{light}: mean {mean}");
+    }
+    // A quarter as wide as high: the bounding sphere fits the horizontal field of view.
+    let c = photonwave::scene::file::fitted_camera_to((glam::Vec3::splat(-1.0), glam::Vec3::ONE), 40.0, 0.25);
+    let half_h = ((20f32).to_radians().tan() * 0.25).atan();
+    let r = 3f32.sqrt();
+    assert!(r / (c.eye - c.target).length() <= half_h.sin() + 1e-6, "{c:?}");
+}
+
+/// More threads than cores is warned of; `compare` prints an exact zero as 0.
+#[test]
+fn small_things_a_user_noticed() {
+    let d = scratch_dir("small");
+    let (scene, out) = (bundled("cornell-box.toml"), d.join("o.exr"));
+    let (code, e) = cli(&[&["render", s(&scene), "-o", s(&out), "--threads", "64"][..], &SMALL[..]].concat());
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    assert_eq!(code, 0, "{e}");
+    assert_eq!(e.contains("warning: 64 threads on"), 64 > 2 * cores, "{e}");
+    let (code, e) = cli(&["compare", s(&out), s(&out)]);
+    let table = String::from_utf8(
+        Command::new(env!("CARGO_BIN_EXE_photonwave")).args(["compare", s(&out), s(&out)]).output().unwrap().stdout,
+    )
+    .unwrap();
+    assert!(code == 0 && table.contains(" 0 ") && !table.contains("0.0000e0"), "{e}{table}");
+}

@@ -218,7 +218,7 @@ fn cli_preset_reference_renders_progressive_passes() {
     let scene = common::bundled("cornell-spheres.toml");
     let render = |extra: &[&str]| {
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_photonwave"))
-            .args(["render", scene.to_str().unwrap(), "--width", "8", "--height", "8", "-q"])
+            .args(["render", scene.to_str().unwrap(), "--width", "8", "--height", "8"])
             .args(["-o", d.join("p.exr").to_str().unwrap(), "--stats", d.join("p.json").to_str().unwrap()])
             .args(extra)
             .output()

@@ -163,7 +163,7 @@ pub fn render(
     stats.times.camera_s = t.elapsed().as_secs_f64();
     stats.rays += rays;
     stats.numerics += numerics;
-    stats.passes.push(if plan.final_gather.on { "final gather".into() } else { "global map read at first hit".into() });
+    stats.phases.push(if plan.final_gather.on { "final gather".into() } else { "global map read at first hit".into() });
     stats.times.total_s = start.elapsed().as_secs_f64();
     stats.mean_rgb = film.mean().to_array();
     Ok((film, stats))
@@ -188,7 +188,7 @@ pub fn photon_passes(
         *time = t.elapsed().as_secs_f64();
         stats.rays.photon += p.rays;
         stats.numerics += p.numerics;
-        stats.passes.push(name.to_string());
+        stats.phases.push(name.to_string());
         let map = if domain == Domain::CausticPhoton { &mut stats.caustic_map } else { &mut stats.global_map };
         map.emitted = p.emitted;
         map.stored = p.photons.len() as u64;

@@ -47,16 +47,14 @@ pub fn render_path_traced_with_stats(
     settings.validate()?;
     let t = std::time::Instant::now();
     let (film, rays, numerics) = render_path_traced(scene, camera, settings, progress);
+    let none = |name: &str| crate::stats::MapStats {
+        reason: format!("the path tracer builds no {name} map: it samples every path from the camera"),
+        ..Default::default()
+    };
     let stats = crate::stats::RenderStats {
-        engine: "path".into(),
-        triangles: scene.triangle_count(),
-        lights: scene.lights.len(),
-        width: settings.width,
-        height: settings.height,
-        spp: settings.spp,
-        threads: settings.thread_count(),
-        seed: settings.seed,
-        passes: vec!["path tracing with next-event estimation".into()],
+        phases: vec!["path tracing with next-event estimation".into()],
+        global_map: none("global"),
+        caustic_map: none("caustic"),
         rays,
         numerics: crate::stats::Numerics { load_normals: scene.zero_normals, ..numerics },
         times: crate::stats::PhaseTimes {
@@ -65,7 +63,7 @@ pub fn render_path_traced_with_stats(
             ..Default::default()
         },
         mean_rgb: film.mean().to_array(),
-        ..Default::default()
+        ..crate::stats::RenderStats::new("path", scene, settings, settings.thread_count())
     };
     Ok((film, stats))
 }

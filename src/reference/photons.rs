@@ -5,8 +5,9 @@
 //! so far was specular (LS+D); their paths are discarded at the first hit when it is not
 //! specular (a Jensen projection map reduced to rejection: unbiased, as the discarded paths still
 //! count in the emitted total). Paths are emitted in fixed batches until the map holds its target,
-//! so the photon set is the same at any thread count. Stored power = Φ-weighted path power divided
-//! by the number of paths emitted.
+//! so the photon set is the same at any thread count; the map keeps exactly the photons asked for,
+//! up to the path that stores the last of them ([`stop_path`]). Stored power = Φ-weighted path
+//! power divided by the number of paths emitted up to that one.
 
 use super::parallel::map_chunks;
 use super::Progress;
@@ -19,7 +20,7 @@ use crate::settings::Settings;
 use crate::stats::Numerics;
 use glam::Vec3;
 
-/// Paths per batch; a map stops growing at the first batch boundary past its target.
+/// Paths per batch: emission runs batch by batch until a map reaches its target.
 pub const BATCH: usize = 16_384;
 /// Paths per work chunk inside a batch.
 const CHUNK: usize = 1024;
@@ -62,20 +63,30 @@ pub fn trace_photons(
             threads,
             |range| {
                 let mut out = Vec::new();
+                let mut stored = Vec::with_capacity(range.len());
                 let (mut r, mut nf) = (0u64, Numerics::default());
                 for i in range {
+                    let n = out.len();
                     trace_path(scene, settings, domain, first + i as u64, &mut out, &mut r, &mut nf);
+                    stored.push((out.len() - n) as u32);
                 }
-                (out, r, nf)
+                (out, r, nf, stored)
             },
             |_| {},
         );
-        for (out, r, nf) in chunks {
+        let before = photons.len() as u64;
+        let mut per_path = Vec::with_capacity(BATCH);
+        for (out, r, nf, stored) in chunks {
             photons.extend(out);
+            per_path.extend(stored);
             rays += r;
             numerics += nf;
         }
         emitted += BATCH as u64;
+        if photons.len() as u64 >= target as u64 {
+            emitted = first + stop_path(&per_path, target as u64 - before) + 1;
+            photons.truncate(target as usize);
+        }
         let now = (photons.len() as u64).min(target as u64);
         progress.advance(now - reported);
         reported = now;
@@ -83,6 +94,23 @@ pub fn trace_photons(
     progress.finish();
     normalise_power(&mut photons, emitted);
     PhotonPass { photons, emitted, rays, numerics }
+}
+
+/// The path (counted from a batch's first) that stores the `need`-th photon of the batch, given
+/// how many each path stored: emission stops there, so a map holds exactly the photons asked
+/// for and its power is divided by the paths emitted up to that one. Its later bounces are not
+/// stored (as in Jensen 1996, where emission stops when the map is full): one path of the
+/// thousands, a bias far below the estimates' noise.
+#[must_use]
+pub fn stop_path(stored_per_path: &[u32], need: u64) -> u64 {
+    let mut sum = 0u64;
+    for (j, &n) in stored_per_path.iter().enumerate() {
+        sum += u64::from(n);
+        if sum >= need {
+            return j as u64;
+        }
+    }
+    stored_per_path.len().saturating_sub(1) as u64
 }
 
 /// Divides stored photons' power by the number of paths emitted: each then carries Φ/N.

@@ -255,11 +255,25 @@ impl MaterialEntry {
 
 /// Loads a scene: a `.toml` scene file, or a bare `.obj` (with its MTL files).
 pub fn load_scene(path: &Path) -> Result<LoadedScene> {
+    load_scene_lit(path, &|_, _| Vec::new())
+}
+
+/// Lights added to a scene once its meshes' bounds and its file's camera are known (the CLI's
+/// `--light` presets, for meshes that bring no light of their own).
+pub type AddedLights<'a> = &'a dyn Fn((Vec3, Vec3), Option<Camera>) -> Vec<Light>;
+
+/// Loads a scene as [`load_scene`] does, with the lights `added` gives it besides its own.
+pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
+    let bounds = |meshes: &[MeshInput]| {
+        let all = meshes.iter().flat_map(|m| m.positions.iter());
+        all.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+    };
     let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if is_obj {
         let (mut table, mut warnings, mut inputs) = (MaterialTable::default(), Vec::new(), Vec::new());
-        let mesh = load_obj(path, (1.0, Vec3::ZERO), &mut table, &mut warnings, &mut inputs)?;
-        let scene = Scene::build(vec![mesh], table.materials, vec![], warnings)?;
+        let meshes = vec![load_obj(path, (1.0, Vec3::ZERO), &mut table, &mut warnings, &mut inputs)?];
+        let lights = added(bounds(&meshes), None);
+        let scene = Scene::build(meshes, table.materials, lights, warnings)?;
         return Ok(LoadedScene { scene, camera: None, settings: Settings::default(), inputs });
     }
     let text = read_text(path, "a scene file", MAX_SCENE_FILE)?;
@@ -287,24 +301,36 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene> {
             return Err(Error::setting(format!("materials.{name}"), "no mesh uses a material of that name"));
         }
     }
-    let lights = file.light.iter().enumerate().map(|(i, l)| l.to_light(i)).collect::<Result<Vec<_>>>()?;
+    let mut lights = file.light.iter().enumerate().map(|(i, l)| l.to_light(i)).collect::<Result<Vec<_>>>()?;
     let camera = file.camera.map(|c| Camera {
         eye: Vec3::from_array(c.eye),
         target: Vec3::from_array(c.target),
         up: Vec3::from_array(c.up),
         fov_deg: c.fov,
     });
+    if !meshes.is_empty() {
+        lights.extend(added(bounds(&meshes), camera));
+    }
     let settings = file.render.unwrap_or_default();
     settings.validate()?;
     let scene = Scene::build(meshes, table.materials, lights, warnings)?;
     Ok(LoadedScene { scene, camera, settings, inputs })
 }
 
-/// A camera that frames the scene's bounding sphere from +z, looking down −z.
+/// A camera that frames the bounding sphere of the scene's triangles from +z, looking down −z, for an image of
+/// `aspect` = width / height: the sphere fits the narrower of the two fields of view.
 #[must_use]
-pub fn fitted_camera(scene: &Scene, fov_deg: f32) -> Camera {
-    let c = scene.centre();
-    let r = scene.radius();
-    let dist = r / (fov_deg.to_radians() * 0.5).sin() * 1.05;
+pub fn fitted_camera(scene: &Scene, fov_deg: f32, aspect: f32) -> Camera {
+    fitted_camera_to(scene.mesh_bounds(), fov_deg, aspect)
+}
+
+/// [`fitted_camera`] for a bounding box (lo, hi).
+#[must_use]
+pub fn fitted_camera_to((lo, hi): (Vec3, Vec3), fov_deg: f32, aspect: f32) -> Camera {
+    let c = (lo + hi) * 0.5;
+    let r = ((hi - lo) * 0.5).length().max(f32::MIN_POSITIVE);
+    let half_v = fov_deg.to_radians() * 0.5;
+    let half = if aspect >= 1.0 { half_v } else { (half_v.tan() * aspect).atan() };
+    let dist = r / half.sin() * 1.05;
     Camera { eye: c + Vec3::Z * dist, target: c, up: Vec3::Y, fov_deg }
 }

@@ -185,3 +185,35 @@ impl Light {
         }
     }
 }
+
+/// Lights the command line can give a scene that brings none of its own (`--light`), such as a
+/// bare OBJ from a model library. Both put an irradiance of π on a surface square to them, so
+/// that a white Lambertian surface facing them has radiance equal to its albedo.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum LightPreset {
+    /// A point light at the camera: everything seen is lit, as with a camera's flash.
+    Headlight,
+    /// A directional light from above the camera, behind and to its left: shading and shadows
+    /// that show the shape.
+    Sun,
+}
+
+impl LightPreset {
+    /// The light for a view from `eye` toward `target` with `up`.
+    #[must_use]
+    pub fn light(self, eye: Vec3, target: Vec3, up: Vec3) -> Light {
+        let forward = (target - eye).normalize_or(Vec3::NEG_Z);
+        let right = forward.cross(up).normalize_or(Vec3::X);
+        let up = right.cross(forward);
+        match self {
+            LightPreset::Headlight => {
+                let d2 = (target - eye).length_squared().max(f32::MIN_POSITIVE);
+                Light::Point { position: eye, intensity: Vec3::splat(PI * d2) }
+            }
+            LightPreset::Sun => Light::Directional {
+                direction: (forward - up * 1.5 + right * 0.5).normalize(),
+                irradiance: Vec3::splat(PI),
+            },
+        }
+    }
+}

@@ -18,7 +18,7 @@ use crate::material::{Bsdf, Material, SurfaceFrame};
 use crate::sampling::Distribution1D;
 pub use camera::Camera;
 use glam::Vec3;
-pub use light::{Light, TriangleGeom};
+pub use light::{Light, LightPreset, TriangleGeom};
 
 /// Triangles of one mesh before the scene is assembled.
 #[derive(Clone, Debug, Default)]
@@ -285,7 +285,8 @@ impl Scene {
         lights.extend(extra_lights);
         if lights.is_empty() {
             return Err(Error::scene(
-                "the scene has no light: give a material a non-zero `Ke` in the MTL file, or add a [[light]] to the scene file",
+                "the scene has no light: give a material a non-zero `Ke` in the MTL file, add a [[light]] to the scene \
+                 file, or light it from the command line with `--light headlight` or `--light sun`",
             ));
         }
         let mut scene = Scene {
@@ -486,6 +487,14 @@ impl Scene {
     #[must_use]
     pub fn centre(&self) -> Vec3 {
         0.5 * (self.bounds.0 + self.bounds.1)
+    }
+
+    /// Bounding box of the triangles alone (without the lights of `bounds`): what a fitted camera
+    /// frames.
+    #[must_use]
+    pub fn mesh_bounds(&self) -> (Vec3, Vec3) {
+        let all = self.p0.iter().chain(&self.p1).chain(&self.p2);
+        all.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
     }
 
     /// Radius of the bounding sphere around the box centre.

@@ -168,6 +168,18 @@ pub struct StageStat {
 #[derive(Resource, Default, Clone, Debug, Serialize, PartialEq)]
 pub struct StageStats(pub BTreeMap<String, StageStat>);
 
+impl std::ops::AddAssign<&StageStats> for StageStats {
+    /// Adds another render's runs, lanes and times, system by system.
+    fn add_assign(&mut self, o: &StageStats) {
+        for (name, s) in &o.0 {
+            let e = self.0.entry(name.clone()).or_default();
+            e.runs += s.runs;
+            e.items += s.items;
+            e.seconds += s.seconds;
+        }
+    }
+}
+
 impl StageStats {
     /// Records one run of `system` over `items` lanes since `start`.
     pub fn record(&mut self, system: &str, items: usize, start: Instant) {
@@ -409,6 +421,14 @@ fn photon_pass(
                 }
                 let end = emitted + BATCH as u64;
                 let n = rest.partition_point(|(path, _, _)| *path < end);
+                let need = target as usize - photons.len();
+                if n >= need {
+                    // Exactly the photons asked for, up to the path that stores the last one,
+                    // as the reference engine cuts (`reference::photons::stop_path`).
+                    photons.extend(rest[..need].iter().map(|(_, _, p)| *p));
+                    emitted = rest[need - 1].0 + 1;
+                    break;
+                }
                 photons.extend(rest[..n].iter().map(|(_, _, p)| *p));
                 rest = &rest[n..];
                 emitted = end;
@@ -431,7 +451,7 @@ fn photon_pass(
         map.emitted = emitted;
         map.stored = photons.len() as u64;
         *time = t.elapsed().as_secs_f64();
-        stats.passes.push(format!("{name} (wavefront)"));
+        stats.phases.push(format!("{name} (wavefront)"));
         maps_photons[k] = photons;
     }
     stats.global_map.built = effects.global_map.on;
@@ -517,7 +537,7 @@ pub fn render(
     stats.rays += w.rays;
     stats.numerics += w.numerics;
     stats.times.camera_s = t.elapsed().as_secs_f64();
-    stats.passes.push(if effects.final_gather.on {
+    stats.phases.push(if effects.final_gather.on {
         "final gather (wavefront)".into()
     } else {
         "global map read at first hit (wavefront)".into()
