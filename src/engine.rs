@@ -70,8 +70,13 @@ pub fn render(
     // Refuse what would exhaust memory before any of it is allocated.
     if let Some((available, total)) = crate::memory::machine() {
         let plan = crate::effects::Effects::plan(scene, settings);
-        let maps = engine != Engine::Path;
-        crate::memory::check(settings, maps && plan.global_map.on, maps && plan.caustic_map.on, available, total)?;
+        let photons = if engine == Engine::Path {
+            0
+        } else {
+            u64::from(settings.photons) * u64::from(plan.global_map.on)
+                + u64::from(settings.caustic_photons) * u64::from(plan.caustic_map.on)
+        };
+        crate::memory::check(settings.width, settings.height, photons, available, total)?;
     }
     if !is_progressive(settings, budget) {
         return render_once(scene, rays, settings, engine, progress);

@@ -8,7 +8,6 @@
 
 use crate::error::{Error, Result};
 use crate::files::bytes;
-use crate::settings::Settings;
 
 /// Bytes per pixel of the image (measured 147).
 pub const BYTES_PER_PIXEL: u64 = 160;
@@ -17,13 +16,11 @@ pub const BYTES_PER_PHOTON: u64 = 96;
 /// Bytes of everything else (measured 12 MiB; the scene itself is already loaded).
 pub const BASE_BYTES: u64 = 16 << 20;
 
-/// A render's estimated peak memory, in bytes.
+/// A render's estimated peak memory, in bytes: a `width × height` image and `photons` stored
+/// in all its maps together.
 #[must_use]
-pub fn estimate(settings: &Settings, global_map: bool, caustic_map: bool) -> u64 {
-    let pixels = u64::from(settings.width) * u64::from(settings.height);
-    let photons = u64::from(settings.photons) * u64::from(global_map)
-        + u64::from(settings.caustic_photons) * u64::from(caustic_map);
-    BASE_BYTES + pixels * BYTES_PER_PIXEL + photons * BYTES_PER_PHOTON
+pub fn estimate(width: u32, height: u32, photons: u64) -> u64 {
+    BASE_BYTES + u64::from(width) * u64::from(height) * BYTES_PER_PIXEL + photons * BYTES_PER_PHOTON
 }
 
 /// The machine's memory available to a new allocation and in all (Linux `/proc/meminfo`'s
@@ -41,23 +38,19 @@ pub fn machine() -> Option<(u64, u64)> {
 
 /// Refuses a render whose estimate exceeds `available` bytes (of `total`), saying what it would
 /// need, what the machine has, and what to lower.
-pub fn check(settings: &Settings, global_map: bool, caustic_map: bool, available: u64, total: u64) -> Result<()> {
-    let need = estimate(settings, global_map, caustic_map);
+pub fn check(width: u32, height: u32, photons: u64, available: u64, total: u64) -> Result<()> {
+    let need = estimate(width, height, photons);
     if need <= available {
         return Ok(());
     }
-    let pixels = u64::from(settings.width) * u64::from(settings.height);
-    let photons = u64::from(settings.photons) * u64::from(global_map)
-        + u64::from(settings.caustic_photons) * u64::from(caustic_map);
+    let pixels = u64::from(width) * u64::from(height);
     Err(Error::setting(
         if pixels * BYTES_PER_PIXEL >= photons * BYTES_PER_PHOTON { "width" } else { "photons" },
         format!(
-            "this render needs about {} ({}×{} pixels at ~{BYTES_PER_PIXEL} B, {photons} photons at \
+            "this render needs about {} ({width}×{height} pixels at ~{BYTES_PER_PIXEL} B, {photons} photons at \
              ~{BYTES_PER_PHOTON} B), but the machine has {} available of {}; lower the image size or \
              the photon counts (README, \"Limits\")",
             bytes(need),
-            settings.width,
-            settings.height,
             bytes(available),
             bytes(total)
         ),
@@ -70,17 +63,14 @@ mod tests {
 
     #[test]
     fn a_huge_image_is_refused_with_the_estimate_and_the_machine() {
-        let s = Settings { width: 16384, height: 16384, ..Settings::default() };
-        let e = check(&s, true, false, 20 << 30, 24 << 30).unwrap_err().to_string();
+        let e = check(16384, 16384, 200_000, 20 << 30, 24 << 30).unwrap_err().to_string();
         assert!(
             e.starts_with("setting `width`") && e.contains("40.0 GiB") && e.contains("20.0 GiB available of 24.0 GiB"),
             "{e}"
         );
-        check(&Settings::default(), true, true, 1 << 30, 1 << 30).unwrap();
-        let many = Settings { photons: 100_000_000, caustic_photons: 100_000_000, ..Settings::default() };
-        let e = check(&many, true, true, 8 << 30, 8 << 30).unwrap_err().to_string();
+        check(320, 320, 300_000, 1 << 30, 1 << 30).unwrap();
+        let e = check(320, 320, 200_000_000, 8 << 30, 8 << 30).unwrap_err().to_string();
         assert!(e.starts_with("setting `photons`") && e.contains("200000000 photons"), "{e}");
-        check(&many, false, false, 8 << 30, 8 << 30).unwrap();
     }
 
     #[test]
