@@ -99,13 +99,22 @@ pub fn normalise_line_ends(text: &str) -> String {
 /// extension, so that writers choosing a format by extension still work). The temporary file is
 /// synced and renamed over `path` only when `write` succeeded; otherwise it is removed and the
 /// previous `path`, if any, is untouched.
+/// A symbolic link is written through: its target is replaced, not the link.
 pub fn replace(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let tmp = temporary_beside(path);
+    let is_link = path.symlink_metadata().is_ok_and(|m| m.file_type().is_symlink());
+    let dest = if is_link { path.canonicalize().unwrap_or_else(|_| path.to_path_buf()) } else { path.to_path_buf() };
+    let tmp = temporary_beside(&dest);
     let result = write(&tmp).and_then(|()| {
         // Sync before the rename: a crash after it must not leave an empty file in place.
-        let f = std::fs::File::open(&tmp).map_err(|e| Error::output(path, e))?;
+        let f = std::fs::OpenOptions::new().write(true).open(&tmp).map_err(|e| Error::output(path, e))?;
         f.sync_all().map_err(|e| Error::output(path, e))?;
-        std::fs::rename(&tmp, path).map_err(|e| Error::output(path, e))
+        std::fs::rename(&tmp, &dest).map_err(|e| Error::output(path, e))?;
+        // And the folder, so that the rename itself survives a crash (best effort: not every
+        // platform can open a folder).
+        if let Ok(dir) = std::fs::File::open(folder_of(&dest)) {
+            let _ = dir.sync_all();
+        }
+        Ok(())
     });
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -139,13 +148,15 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<()>
     })
 }
 
-/// `.NAME.partial-PID-N.EXT` in `path`'s folder.
+/// `.NAME.partial-PID-TIME-N.EXT` in `path`'s folder: unique to this process and call, and unlike
+/// any file a killed earlier run with the same process id may have left.
 fn temporary_beside(path: &Path) -> PathBuf {
     static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let t = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos());
     let name = path.file_name().map_or("output".into(), |s| s.to_string_lossy().into_owned());
     let ext = path.extension().map_or(String::new(), |e| format!(".{}", e.to_string_lossy()));
-    path.with_file_name(format!(".{name}.partial-{}-{n}{ext}", std::process::id()))
+    path.with_file_name(format!(".{name}.partial-{}-{t}-{n}{ext}", std::process::id()))
 }
 
 /// One output file of a command: the flag that names it, its path and the extension its format
@@ -164,8 +175,8 @@ pub struct Output<'a> {
 /// is not a directory, lies in an existing folder where a file can be created, is none of
 /// `inputs` (the scene's files, a reference image), and no two name the same file.
 pub fn check_outputs(outputs: &[Output], inputs: &[PathBuf]) -> Result<()> {
-    let inputs: Vec<(PathBuf, &PathBuf)> = inputs.iter().map(|p| (identity(p), p)).collect();
-    let mut seen: Vec<(PathBuf, &Output)> = Vec::new();
+    let inputs: Vec<(Identity, &PathBuf)> = inputs.iter().map(|p| (identity(p), p)).collect();
+    let mut seen: Vec<(Identity, &Output)> = Vec::new();
     for out in outputs {
         let (flag, path) = (out.flag, out.path);
         match path.extension().and_then(|e| e.to_str()) {
@@ -239,18 +250,39 @@ fn folder_of(path: &Path) -> PathBuf {
     }
 }
 
-/// A path that is the same for every way of naming one file: the canonical path where the
-/// file exists (links resolved), else the canonical folder joined with the name.
-fn identity(path: &Path) -> PathBuf {
+/// What names one file, however it is written: the canonical path where the file exists (links
+/// resolved), else the canonical folder joined with the name; and on Unix the device and inode
+/// of a file that exists, so that hard links match too.
+#[derive(Debug)]
+struct Identity {
+    path: PathBuf,
+    inode: Option<(u64, u64)>,
+}
+
+impl PartialEq for Identity {
+    fn eq(&self, o: &Identity) -> bool {
+        self.path == o.path || (self.inode.is_some() && self.inode == o.inode)
+    }
+}
+
+fn identity(path: &Path) -> Identity {
+    #[cfg(unix)]
+    let inode = std::fs::metadata(path).ok().map(|m| {
+        use std::os::unix::fs::MetadataExt;
+        (m.dev(), m.ino())
+    });
+    #[cfg(not(unix))]
+    let inode = None;
     if let Ok(p) = path.canonicalize() {
-        return p;
+        return Identity { path: p, inode };
     }
     let dir = folder_of(path);
     let dir = dir.canonicalize().unwrap_or(dir);
-    match path.file_name() {
+    let path = match path.file_name() {
         Some(name) => dir.join(name),
         None => dir,
-    }
+    };
+    Identity { path, inode }
 }
 
 #[cfg(test)]
@@ -281,6 +313,25 @@ mod tests {
         write_bytes(&p, b"new").unwrap();
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "new");
         assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1);
+    }
+
+    /// A link is written through (its target replaced), and an input reached through a hard
+    /// link or a symbolic link is still recognised as the input.
+    #[cfg(unix)]
+    #[test]
+    fn links_are_followed() {
+        let d = scratch("links");
+        let (target, link, hard) = (d.join("real.json"), d.join("link.json"), d.join("hard.json"));
+        std::fs::write(&target, "old").unwrap();
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        std::fs::hard_link(&target, &hard).unwrap();
+        for path in [&link, &hard] {
+            let e = check_outputs(&[out("--stats", path, "json")], std::slice::from_ref(&target)).unwrap_err();
+            assert!(e.to_string().contains("is an input"), "{e}");
+        }
+        write_bytes(&link, b"new").unwrap();
+        assert!(link.symlink_metadata().unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
     }
 
     #[test]

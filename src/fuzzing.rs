@@ -6,7 +6,7 @@ use crate::engine::{render, Engine};
 use crate::geometry::bvh::TriangleColumns;
 use crate::geometry::packet::closest_packets;
 use crate::geometry::traverse::closest_rays;
-use crate::geometry::{Bvh, RayQuery, MAX_COORDINATE};
+use crate::geometry::{in_range, Bvh, RayQuery};
 use crate::reference::NoProgress;
 use crate::scene::file::load_scene;
 use crate::settings::Settings;
@@ -88,10 +88,10 @@ pub fn scene_files(dir: &Path, toml: &[u8], obj: &[u8], mtl: &[u8]) -> Result<()
 /// alone do not close the space: near a vertex, or beside a face seen edge-on that is thinner
 /// than f32 resolves, a ray may rightly pass where a closed mesh has its other faces.)
 ///
-/// Points outside ±[`MAX_COORDINATE`] are skipped: the loader refuses such scenes, because the
+/// Points outside ±[`MAX_COORDINATE`](crate::geometry::MAX_COORDINATE) are skipped: the loader refuses such scenes, because the
 /// f32 test's products overflow there.
 pub fn edge_ray(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3, target: Vec3, normalise: bool) -> Result<(), String> {
-    if [a, b, c1, c2, o, target].iter().any(|p| !(p.abs().max_element() <= MAX_COORDINATE)) {
+    if ![a, b, c1, c2, o, target].into_iter().all(in_range) {
         return Ok(());
     }
     let d = if normalise { (target - o).normalize_or_zero() } else { target - o };

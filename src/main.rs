@@ -351,11 +351,11 @@ fn render(args: RenderArgs) -> Result<()> {
     outputs.extend(args.stats.as_deref().map(|path| Output { flag: "--stats", path, ext: "json" }));
     // Every output is checked before any work, and again against every file the scene read.
     check_outputs(&outputs, std::slice::from_ref(&args.scene))?;
-    // `--light` presets are placed from the camera, which may be fitted to the meshes' bounds.
-    let cli_aspect = match (args.width, args.height) {
-        (Some(w), Some(h)) if h > 0 => w as f32 / h as f32,
-        _ => 1.0,
-    };
+    // `--light` presets are placed from the camera, which may be fitted to the meshes' bounds
+    // for the image's aspect ratio (as the flags or the defaults give it: a scene file that sets
+    // a size has a camera too).
+    let default = photonwave::settings::Settings::default();
+    let cli_aspect = args.width.unwrap_or(default.width) as f32 / args.height.unwrap_or(default.height).max(1) as f32;
     let added = |bounds: (Vec3, Vec3), file: Option<Camera>| -> Vec<Light> {
         let c = view(&args, file, bounds, cli_aspect);
         args.light.iter().map(|preset| preset.light(c.eye, c.target, c.up)).collect()

@@ -9,4 +9,4 @@ pub mod triangle;
 pub use bvh::{Bvh, Hit};
 pub use offset::{gamma, offset_ray_origin};
 pub use traverse::RayQuery;
-pub use triangle::{intersect_triangle, normal_and_area, MAX_COORDINATE};
+pub use triangle::{in_range, intersect_triangle, normal_and_area, MAX_COORDINATE};

@@ -19,6 +19,13 @@ use glam::Vec3;
 /// which is itself a crack. Scale such scenes down (`scale` in the scene file).
 pub const MAX_COORDINATE: f32 = 1e10;
 
+/// Whether `p` lies within ±[`MAX_COORDINATE`] on every axis (false for NaN).
+#[inline]
+#[must_use]
+pub fn in_range(p: Vec3) -> bool {
+    p.abs().max_element() <= MAX_COORDINATE
+}
+
 /// The unit normal (counter-clockwise) and area of a triangle: in f32 as everywhere else, and in
 /// f64 where the f32 cross product's squared length overflows (edges longer than about 10⁹) or
 /// leaves the normal range (edges shorter than about 10⁻¹⁹), so that large and tiny triangles

@@ -104,13 +104,12 @@ pub fn trace_photons(
 #[must_use]
 pub fn stop_path(stored_per_path: &[u32], need: u64) -> u64 {
     let mut sum = 0u64;
-    for (j, &n) in stored_per_path.iter().enumerate() {
+    let j = stored_per_path.iter().position(|&n| {
         sum += u64::from(n);
-        if sum >= need {
-            return j as u64;
-        }
-    }
-    stored_per_path.len().saturating_sub(1) as u64
+        sum >= need
+    });
+    debug_assert!(j.is_some(), "the batch stored fewer than the {need} photons it is cut at");
+    j.unwrap_or(stored_per_path.len().saturating_sub(1)) as u64
 }
 
 /// Divides stored photons' power by the number of paths emitted: each then carries Φ/N.
@@ -300,4 +299,18 @@ pub fn shading_normal_correction(frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> f3
 #[must_use]
 pub fn first_hit_power(photons: &[Photon]) -> Vec3 {
     photons.iter().filter(|p| p.flags & flags::DIRECT != 0).map(|p| p.power).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::stop_path;
+
+    /// The path that stores the `need`-th photon of a batch: paths storing nothing are passed
+    /// over, and a path whose photons straddle the count is the one emission stops at.
+    #[test]
+    fn emission_stops_at_the_path_that_stores_the_last_photon() {
+        let stored = [0, 2, 0, 3, 1];
+        let cuts: Vec<u64> = (1..=6).map(|need| stop_path(&stored, need)).collect();
+        assert_eq!(cuts, [1, 1, 3, 3, 3, 4]);
+    }
 }

@@ -1,7 +1,7 @@
 //! A pinhole camera: eye, target, up and vertical field of view.
 
 use crate::error::{Error, Result};
-use crate::geometry::MAX_COORDINATE;
+use crate::geometry::{in_range, MAX_COORDINATE};
 use glam::Vec3;
 
 /// Where the camera is and where it looks.
@@ -35,10 +35,14 @@ impl Camera {
         if !(self.eye.is_finite() && self.target.is_finite() && self.up.is_finite()) {
             return bad("camera", "eye, target and up must be finite");
         }
-        if !(self.eye.abs().max_element() <= MAX_COORDINATE) {
+        if !in_range(self.eye) {
             return Err(Error::setting(
                 "camera.eye",
-                format!("{} is outside ±{MAX_COORDINATE:e}, the range photonwave supports", self.eye),
+                format!(
+                    "{} is outside ±{MAX_COORDINATE:e}, the range photonwave supports (a camera fitted to a \
+                     scene this large lies there too: scale the scene down with `scale` in the scene file)",
+                    self.eye
+                ),
             ));
         }
         let Some(forward) = (self.target - self.eye).try_normalize() else {

@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 use crate::geometry::bvh::TriangleColumns;
 use crate::geometry::offset::{barycentric_error, offset_ray_origin};
 use crate::geometry::triangle::is_degenerate;
-use crate::geometry::{normal_and_area, Bvh, Hit, MAX_COORDINATE};
+use crate::geometry::{in_range, normal_and_area, Bvh, Hit, MAX_COORDINATE};
 use crate::material::{Bsdf, Material, SurfaceFrame};
 use crate::sampling::Distribution1D;
 pub use camera::Camera;
@@ -187,11 +187,11 @@ impl Scene {
         let mut emitter_area = vec![0.0f64; materials.len()];
         let mut emitter_seen = vec![false; materials.len()];
         for m in &meshes {
-            if let Some(k) = m.positions.iter().position(|p| !(p.abs().max_element() <= MAX_COORDINATE)) {
+            // `load_obj` names the line; this catches meshes made in code.
+            if let Some(k) = m.positions.iter().position(|p| !in_range(*p)) {
                 return Err(Error::scene(format!(
-                    "{}: vertex {} lies at {} (after scale and translate), outside ±{MAX_COORDINATE:e}, the \
-                     range in which photonwave's f32 geometry is exact enough to be watertight; scale the \
-                     scene down (`scale` in the scene file; README, \"Limits\")",
+                    "{}: vertex {} lies at {}, outside ±{MAX_COORDINATE:e}, the range in which photonwave's \
+                     f32 geometry stays watertight (README, \"Limits\")",
                     m.source,
                     k + 1,
                     m.positions[k]
@@ -238,15 +238,18 @@ impl Scene {
         }
         if p0.is_empty() {
             let directional = extra_lights.iter().any(|l| matches!(l, Light::Directional { .. }));
-            return Err(Error::scene(if directional {
-                "the scene has no triangles: a directional light needs geometry to light (add a [[mesh]])"
+            let why = if dropped > 0 {
+                format!(" (all {dropped} of its triangles have zero area)")
+            } else if directional {
+                ": a directional light needs geometry to light (add a [[mesh]])".into()
             } else {
-                "the scene has no triangles to light (add a [[mesh]])"
-            }));
+                " to light (add a [[mesh]])".into()
+            };
+            return Err(Error::scene(format!("the scene has no triangles{why}")));
         }
         for (i, l) in extra_lights.iter().enumerate() {
             if let Light::Point { position, .. } | Light::Spot { position, .. } = *l {
-                if !(position.abs().max_element() <= MAX_COORDINATE) {
+                if !in_range(position) {
                     return Err(Error::setting(
                         format!("light[{i}].position"),
                         format!("{position} is outside ±{MAX_COORDINATE:e}, the range photonwave supports"),

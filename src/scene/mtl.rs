@@ -11,8 +11,9 @@
 //!
 //! Colours take three numbers, one (grey), or `xyz X [Y Z]` (CIE XYZ, converted to linear sRGB).
 //! Statements the spec defines but photonwave does not simulate (texture maps with their
-//! options, `d`/`Tr` transparency, `sharpness`, `Km`, the PBR keys, spectral colours) are read,
-//! checked where they hold numbers, and reported in one warning per material. Anything else is
+//! options, `d`/`Tr` transparency, a coloured `Tf`, `sharpness`, `Km`, the PBR keys, spectral
+//! colours) are read, checked where they hold numbers, and reported in one warning per
+//! material (`Ka` is read and not reported: ambient light has no place in global illumination). Anything else is
 //! an error naming the file and line.
 
 use crate::error::{Error, Result};
@@ -149,12 +150,21 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
                 m.ignored.push(what.to_string());
             }
         };
+        if words.first() == Some(&"spectral") {
+            ignore(m, &format!("{kw} spectral"));
+        }
         match kw {
             "Kd" => m.kd = colour(path, line, kw, &words)?.or(m.kd),
             "Ks" => m.ks = colour(path, line, kw, &words)?.or(m.ks),
             "Ke" => m.ke = colour(path, line, kw, &words)?.or(m.ke),
-            "Ka" | "Tf" => {
+            "Ka" => {
                 colour(path, line, kw, &words)?;
+            }
+            "Tf" => {
+                // The transmission filter: clear (1 1 1) is what photonwave's glass does.
+                if colour(path, line, kw, &words)?.is_some_and(|c| c != Vec3::ONE) {
+                    ignore(m, kw);
+                }
             }
             "Ns" => {
                 let v = one(kw)?;

@@ -11,7 +11,7 @@ use super::validate::{check_obj, MtlLib};
 use super::MeshInput;
 use crate::error::{Error, Result};
 use crate::files::{read_text, MAX_MATERIAL_FILE, MAX_MESH_FILE};
-use crate::geometry::MAX_COORDINATE;
+use crate::geometry::{in_range, MAX_COORDINATE};
 use crate::material::{Bsdf, Material};
 use glam::Vec3;
 use std::collections::HashMap;
@@ -100,10 +100,6 @@ fn named_by(e: Error, obj: &Path, line: usize) -> Error {
         }
         other => other,
     }
-}
-
-fn in_range(p: Vec3) -> bool {
-    p.abs().max_element() <= MAX_COORDINATE
 }
 
 /// The error for the first `v` statement of `text` that lies outside ±[`MAX_COORDINATE`] once
