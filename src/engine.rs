@@ -11,7 +11,6 @@ use crate::scene::Scene;
 use crate::settings::Settings;
 use crate::stats::RenderStats;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
 
 /// A rendering engine.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -25,14 +24,7 @@ pub enum Engine {
     Path,
 }
 
-/// A time budget: stop starting passes so that the render ends near `start + limit`.
-#[derive(Clone, Copy, Debug)]
-pub struct Budget {
-    /// The whole budget.
-    pub limit: Duration,
-    /// When the budget started counting (the CLI counts scene loading too).
-    pub start: Instant,
-}
+pub use crate::progressive::Budget;
 
 /// Whether `settings` (and an optional budget) make a progressive render.
 #[must_use]
@@ -84,5 +76,6 @@ pub fn render(
     if engine == Engine::Path {
         return Err(Error::setting("--engine", "progressive passes (--passes, --time) need a photon-mapping engine"));
     }
-    crate::progressive::render_passes(scene, rays, settings, engine, budget, progress)
+    let run = |s: &Settings| render_once(scene, rays, s, engine, &crate::reference::NoProgress);
+    crate::progressive::render_passes(scene, rays, settings, &run, budget, progress)
 }

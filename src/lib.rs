@@ -23,6 +23,7 @@ pub mod kernels;
 pub mod material;
 pub mod memory;
 pub mod photon_map;
+pub mod plan;
 pub mod plot;
 pub mod progressive;
 pub mod reference;

@@ -23,10 +23,34 @@
 //! same order, so both find the same photons.
 
 use crate::kernels::KernelSet;
-use crate::settings::Kernel;
 use glam::Vec3;
+use serde::{Deserialize, Serialize};
 use std::f32::consts::PI;
 use wide::{f32x8, i32x8, u32x8};
+
+/// Density-estimation kernel, each normalised so that a uniform photon density is returned exactly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Kernel {
+    /// Constant weight: ∑Φ / (πr²).
+    Box,
+    /// Jensen's cone filter, weight 1 − d/r, normalised by 3/(πr²).
+    Cone,
+    /// Epanechnikov, weight 1 − d²/r², normalised by 2/(πr²).
+    Epanechnikov,
+}
+
+impl std::str::FromStr for Kernel {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "box" => Ok(Kernel::Box),
+            "cone" => Ok(Kernel::Cone),
+            "epanechnikov" => Ok(Kernel::Epanechnikov),
+            _ => Err(format!("unknown kernel `{s}` (box, cone, epanechnikov)")),
+        }
+    }
+}
 
 /// Flags on a stored photon.
 pub mod flags {

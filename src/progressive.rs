@@ -17,48 +17,32 @@
 //! pass here, which the probabilistic analysis covers but which blurs sparse regions as much as
 //! dense ones.
 
-use crate::engine::{Budget, Engine};
 use crate::error::Result;
 use crate::film::{Film, Terms};
 use crate::kernels::KernelSet;
 use crate::photon_map::{flags, Filter, Lookup, PhotonMap};
-use crate::reference::{build_maps, NoProgress, Progress};
+use crate::reference::{build_maps, Progress};
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::{FixedRadii, PixelRadii, Settings};
 use crate::stats::RenderStats;
-use serde::Serialize;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+
+/// A time budget: stop starting passes so that the render ends near `start + limit`.
+#[derive(Clone, Copy, Debug)]
+pub struct Budget {
+    /// The whole budget.
+    pub limit: Duration,
+    /// When the budget started counting (the CLI counts scene loading too).
+    pub start: Instant,
+}
 
 /// Photons sampled for the first radii.
 pub const RADIUS_SAMPLES: usize = 1024;
 
-/// What a progressive render did (in `--stats` and the summary).
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
-pub struct ProgressiveStats {
-    /// Passes rendered.
-    pub passes: u32,
-    /// Radius reduction α.
-    pub alpha: f32,
-    /// First global and caustic radii (scene units).
-    pub initial_radii: [f32; 2],
-    /// Last pass's global and caustic radii.
-    pub final_radii: [f32; 2],
-    /// First caustic radii per pixel (10th, 50th, 90th percentile), with per-pixel radii.
-    pub pixel_caustic_radii: Option<[f32; 3]>,
-    /// First global radii per pixel (10th, 50th, 90th percentile), with per-pixel radii and
-    /// final gathering off.
-    pub pixel_global_radii: Option<[f32; 3]>,
-    /// Time budget in seconds, if one was given.
-    pub budget_s: Option<f64>,
-    /// Seconds from the caller's start to the last pass's end.
-    pub elapsed_s: f64,
-    /// Wall time of each pass.
-    pub pass_seconds: Vec<f64>,
-    /// Wall time of the pilot photon pass and the per-pixel radii.
-    pub pilot_seconds: f64,
-}
+pub use crate::settings::PerPass;
+pub use crate::stats::ProgressiveStats;
 
 /// The seed of pass `i`: pass 0 keeps the user's seed; later ones are mixed from it.
 #[must_use]
@@ -339,29 +323,6 @@ impl Progressive {
     }
 }
 
-/// Which per-pass amounts were given explicitly (by a flag, a sweep knob or a preset); those are
-/// used as they are in every pass instead of being spread over the passes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct PerPass {
-    /// `spp` is per pass.
-    pub spp: bool,
-    /// `photons` is per pass.
-    pub photons: bool,
-    /// `caustic_photons` is per pass.
-    pub caustic_photons: bool,
-}
-
-impl std::ops::BitOr for PerPass {
-    type Output = PerPass;
-    fn bitor(self, o: PerPass) -> PerPass {
-        PerPass {
-            spp: self.spp || o.spp,
-            photons: self.photons || o.photons,
-            caustic_photons: self.caustic_photons || o.caustic_photons,
-        }
-    }
-}
-
 /// Settings for each pass when a one-pass render's `spp` samples and photon counts are spread
 /// over passes: 1 sample per pixel and photons / spp per map (at least 1 000), except for the
 /// amounts `given` per pass.
@@ -416,20 +377,19 @@ pub fn budget_warning(p: &ProgressiveStats) -> Option<String> {
     })
 }
 
-/// Progressive passes of `engine` with `settings` per pass, until `settings.passes` or, with a
-/// budget, until the budget is spent ([`Progressive::another_fits`]). `progress` gets one bar:
+/// Progressive passes, each rendered by `run` with that pass's settings (`settings` per pass),
+/// until `settings.passes` or, with a budget, until the budget is spent ([`Progressive::another_fits`]). `progress` gets one bar:
 /// passes, or the budget's milliseconds, with the pass number and time left as its message.
 pub fn render_passes(
     scene: &Arc<Scene>,
     rays: &CameraRays,
     settings: &Settings,
-    engine: Engine,
+    run: &dyn Fn(&Settings) -> Result<(Film, RenderStats)>,
     budget: Option<Budget>,
     progress: &dyn Progress,
 ) -> Result<(Film, RenderStats)> {
     let t = Instant::now();
     let start = budget.map_or(t, |b| b.start);
-    let run = |s: &Settings| crate::engine::render_once(scene, rays, s, engine, &NoProgress);
     let mut p = Progressive::new(scene, rays, settings)?;
     let total = budget.map_or(u64::from(settings.passes), |b| b.limit.as_millis() as u64);
     progress.start(if budget.is_some() { "ms of budget" } else { "passes" }, total);
@@ -442,7 +402,7 @@ pub fn render_passes(
         if !go_on {
             break;
         }
-        p.step(&run)?;
+        p.step(run)?;
         let elapsed = start.elapsed();
         let done = match budget {
             Some(b) => {

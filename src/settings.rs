@@ -4,26 +4,34 @@
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
-/// Density-estimation kernel, each normalised so that a uniform photon density is returned exactly.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Kernel {
-    /// Constant weight: ∑Φ / (πr²).
-    Box,
-    /// Jensen's cone filter, weight 1 − d/r, normalised by 3/(πr²).
-    Cone,
-    /// Epanechnikov, weight 1 − d²/r², normalised by 2/(πr²).
-    Epanechnikov,
+pub use crate::photon_map::Kernel;
+
+/// Names of the effects plan's parts, as `force` accepts them.
+pub const PART_NAMES: [&str; 5] = ["caustic_map", "global_map", "final_gather", "refraction", "shadow_rays"];
+
+/// At most this many photon paths per stored photon asked for (caps scenes where few paths
+/// reach a surface the map stores on).
+pub const MAX_PATHS_PER_PHOTON: u64 = 256;
+
+/// Which per-pass amounts were given explicitly (by a flag, a sweep knob or a preset); those are
+/// used as they are in every pass instead of being spread over the passes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PerPass {
+    /// `spp` is per pass.
+    pub spp: bool,
+    /// `photons` is per pass.
+    pub photons: bool,
+    /// `caustic_photons` is per pass.
+    pub caustic_photons: bool,
 }
 
-impl std::str::FromStr for Kernel {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "box" => Ok(Kernel::Box),
-            "cone" => Ok(Kernel::Cone),
-            "epanechnikov" => Ok(Kernel::Epanechnikov),
-            _ => Err(format!("unknown kernel `{s}` (box, cone, epanechnikov)")),
+impl std::ops::BitOr for PerPass {
+    type Output = PerPass;
+    fn bitor(self, o: PerPass) -> PerPass {
+        PerPass {
+            spp: self.spp || o.spp,
+            photons: self.photons || o.photons,
+            caustic_photons: self.caustic_photons || o.caustic_photons,
         }
     }
 }
@@ -203,8 +211,8 @@ pub enum Preset {
 
 impl Preset {
     /// Sets the preset's knobs on `settings`; returns the per-pass amounts it fixed (see
-    /// [`crate::progressive::per_pass`]).
-    pub fn apply(self, s: &mut Settings) -> crate::progressive::PerPass {
+    /// `progressive::per_pass`).
+    pub fn apply(self, s: &mut Settings) -> PerPass {
         let (spp, photons, caustic_photons, gather_rays, passes) = match self {
             Preset::Preview => (4, 50_000, 25_000, 8, 1),
             Preset::Default => {
@@ -216,7 +224,7 @@ impl Preset {
         (s.spp, s.photons, s.caustic_photons, s.gather_rays, s.passes) =
             (spp, photons, caustic_photons, gather_rays, passes);
         let per_pass = passes > 1;
-        crate::progressive::PerPass { spp: per_pass, photons: per_pass, caustic_photons: per_pass }
+        PerPass { spp: per_pass, photons: per_pass, caustic_photons: per_pass }
     }
 }
 
@@ -275,11 +283,8 @@ impl Settings {
         if self.threads > 1024 {
             return err("threads", "at most 1024");
         }
-        if let Some(bad) = self.force.iter().find(|f| !crate::effects::PART_NAMES.contains(&f.as_str())) {
-            return Err(Error::setting(
-                "force",
-                format!("unknown part `{bad}` (one of {})", crate::effects::PART_NAMES.join(", ")),
-            ));
+        if let Some(bad) = self.force.iter().find(|f| !PART_NAMES.contains(&f.as_str())) {
+            return Err(Error::setting("force", format!("unknown part `{bad}` (one of {})", PART_NAMES.join(", "))));
         }
         Ok(())
     }

@@ -55,7 +55,7 @@ impl std::ops::AddAssign<&MapStats> for MapStats {
 
 impl MapStats {
     /// A warning when the map holds fewer photons than `asked` because its photon pass hit the
-    /// cap of [`MAX_PATHS_PER_PHOTON`](crate::reference::photons::MAX_PATHS_PER_PHOTON) paths per
+    /// cap of [`MAX_PATHS_PER_PHOTON`](crate::settings::MAX_PATHS_PER_PHOTON) paths per
     /// photon asked: few light paths reach the surfaces it stores on, and its estimates are
     /// sparse (or, when it is empty, zero).
     #[must_use]
@@ -66,7 +66,7 @@ impl MapStats {
                  few light paths reach the surfaces it stores on{}",
                 self.stored,
                 self.emitted,
-                crate::reference::photons::MAX_PATHS_PER_PHOTON,
+                crate::settings::MAX_PATHS_PER_PHOTON,
                 if self.stored == 0 { "; it is empty and adds nothing" } else { "" }
             )
         })
@@ -155,7 +155,7 @@ pub struct RenderStats {
     /// The effects plan: each part with whether it ran and why (photon-mapping engines only;
     /// absent from the JSON for the path tracer).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub effects: Option<crate::effects::Effects>,
+    pub effects: Option<crate::plan::Effects>,
     /// Global photon map.
     pub global_map: MapStats,
     /// Caustic photon map.
@@ -172,11 +172,11 @@ pub struct RenderStats {
     /// Phase times.
     pub times: PhaseTimes,
     /// Per-system runs, lanes and time (wavefront engine).
-    pub stages: Option<crate::wavefront::StageStats>,
+    pub stages: Option<StageStats>,
     /// Mean of the beauty image (RGB).
     pub mean_rgb: [f32; 3],
     /// Progressive passes, radii and budget (progressive renders only).
-    pub progressive: Option<crate::progressive::ProgressiveStats>,
+    pub progressive: Option<ProgressiveStats>,
 }
 
 impl RenderStats {
@@ -292,4 +292,67 @@ impl RenderStats {
         }
         out
     }
+}
+
+/// Work done by one system.
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+pub struct StageStat {
+    /// Times the system ran.
+    pub runs: u64,
+    /// Lanes it processed.
+    pub items: u64,
+    /// Wall time inside it.
+    pub seconds: f64,
+}
+
+/// Per-system counts and times.
+#[derive(bevy_ecs::resource::Resource, Default, Clone, Debug, Serialize, PartialEq)]
+pub struct StageStats(pub std::collections::BTreeMap<String, StageStat>);
+
+impl std::ops::AddAssign<&StageStats> for StageStats {
+    /// Adds another render's runs, lanes and times, system by system.
+    fn add_assign(&mut self, o: &StageStats) {
+        for (name, s) in &o.0 {
+            let e = self.0.entry(name.clone()).or_default();
+            e.runs += s.runs;
+            e.items += s.items;
+            e.seconds += s.seconds;
+        }
+    }
+}
+
+impl StageStats {
+    /// Records one run of `system` over `items` lanes since `start`.
+    pub fn record(&mut self, system: &str, items: usize, start: std::time::Instant) {
+        let e = self.0.entry(system.to_string()).or_default();
+        e.runs += 1;
+        e.items += items as u64;
+        e.seconds += start.elapsed().as_secs_f64();
+    }
+}
+
+/// What a progressive render did (in `--stats` and the summary).
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct ProgressiveStats {
+    /// Passes rendered.
+    pub passes: u32,
+    /// Radius reduction α.
+    pub alpha: f32,
+    /// First global and caustic radii (scene units).
+    pub initial_radii: [f32; 2],
+    /// Last pass's global and caustic radii.
+    pub final_radii: [f32; 2],
+    /// First caustic radii per pixel (10th, 50th, 90th percentile), with per-pixel radii.
+    pub pixel_caustic_radii: Option<[f32; 3]>,
+    /// First global radii per pixel (10th, 50th, 90th percentile), with per-pixel radii and
+    /// final gathering off.
+    pub pixel_global_radii: Option<[f32; 3]>,
+    /// Time budget in seconds, if one was given.
+    pub budget_s: Option<f64>,
+    /// Seconds from the caller's start to the last pass's end.
+    pub elapsed_s: f64,
+    /// Wall time of each pass.
+    pub pass_seconds: Vec<f64>,
+    /// Wall time of the pilot photon pass and the per-pixel radii.
+    pub pilot_seconds: f64,
 }

@@ -50,19 +50,6 @@ impl Bvh {
         &self.bvh.nodes
     }
 
-    /// Closest hit with 0 < t < `t_max` among triangles given by the BVH-ordered columns
-    /// (single-ray traversal; ties in t go to the lower triangle index).
-    #[must_use]
-    pub fn closest(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> Option<Hit> {
-        super::traverse::closest(self, tris, &super::traverse::RayQuery::new(o, d, t_max))
-    }
-
-    /// True if any triangle is hit with 0 < t < `t_max` (shadow rays).
-    #[must_use]
-    pub fn occluded(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> bool {
-        super::traverse::occluded(self, tris, &super::traverse::RayQuery::new(o, d, t_max))
-    }
-
     /// obvhs's own single-ray traversal (closest hit) calling the same triangle test: the
     /// baseline the packet traversal is benchmarked against. Ties go to the first found.
     #[must_use]

@@ -377,3 +377,19 @@ pub fn occluded_rays(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery], ou
         *o = occluded_with(bvh, tris, r, &mut stack);
     }
 }
+/// The single-ray traversals as methods of the tree (kept here, beside the traversal, so that
+/// `bvh.rs` needs nothing from this file).
+impl Bvh {
+    /// Closest hit with 0 < t < `t_max` among triangles given by the BVH-ordered columns
+    /// (single-ray traversal; ties in t go to the lower triangle index).
+    #[must_use]
+    pub fn closest(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> Option<Hit> {
+        closest(self, tris, &RayQuery::new(o, d, t_max))
+    }
+
+    /// True if any triangle is hit with 0 < t < `t_max` (shadow rays).
+    #[must_use]
+    pub fn occluded(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> bool {
+        occluded(self, tris, &RayQuery::new(o, d, t_max))
+    }
+}

@@ -24,8 +24,7 @@ use glam::Vec3;
 pub const BATCH: usize = 16_384;
 /// Paths per work chunk inside a batch.
 const CHUNK: usize = 1024;
-/// At most this many paths per stored photon requested (caps scenes where few photons qualify).
-pub const MAX_PATHS_PER_PHOTON: u64 = 256;
+pub use crate::settings::MAX_PATHS_PER_PHOTON;
 
 /// What a photon pass produced.
 pub struct PhotonPass {

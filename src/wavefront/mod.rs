@@ -39,8 +39,6 @@ use crate::stats::{RayCounts, RenderStats};
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{ExecutorKind, ScheduleLabel};
 use queues::{Classified, PathQueue, PhotonQueue, ShadowQueue};
-use serde::Serialize;
-use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -153,42 +151,7 @@ pub struct CameraWork {
     pub numerics: crate::stats::Numerics,
 }
 
-/// Work done by one system.
-#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
-pub struct StageStat {
-    /// Times the system ran.
-    pub runs: u64,
-    /// Lanes it processed.
-    pub items: u64,
-    /// Wall time inside it.
-    pub seconds: f64,
-}
-
-/// Per-system counts and times.
-#[derive(Resource, Default, Clone, Debug, Serialize, PartialEq)]
-pub struct StageStats(pub BTreeMap<String, StageStat>);
-
-impl std::ops::AddAssign<&StageStats> for StageStats {
-    /// Adds another render's runs, lanes and times, system by system.
-    fn add_assign(&mut self, o: &StageStats) {
-        for (name, s) in &o.0 {
-            let e = self.0.entry(name.clone()).or_default();
-            e.runs += s.runs;
-            e.items += s.items;
-            e.seconds += s.seconds;
-        }
-    }
-}
-
-impl StageStats {
-    /// Records one run of `system` over `items` lanes since `start`.
-    pub fn record(&mut self, system: &str, items: usize, start: Instant) {
-        let e = self.0.entry(system.to_string()).or_default();
-        e.runs += 1;
-        e.items += items as u64;
-        e.seconds += start.elapsed().as_secs_f64();
-    }
-}
+pub use crate::stats::{StageStat, StageStats};
 
 /// Runs `f` over `0..n` in chunks on `threads` threads; each chunk fills its own `T` (a queue
 /// or columns) and the chunks are appended in lane order with `append` (column copies, so the
