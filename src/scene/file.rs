@@ -29,7 +29,7 @@
 use super::camera::Camera;
 use super::light::Light;
 use super::obj::{load_obj, MaterialTable};
-use super::{MeshInput, Scene};
+use super::{bounds_of, MeshInput, Scene};
 use crate::error::{Error, Result};
 use crate::files::{read_text, MAX_SCENE_FILE};
 use crate::material::{Bsdf, Material};
@@ -264,10 +264,7 @@ pub type AddedLights<'a> = &'a dyn Fn((Vec3, Vec3), Option<Camera>) -> Vec<Light
 
 /// Loads a scene as [`load_scene`] does, with the lights `added` gives it besides its own.
 pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
-    let bounds = |meshes: &[MeshInput]| {
-        let all = meshes.iter().flat_map(|m| m.positions.iter());
-        all.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
-    };
+    let bounds = |meshes: &[MeshInput]| bounds_of(meshes.iter().flat_map(|m| m.positions.iter()));
     let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if is_obj {
         let (mut table, mut warnings, mut inputs) = (MaterialTable::default(), Vec::new(), Vec::new());

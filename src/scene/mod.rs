@@ -172,6 +172,12 @@ fn coincident_dielectrics(
     })
 }
 
+/// The bounding box (lo, hi) of `points`; (+∞, −∞) for none.
+#[must_use]
+pub fn bounds_of<'a>(points: impl Iterator<Item = &'a Vec3>) -> (Vec3, Vec3) {
+    points.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+}
+
 impl Scene {
     /// Assembles meshes, materials and extra lights; validates and builds the BVH.
     pub fn build(
@@ -258,12 +264,7 @@ impl Scene {
             }
         }
 
-        let mut lo = Vec3::splat(f32::INFINITY);
-        let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        for p in p0.iter().chain(&p1).chain(&p2) {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
+        let (mut lo, mut hi) = bounds_of(p0.iter().chain(&p1).chain(&p2));
         let size = (hi - lo).length().max(f32::MIN_POSITIVE);
         if let Some(w) = coincident_dielectrics(&p0, &p1, &p2, &mat, &materials, size) {
             warnings.push(w);
@@ -496,8 +497,7 @@ impl Scene {
     /// frames.
     #[must_use]
     pub fn mesh_bounds(&self) -> (Vec3, Vec3) {
-        let all = self.p0.iter().chain(&self.p1).chain(&self.p2);
-        all.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+        bounds_of(self.p0.iter().chain(&self.p1).chain(&self.p2))
     }
 
     /// Radius of the bounding sphere around the box centre.

@@ -16,6 +16,7 @@
 //! material (`Ka` is read and not reported: ambient light has no place in global illumination). Anything else is
 //! an error naming the file and line.
 
+use super::validate::number;
 use crate::error::{Error, Result};
 use crate::material::{Bsdf, Material};
 use glam::Vec3;
@@ -42,15 +43,6 @@ pub struct MtlMaterial {
     pub illum: Option<u8>,
     /// Statements read but not simulated, in order of first appearance (`map_Kd`, `d`, …).
     pub ignored: Vec<String>,
-}
-
-fn number(path: &Path, line: usize, what: &str, w: &str) -> Result<f32> {
-    let v: f32 = w.parse().map_err(|_| Error::parse(path, line, format!("`{what}`: `{w}` is not a number")))?;
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(Error::parse(path, line, format!("`{what}`: `{w}` is not finite")))
-    }
 }
 
 /// A colour statement's value: `r g b`, `r` (grey), or `xyz X [Y Z]`. `None` for `spectral`.

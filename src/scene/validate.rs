@@ -10,18 +10,18 @@ fn floats(path: &Path, line_no: usize, what: &str, words: &[&str], min: usize, m
         let count = if min == max { format!("{min}") } else { format!("{min} to {max}") };
         return Err(Error::parse(path, line_no, format!("`{what}` needs {count} numbers, found {}", words.len())));
     }
-    words
-        .iter()
-        .map(|w| {
-            let v: f32 =
-                w.parse().map_err(|_| Error::parse(path, line_no, format!("`{what}`: `{w}` is not a number")))?;
-            if v.is_finite() {
-                Ok(v)
-            } else {
-                Err(Error::parse(path, line_no, format!("`{what}`: `{w}` is not finite")))
-            }
-        })
-        .collect()
+    words.iter().map(|w| number(path, line_no, what, w)).collect()
+}
+
+/// The word `w` of statement `what` as a finite number (Rust's parser alone accepts "nan" and
+/// "inf"), or an error naming the file and line.
+pub(super) fn number(path: &Path, line: usize, what: &str, w: &str) -> Result<f32> {
+    let v: f32 = w.parse().map_err(|_| Error::parse(path, line, format!("`{what}`: `{w}` is not a number")))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(Error::parse(path, line, format!("`{what}`: `{w}` is not finite")))
+    }
 }
 
 /// An `mtllib` statement: its line and what follows the keyword (one or more file names).
