@@ -49,7 +49,7 @@ fn density(c: &mut Criterion) {
     let loaded = load_scene(&scene_path("cornell-box.toml")).expect("bundled scene");
     let scene = &loaded.scene;
     let settings = Settings { photons: 200_000, ..Default::default() };
-    let (maps, _, _) = build_maps(scene, &settings);
+    let (maps, _, _) = build_maps(scene, &settings).unwrap();
     // Queries at stored photon positions (on surfaces), in a scattered order.
     let queries: Vec<(Vec3, Vec3)> = (0..16_384usize)
         .map(|i| {

@@ -61,7 +61,7 @@ fn density(c: &mut Criterion) {
     let cam = loaded.camera.unwrap().prepare(photonwave::bench::SIDE, photonwave::bench::SIDE).unwrap();
     let sets = RaySets::new(s, &cam);
     let settings = Settings { photons: 200_000, ..Default::default() };
-    let (maps, _, _) = build_maps(s, &settings);
+    let (maps, _, _) = build_maps(s, &settings).unwrap();
     let queries: Vec<(Vec3, Vec3)> = sets.hits.iter().step_by(16).copied().collect();
     let r = settings.global_radius * s.diagonal();
     let mut g = c.benchmark_group("simd_density");

@@ -7,7 +7,6 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::system::RunSystemOnce;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec3;
-use photonwave::effects::Effects;
 use photonwave::film::Terms;
 use photonwave::reference::build_maps;
 use photonwave::rng::Domain;
@@ -33,10 +32,10 @@ fn setup(threads: usize) -> World {
     };
     let camera = loaded.camera.unwrap().prepare(settings.width, settings.height).unwrap();
     let scene = Arc::new(loaded.scene);
-    let (maps, _, _) = build_maps(&scene, &settings);
+    let (maps, _, _) = build_maps(&scene, &settings).unwrap();
     let mut w = World::new();
-    let effects = Effects::plan(&scene, &settings);
-    w.insert_resource(Shared { scene, settings, effects, threads });
+    let job = photonwave::job::Job::new(&scene, &settings).expect("valid bench settings");
+    w.insert_resource(Shared { scene, job });
     w.insert_resource(StageStats::default());
     w.insert_resource(Maps(Arc::new(maps)));
     w.insert_resource(PhotonWork { domain: Some(Domain::GlobalPhoton), ..Default::default() });
@@ -59,7 +58,7 @@ fn setup(threads: usize) -> World {
 fn photon_stages(c: &mut Criterion) {
     let mut w = setup(1);
     let mut g = c.benchmark_group("photon_stages");
-    g.throughput(Throughput::Elements(photonwave::reference::photons::BATCH as u64));
+    g.throughput(Throughput::Elements(photonwave::transport::photon::BATCH as u64));
     g.bench_function("emit_photons", |b| b.iter(|| w.run_system_once(emit::emit_photons).unwrap()));
     w.run_system_once(emit::emit_photons).unwrap();
     g.bench_function("intersect_photons", |b| b.iter(|| w.run_system_once(intersect::intersect_photons).unwrap()));

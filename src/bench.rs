@@ -15,7 +15,7 @@
 
 use crate::geometry::packet::{closest_packets, occluded_packets};
 use crate::geometry::{offset_ray_origin, RayQuery};
-use crate::reference::parallel::map_chunks;
+use crate::parallel::map_chunks;
 use crate::rng::{Domain, Sampler};
 use crate::sampling::{cosine_hemisphere, Frame};
 use crate::scene::camera::CameraRays;
@@ -360,7 +360,8 @@ fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usiz
         return vec![];
     }
     let settings = Settings { photons: BENCH_PHOTONS, threads: threads as u32, ..Default::default() };
-    let (maps, _, _) = build_maps(scene, &settings);
+    // Default settings with a photon count: always valid, so an error here cannot happen.
+    let Ok((maps, _, _)) = build_maps(scene, &settings) else { return vec![] };
     let map = &maps.global;
     if map.is_empty() {
         return vec![];

@@ -5,7 +5,8 @@
 
 use crate::error::{Error, Result};
 use crate::film::Film;
-use crate::reference::Progress;
+use crate::job::Job;
+use crate::progress::{NoProgress, Progress};
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::Settings;
@@ -32,23 +33,26 @@ pub fn is_progressive(settings: &Settings, budget: Option<Budget>) -> bool {
     settings.passes > 1 || budget.is_some()
 }
 
-/// One render of `scene` with `engine`, with no progressive passes.
-pub fn render_once(
+/// One pass of `job` rendered by `engine`: a whole render with the job's seed and, in a
+/// progressive pass, its fixed radii.
+#[must_use]
+pub fn render_job(
     scene: &Arc<Scene>,
     rays: &CameraRays,
-    settings: &Settings,
+    job: &Job,
     engine: Engine,
     progress: &dyn Progress,
-) -> Result<(Film, RenderStats)> {
+) -> (Film, RenderStats) {
     match engine {
-        Engine::Wavefront => crate::wavefront::render(scene.clone(), rays, settings, progress),
-        Engine::Reference => crate::reference::render(scene, rays, settings, progress),
-        Engine::Path => crate::reference::path::render_path_traced_with_stats(scene, rays, settings, progress),
+        Engine::Wavefront => crate::wavefront::render_job(scene.clone(), rays, job, progress),
+        Engine::Reference => crate::reference::render_job(scene, rays, job, progress),
+        Engine::Path => crate::path::render_job(scene, rays, job, progress),
     }
 }
 
 /// Renders `scene`: once, or — when `settings.passes > 1` or a budget is given — progressive
-/// passes with `settings` as each pass's settings (see [`crate::progressive::per_pass`]).
+/// passes with `settings` as each pass's settings (see [`crate::progressive::per_pass`]). The
+/// settings are validated and the effects plan made here, once for the whole render.
 /// `progress` sees one phase per pass in a single render, or one bar over the passes (or the
 /// budget's milliseconds) in a progressive one.
 pub fn render(
@@ -59,23 +63,26 @@ pub fn render(
     budget: Option<Budget>,
     progress: &dyn Progress,
 ) -> Result<(Film, RenderStats)> {
+    let job = Job::new(scene, settings)?;
+    if engine != Engine::Path {
+        job.plan.check(settings)?;
+    }
     // Refuse what would exhaust memory before any of it is allocated.
     if let Some((available, total)) = crate::memory::machine() {
-        let plan = crate::effects::Effects::plan(scene, settings);
         let photons = if engine == Engine::Path {
             0
         } else {
-            u64::from(settings.photons) * u64::from(plan.global_map.on)
-                + u64::from(settings.caustic_photons) * u64::from(plan.caustic_map.on)
+            u64::from(settings.photons) * u64::from(job.plan.global_map.on)
+                + u64::from(settings.caustic_photons) * u64::from(job.plan.caustic_map.on)
         };
         crate::memory::check(settings.width, settings.height, photons, available, total)?;
     }
     if !is_progressive(settings, budget) {
-        return render_once(scene, rays, settings, engine, progress);
+        return Ok(render_job(scene, rays, &job, engine, progress));
     }
     if engine == Engine::Path {
         return Err(Error::setting("--engine", "progressive passes (--passes, --time) need a photon-mapping engine"));
     }
-    let run = |s: &Settings| render_once(scene, rays, s, engine, &crate::reference::NoProgress);
-    crate::progressive::render_passes(scene, rays, settings, &run, budget, progress)
+    let run = |pass: &Job| Ok(render_job(scene, rays, pass, engine, &NoProgress));
+    crate::progressive::render_passes(scene, rays, &job, &run, budget, progress)
 }

@@ -7,6 +7,8 @@ use std::path::{Path, PathBuf};
 
 /// Everything that can go wrong before or while rendering, caused by input.
 #[derive(Debug)]
+// Each variant's doc names and explains its fields.
+#[allow(missing_docs)]
 pub enum Error {
     /// A file could not be read at all.
     Io { path: PathBuf, message: String },

@@ -20,8 +20,54 @@ pub struct Terms {
     pub indirect: Vec3,
 }
 
-/// Layer names in EXR order (beauty is the unnamed default layer).
-pub const TERM_NAMES: [&str; 5] = ["emitted", "direct", "specular", "caustic", "indirect"];
+/// One of the five terms a film keeps apart, in EXR layer order. Every engine routes what it
+/// finds to one of these; [`Terms`] holds one value per term.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Term {
+    /// Emission seen directly by the camera.
+    Emitted,
+    /// Direct light at the first non-specular hit.
+    Direct,
+    /// Everything seen through mirrors and glass, and the glossy lobe's reflection.
+    Specular,
+    /// The caustic map's estimate at the first non-specular hit.
+    Caustic,
+    /// Indirect diffuse light at the first non-specular hit.
+    Indirect,
+}
+
+impl Term {
+    /// Every term, in EXR layer order.
+    pub const ALL: [Term; 5] = [Term::Emitted, Term::Direct, Term::Specular, Term::Caustic, Term::Indirect];
+
+    /// The term's EXR layer name.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Term::Emitted => "emitted",
+            Term::Direct => "direct",
+            Term::Specular => "specular",
+            Term::Caustic => "caustic",
+            Term::Indirect => "indirect",
+        }
+    }
+
+    /// Where a camera path's findings of this term go: the term itself, or [`Term::Specular`]
+    /// once the path has gone through a mirror or glass.
+    #[must_use]
+    pub fn seen(self, through_specular: bool) -> Term {
+        if through_specular {
+            Term::Specular
+        } else {
+            self
+        }
+    }
+}
+
+/// Layer names in EXR order (beauty is the unnamed default layer): [`Term::name`] of [`Term::ALL`].
+pub const TERM_NAMES: [&str; 5] =
+    [Term::Emitted.name(), Term::Direct.name(), Term::Specular.name(), Term::Caustic.name(), Term::Indirect.name()];
 
 impl Terms {
     /// Sum of all terms.
@@ -29,10 +75,31 @@ impl Terms {
     pub fn beauty(&self) -> Vec3 {
         self.emitted + self.direct + self.specular + self.caustic + self.indirect
     }
-    /// The terms as an array, in [`TERM_NAMES`] order.
+    /// The terms as an array, in [`Term::ALL`] order.
     #[must_use]
     pub fn as_array(&self) -> [Vec3; 5] {
-        [self.emitted, self.direct, self.specular, self.caustic, self.indirect]
+        Term::ALL.map(|t| self.get(t))
+    }
+    /// The value of term `t`.
+    #[must_use]
+    pub fn get(&self, t: Term) -> Vec3 {
+        match t {
+            Term::Emitted => self.emitted,
+            Term::Direct => self.direct,
+            Term::Specular => self.specular,
+            Term::Caustic => self.caustic,
+            Term::Indirect => self.indirect,
+        }
+    }
+    /// Adds `v` to term `t`.
+    pub fn add(&mut self, t: Term, v: Vec3) {
+        match t {
+            Term::Emitted => self.emitted += v,
+            Term::Direct => self.direct += v,
+            Term::Specular => self.specular += v,
+            Term::Caustic => self.caustic += v,
+            Term::Indirect => self.indirect += v,
+        }
     }
     /// True if every component is finite.
     #[must_use]
@@ -131,8 +198,8 @@ impl Film {
     #[must_use]
     pub fn layers(&self) -> Vec<(String, Vec<Vec3>)> {
         let mut layers = vec![(String::new(), self.beauty())];
-        for (i, name) in TERM_NAMES.iter().enumerate() {
-            layers.push((name.to_string(), self.pixels.iter().map(|t| t.as_array()[i]).collect()));
+        for term in Term::ALL {
+            layers.push((term.name().to_string(), self.pixels.iter().map(|t| t.get(term)).collect()));
         }
         layers
     }

@@ -7,7 +7,7 @@ use crate::geometry::bvh::TriangleColumns;
 use crate::geometry::packet::closest_packets;
 use crate::geometry::traverse::closest_rays;
 use crate::geometry::{in_range, Bvh, RayQuery};
-use crate::reference::NoProgress;
+use crate::progress::NoProgress;
 use crate::scene::file::load_scene;
 use crate::settings::Settings;
 use glam::Vec3;

@@ -3,12 +3,52 @@
 //! Reflected radiance splits into four terms, each computed the way that suits it: direct light
 //! (light sampling with shadow rays), specular and glossy reflection (ray tracing), caustics
 //! (caustic photon map) and soft indirect light (final gather over the global photon map).
-//! [`reference`] is the scalar, one-ray-at-a-time renderer that every faster engine is tested
-//! against.
+//!
+//! # Module map, in layer order
+//! Each module imports only from the modules above it (`python3 ../shared/tools/layers.py src`
+//! prints any cycle).
+//!
+//! **Leaves** — no physics, no scene:
+//! - [`error`]: the crate's error type, naming the file, line or setting at fault;
+//! - [`rng`]: counter-based random streams keyed by (seed, domain, index);
+//! - [`sampling`]: warps of uniform numbers (hemispheres, discrete distributions);
+//! - [`parallel`]: deterministic chunked work sharing on a persistent pool;
+//! - [`progress`]: the progress-reporting trait;
+//! - [`files`]: checked reads, atomic writes and output checks;
+//! - [`memory`]: the memory a render needs against what the machine has;
+//! - [`kernels`]: the SIMD-or-scalar choice for traversal and photon lookups;
+//! - [`geometry`]: triangles, the BVH, single-ray and 8-wide packet traversal;
+//!
+//! **Data** — records and their own methods:
+//! - [`material`]: BSDFs (Lambert, glossy Phong, mirror, glass) and Fresnel;
+//! - [`photon_map`]: the 20-byte photon, the kd-tree, k-NN and fixed-radius density estimates;
+//! - [`settings`]: the user's knobs and their validation;
+//! - [`plan`] and [`effects`]: the effects plan — which terms and machinery a scene needs, and why;
+//! - [`film`]: the five [`film::Term`]s per pixel, EXR and PNG output;
+//! - [`stats`]: plain records of what a render did (rays, times, maps, numerics);
+//! - [`scene`]: OBJ/MTL and TOML loading, lights, the camera;
+//! - [`job`]: one render's validated settings, plan and pass (seed, progressive radii);
+//!
+//! **Physics** — written once:
+//! - [`transport`]: every vertex both engines and the path tracer share — camera samples,
+//!   photon emission, deposit and scattering, direct light, gather and glossy rays, the
+//!   specular continuation, density estimates, the random-stream layout;
+//!
+//! **Engines** — loops over the transport core:
+//! - [`reference`]: the scalar oracle, one ray at a time, that every fast path is tested against;
+//! - [`wavefront`]: bevy_ecs systems over structure-of-arrays queues, SIMD packets;
+//! - [`path`]: an unbiased path tracer for checking energy;
+//!
+//! **Drivers and tools**:
+//! - [`progressive`]: progressive passes with shrinking radii and a time budget;
+//! - [`engine`]: the one render entry point — a single render or progressive passes;
+//! - [`compare`], [`sweep`], [`plot`], [`bench`], [`fuzzing`]: the CLI's `compare`, `sweep`,
+//!   `bench` and the fuzz targets' entry points.
 
 // `!(x > 0.0)` is used on purpose throughout: unlike `x <= 0.0` it is also true for NaN, so a
 // NaN value is rejected by the same test as a non-positive one.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![warn(missing_docs)]
 
 pub mod bench;
 pub mod compare;
@@ -19,12 +59,16 @@ pub mod files;
 pub mod film;
 pub mod fuzzing;
 pub mod geometry;
+pub mod job;
 pub mod kernels;
 pub mod material;
 pub mod memory;
+pub mod parallel;
+pub mod path;
 pub mod photon_map;
 pub mod plan;
 pub mod plot;
+pub mod progress;
 pub mod progressive;
 pub mod reference;
 pub mod rng;
@@ -33,6 +77,7 @@ pub mod scene;
 pub mod settings;
 pub mod stats;
 pub mod sweep;
+pub mod transport;
 pub mod wavefront;
 
 pub use error::{Error, Result};

@@ -22,6 +22,8 @@ pub enum Transport {
 
 /// The scattering part of a material.
 #[derive(Clone, Copy, Debug, PartialEq)]
+// Each variant's doc names and explains its fields.
+#[allow(missing_docs)]
 pub enum Bsdf {
     /// Lambertian reflection with albedo `kd`.
     Lambert { kd: Vec3 },

@@ -9,23 +9,31 @@
 //! so that bias (∝ r²) and variance (∝ 1/(N·r²) per pass, averaged over N passes) both vanish:
 //! the mean squared error falls as N^(−2/3) for α = 2/3 and the RMSE as N^(−1/3). No statistic is
 //! carried between passes, so memory stays at one pass's photon maps. The caustic and the global
-//! map each have their own radius sequence; the first radii are the median distance to the k-th
-//! nearest photon (`caustic_k`, `k`) over up to [`RADIUS_SAMPLES`] of the first pass's own
-//! photons, so that `k` keeps its meaning as the blur of the first pass.
+//! map each have their own radius sequence. The first radii come from a pilot photon pass with
+//! its own seed ([`pilot_seed`], independent of every pass's photons): per map, the median
+//! distance to the k-th nearest photon (`caustic_k`, `k`) over up to [`RADIUS_SAMPLES`] pilot
+//! photons, so that `k` keeps its meaning as the blur of the first pass; and with
+//! `per_pixel_radii` (the default) each pixel's own, the k-th-neighbour distance at the pixel's
+//! first non-specular point ([`pixel_radii`]), scaled by the same sequence.
 //!
-//! Not done: radii per pixel (SPPM's per-visible-point statistics). Each map has one radius per
-//! pass here, which the probabilistic analysis covers but which blurs sparse regions as much as
-//! dense ones.
+//! The driver ([`render_passes`]) takes a closure that renders one pass of a [`Job`], so it
+//! knows nothing of the engines; it owns the time budget ([`Budget`]).
 
 use crate::error::Result;
 use crate::film::{Film, Terms};
+use crate::job::{FixedRadii, Job, Pass, PixelRadii};
 use crate::kernels::KernelSet;
-use crate::photon_map::{flags, Filter, Lookup, PhotonMap};
-use crate::reference::{build_maps, Progress};
+use crate::parallel::map_chunks;
+use crate::photon_map::{flags, Filter, Kernel, Lookup, PhotonMap};
+use crate::progress::Progress;
+use crate::reference::build_job_maps;
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
-use crate::settings::{FixedRadii, PixelRadii, Settings};
+use crate::settings::Settings;
 use crate::stats::RenderStats;
+use crate::transport::camera::camera_sample;
+use crate::transport::specular::first_non_specular;
+use crate::transport::{streams, Context, PhotonMaps};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -77,7 +85,7 @@ pub fn median_knn_radius(map: &PhotonMap, k: u32, r_max: f32, kernels: KernelSet
                 p: p.position,
                 k: k as usize,
                 r_max,
-                kernel: crate::settings::Kernel::Box,
+                kernel: Kernel::Box,
                 filter: Filter { n: p.normal, flags_mask: 0 },
             };
             map.nearest(kernels, &q, &mut scratch);
@@ -101,21 +109,22 @@ pub fn pilot_seed(seed: u64) -> u64 {
 /// median k-th-neighbour distance over the pilot's photons (the maximum radius where a map is
 /// empty or too sparse); with `per_pixel_radii`, each pixel's own as well ([`pixel_radii`]).
 #[must_use]
-pub fn initial_radii(scene: &Scene, rays: &CameraRays, settings: &Settings) -> FixedRadii {
+pub fn initial_radii(scene: &Scene, rays: &CameraRays, job: &Job) -> FixedRadii {
+    let settings = &job.settings;
     let d = scene.diagonal();
     let (r_global, r_caustic) = (settings.global_radius * d, settings.caustic_radius * d);
-    let pilot = Settings {
-        fixed_radii: None,
-        precompute_irradiance: false,
-        seed: pilot_seed(settings.seed),
-        ..settings.clone()
+    let pilot = Job {
+        settings: Settings { precompute_irradiance: false, ..settings.clone() },
+        pass: Pass { seed: pilot_seed(settings.seed), radii: None },
+        ..job.clone()
     };
-    let (maps, _, _) = build_maps(scene, &pilot);
+    let (maps, _, _) = build_job_maps(scene, &pilot);
     let uniform = FixedRadii::uniform(
         median_knn_radius(&maps.global, settings.k, r_global, settings.kernels).unwrap_or(r_global),
         median_knn_radius(&maps.caustic, settings.caustic_k, r_caustic, settings.kernels).unwrap_or(r_caustic),
     );
-    let pixels = settings.per_pixel_radii.then(|| Arc::new(pixel_radii(scene, rays, settings, &maps, &uniform)));
+    let first = Job { pass: Pass { seed: settings.seed, radii: None }, ..job.clone() };
+    let pixels = settings.per_pixel_radii.then(|| Arc::new(pixel_radii(scene, rays, &first, &maps, &uniform)));
     FixedRadii { pixels, ..uniform }
 }
 
@@ -130,12 +139,12 @@ pub fn initial_radii(scene: &Scene, rays: &CameraRays, settings: &Settings) -> F
 pub fn pixel_radii(
     scene: &Scene,
     rays: &CameraRays,
-    settings: &Settings,
-    maps: &crate::reference::PhotonMaps,
+    job: &Job,
+    maps: &PhotonMaps,
     fallback: &FixedRadii,
 ) -> PixelRadii {
-    use crate::reference::camera::{camera_sample, first_non_specular, Context};
-    let ctx = Context::new(scene, maps, settings);
+    let settings = &job.settings;
+    let ctx = Context::new(scene, maps, job);
     let w = settings.width as usize;
     let pixels = w * settings.height as usize;
     let want_global = ctx.effects.global_map.on && !ctx.effects.final_gather.on;
@@ -148,18 +157,19 @@ pub fn pixel_radii(
             r_max
         }
     };
-    let chunks = crate::reference::parallel::map_chunks(
+    let chunks = map_chunks(
         pixels,
         256,
-        settings.thread_count(),
+        job.threads,
         |range| {
             let mut scratch = Vec::new();
             let mut counts = crate::stats::RayCounts::default();
             range
                 .map(|pixel| {
-                    let (sampler, (fx, fy)) = camera_sample(settings, pixel as u64 * u64::from(settings.spp));
+                    let (sampler, (fx, fy)) = camera_sample(job, pixel as u64 * u64::from(settings.spp));
                     let (o, d) = rays.ray((pixel % w) as f32 + fx, (pixel / w) as f32 + fy);
-                    let Some((sp, d, _)) = first_non_specular(&ctx, o, d, &sampler, 1, &mut counts) else {
+                    let chain = streams::CAMERA_CHAIN_BOUNCE;
+                    let Some((sp, d, _)) = first_non_specular(&ctx, o, d, &sampler, chain, &mut counts) else {
                         return (fallback.global, fallback.caustic);
                     };
                     let (ng, _) = sp.frame.oriented(-d);
@@ -201,7 +211,7 @@ fn percentiles(values: &[f32]) -> Option<[f32; 3]> {
 /// A progressive render in progress: call [`Progressive::step`] for each pass, read the mean
 /// with [`Progressive::image`].
 pub struct Progressive {
-    settings: Settings,
+    job: Job,
     first: FixedRadii,
     /// r² of the next pass over r² of the first ([`radius2_scale`], kept as a running product).
     scale2: f64,
@@ -213,12 +223,13 @@ pub struct Progressive {
 }
 
 impl Progressive {
-    /// Prepares a progressive render of `scene` seen through `rays` with `settings` (spp and
-    /// photon counts per pass): finds the first radii.
-    pub fn new(scene: &Scene, rays: &CameraRays, settings: &Settings) -> Result<Self> {
-        settings.validate()?;
+    /// Prepares a progressive render of `scene` seen through `rays` as `job` says (its settings
+    /// hold spp and photon counts per pass): finds the first radii.
+    #[must_use]
+    pub fn new(scene: &Scene, rays: &CameraRays, job: &Job) -> Self {
+        let settings = &job.settings;
         let t = Instant::now();
-        let first = initial_radii(scene, rays, settings);
+        let first = initial_radii(scene, rays, job);
         let pixel = first.pixels.as_deref();
         let progress = ProgressiveStats {
             alpha: settings.alpha,
@@ -228,14 +239,14 @@ impl Progressive {
             pilot_seconds: t.elapsed().as_secs_f64(),
             ..Default::default()
         };
-        Ok(Progressive {
-            settings: settings.clone(),
+        Progressive {
+            job: job.clone(),
             first,
             scale2: 1.0,
             sum: vec![Terms::default(); settings.width as usize * settings.height as usize],
             stats: RenderStats::default(),
             progress,
-        })
+        }
     }
 
     /// The radii of the next pass.
@@ -256,14 +267,13 @@ impl Progressive {
         self.progress.passes
     }
 
-    /// Renders the next pass with `engine` (given the pass's settings) and adds it to the mean.
-    pub fn step(&mut self, engine: &dyn Fn(&Settings) -> Result<(Film, RenderStats)>) -> Result<()> {
+    /// Renders the next pass with `engine` (given the pass's job) and adds it to the mean.
+    pub fn step(&mut self, engine: &dyn Fn(&Job) -> Result<(Film, RenderStats)>) -> Result<()> {
         let t = Instant::now();
         let i = self.progress.passes;
         let radii = self.next_radii();
         let final_radii = [radii.global, radii.caustic];
-        let pass =
-            Settings { seed: pass_seed(self.settings.seed, i), fixed_radii: Some(radii), ..self.settings.clone() };
+        let pass = self.job.with_pass(Pass { seed: pass_seed(self.job.settings.seed, i), radii: Some(radii) })?;
         let (film, stats) = engine(&pass)?;
         for (s, p) in self.sum.iter_mut().zip(&film.pixels) {
             *s += *p;
@@ -286,12 +296,11 @@ impl Progressive {
         if let (Some(s), Some(o)) = (stats.stages.as_mut(), old.stages.as_ref()) {
             *s += o;
         }
-        stats.seed = self.settings.seed;
         self.stats = stats;
         self.progress.passes += 1;
         // Pass i + 1 (1-based) done: r²ᵢ₊₂ = r²ᵢ₊₁ · (i + 1 + α)/(i + 2).
         let j = f64::from(self.progress.passes);
-        self.scale2 *= (j + f64::from(self.settings.alpha)) / (j + 1.0);
+        self.scale2 *= (j + f64::from(self.job.settings.alpha)) / (j + 1.0);
         self.progress.final_radii = final_radii;
         self.progress.pass_seconds.push(t.elapsed().as_secs_f64());
         Ok(())
@@ -302,8 +311,8 @@ impl Progressive {
     pub fn image(&self) -> Film {
         let n = self.progress.passes.max(1) as f32;
         Film {
-            width: self.settings.width,
-            height: self.settings.height,
+            width: self.job.settings.width,
+            height: self.job.settings.height,
             pixels: self.sum.iter().map(|t| *t * (1.0 / n)).collect(),
         }
     }
@@ -377,20 +386,22 @@ pub fn budget_warning(p: &ProgressiveStats) -> Option<String> {
     })
 }
 
-/// Progressive passes, each rendered by `run` with that pass's settings (`settings` per pass),
-/// until `settings.passes` or, with a budget, until the budget is spent ([`Progressive::another_fits`]). `progress` gets one bar:
-/// passes, or the budget's milliseconds, with the pass number and time left as its message.
+/// Progressive passes of `job` (its settings per pass), each rendered by `run` given the pass's
+/// job, until `settings.passes` or, with a budget, until the budget is spent
+/// ([`Progressive::another_fits`]). `progress` gets one bar: passes, or the budget's
+/// milliseconds, with the pass number and time left as its message.
 pub fn render_passes(
     scene: &Arc<Scene>,
     rays: &CameraRays,
-    settings: &Settings,
-    run: &dyn Fn(&Settings) -> Result<(Film, RenderStats)>,
+    job: &Job,
+    run: &dyn Fn(&Job) -> Result<(Film, RenderStats)>,
     budget: Option<Budget>,
     progress: &dyn Progress,
 ) -> Result<(Film, RenderStats)> {
+    let settings = &job.settings;
     let t = Instant::now();
     let start = budget.map_or(t, |b| b.start);
-    let mut p = Progressive::new(scene, rays, settings)?;
+    let mut p = Progressive::new(scene, rays, job);
     let total = budget.map_or(u64::from(settings.passes), |b| b.limit.as_millis() as u64);
     progress.start(if budget.is_some() { "ms of budget" } else { "passes" }, total);
     let mut shown = 0u64;

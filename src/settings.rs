@@ -105,60 +105,6 @@ pub struct Settings {
     /// thinner than the search radius (scenes/hard/thin-wall.toml), at a cost measured in
     /// BENCHMARKS.md. Off by default.
     pub visibility: bool,
-    /// Set by the progressive driver for one pass: estimate every photon within these radii
-    /// (scene units) instead of the k nearest. Not a user setting.
-    #[serde(skip)]
-    pub fixed_radii: Option<FixedRadii>,
-}
-
-/// Fixed density-estimation radii of one progressive pass, in scene units.
-#[derive(Clone, Debug, PartialEq)]
-pub struct FixedRadii {
-    /// Global map (and the irradiance precomputed from it).
-    pub global: f32,
-    /// Caustic map.
-    pub caustic: f32,
-    /// Per-pixel radii for the estimates at camera paths' first non-specular hits: each pixel's
-    /// first radius, times `scale`. `None`: `global` and `caustic` everywhere.
-    pub pixels: Option<std::sync::Arc<PixelRadii>>,
-    /// This pass's radius over the first pass's (√ of ∏ (j+α)/(j+1)).
-    pub scale: f32,
-}
-
-/// The first progressive pass's radii per pixel (row-major), in scene units.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct PixelRadii {
-    /// Global-map radius per pixel (used where the global map is read at the first hit, i.e.
-    /// with final gathering off; empty otherwise).
-    pub global: Vec<f32>,
-    /// Caustic-map radius per pixel.
-    pub caustic: Vec<f32>,
-}
-
-impl FixedRadii {
-    /// The same radius everywhere.
-    #[must_use]
-    pub fn uniform(global: f32, caustic: f32) -> Self {
-        FixedRadii { global, caustic, pixels: None, scale: 1.0 }
-    }
-
-    /// The caustic radius at `pixel`'s camera paths (`None`: anywhere else).
-    #[must_use]
-    pub fn caustic_at(&self, pixel: Option<usize>) -> f32 {
-        match (&self.pixels, pixel) {
-            (Some(p), Some(i)) if i < p.caustic.len() => p.caustic[i] * self.scale,
-            _ => self.caustic,
-        }
-    }
-
-    /// The global radius at `pixel`'s camera paths (`None`: anywhere else).
-    #[must_use]
-    pub fn global_at(&self, pixel: Option<usize>) -> f32 {
-        match (&self.pixels, pixel) {
-            (Some(p), Some(i)) if i < p.global.len() => p.global[i] * self.scale,
-            _ => self.global,
-        }
-    }
 }
 
 impl Default for Settings {
@@ -187,7 +133,6 @@ impl Default for Settings {
             alpha: 2.0 / 3.0,
             per_pixel_radii: true,
             visibility: false,
-            fixed_radii: None,
         }
     }
 }
@@ -273,12 +218,6 @@ impl Settings {
         }
         if !(self.alpha > 0.0 && self.alpha < 1.0) {
             return err("alpha", "must be in (0, 1) (2/3 is the usual choice)");
-        }
-        if let Some(r) = &self.fixed_radii {
-            let ok = |v: f32| v > 0.0 && v.is_finite();
-            if !(ok(r.global) && ok(r.caustic) && ok(r.scale)) {
-                return err("fixed_radii", "progressive radii must be positive and finite");
-            }
         }
         if self.threads > 1024 {
             return err("threads", "at most 1024");

@@ -203,6 +203,14 @@ impl RenderStats {
         }
     }
 
+    /// Records which maps the plan builds and why.
+    pub fn record_plan(&mut self, plan: &crate::plan::Effects) {
+        self.global_map.built = plan.global_map.on;
+        self.global_map.reason = plan.global_map.reason.clone();
+        self.caustic_map.built = plan.caustic_map.on;
+        self.caustic_map.reason = plan.caustic_map.reason.clone();
+    }
+
     /// A human-readable summary (without the per-system table: [`RenderStats::stage_summary`]).
     #[must_use]
     pub fn summary(&self) -> String {

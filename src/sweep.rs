@@ -14,8 +14,8 @@ use crate::engine::{Budget, Engine};
 use crate::error::{Error, Result};
 use crate::film::ExrLayers;
 use crate::plot::{Figure, Line, PointGroup};
+use crate::progress::{NoProgress, Progress};
 use crate::progressive::{per_pass, PerPass};
-use crate::reference::Progress;
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::Settings;
@@ -246,14 +246,7 @@ impl Sweep {
                 });
                 let start = Instant::now();
                 let budget = limit.map(|limit| Budget { limit, start });
-                let (film, stats) = crate::engine::render(
-                    scene,
-                    rays,
-                    &c.settings,
-                    self.engine,
-                    budget,
-                    &crate::reference::NoProgress,
-                )?;
+                let (film, stats) = crate::engine::render(scene, rays, &c.settings, self.engine, budget, &NoProgress)?;
                 let seconds = start.elapsed().as_secs_f64();
                 rows.push(Row {
                     config: i,

@@ -8,12 +8,14 @@ use glam::Vec3;
 use photonwave::kernels::KernelSet;
 use photonwave::material::{Bsdf, Material, SurfaceFrame};
 use photonwave::photon_map::{Filter, Lookup, Photon, PhotonMap, Reflectance};
-use photonwave::reference::camera::{direct_light, Context};
-use photonwave::reference::photons::{first_hit_power, trace_photons};
-use photonwave::reference::{NoProgress, PhotonMaps};
+use photonwave::progress::NoProgress;
+use photonwave::reference::photons::trace_photons;
 use photonwave::rng::{Domain, Sampler};
 use photonwave::scene::{Light, MeshInput, Scene, SurfacePoint};
 use photonwave::settings::{Kernel, Settings};
+use photonwave::transport::direct::direct_light;
+use photonwave::transport::photon::first_hit_power;
+use photonwave::transport::{Context, PhotonMaps};
 
 /// Furnace: Le = 1, albedo a = 0.5 (scenes/furnace.toml).
 const LE: f64 = 1.0;
@@ -70,7 +72,13 @@ fn first_hit_photon_power_sums_to_light_power() {
     // In a closed sphere every emitted photon lands; each carries Φ/N, so the first hits sum to Φ.
     let loaded = load("furnace.toml");
     let s = Settings::default();
-    let pass = trace_photons(&loaded.scene, &s, Domain::GlobalPhoton, 20_000, 1, &NoProgress);
+    let pass = trace_photons(
+        &loaded.scene,
+        &job(&loaded.scene, &Settings { threads: 1, ..s.clone() }),
+        Domain::GlobalPhoton,
+        20_000,
+        &NoProgress,
+    );
     let got = first_hit_power(&pass.photons);
     let want = loaded.scene.total_power();
     assert!(((got - want) / want).abs().max_element() < 1e-4, "{got} vs {want}");
@@ -109,7 +117,13 @@ fn spot_light_flux_is_conserved_in_a_closed_box() {
         cos_outer: 40f32.to_radians().cos(),
     };
     let scene = Scene::build(vec![closed_cube(1.0)], vec![mat], vec![spot], vec![]).unwrap();
-    let pass = trace_photons(&scene, &Settings::default(), Domain::GlobalPhoton, 16_384, 1, &NoProgress);
+    let pass = trace_photons(
+        &scene,
+        &job(&scene, &Settings { threads: 1, ..Settings::default().clone() }),
+        Domain::GlobalPhoton,
+        16_384,
+        &NoProgress,
+    );
     let got = first_hit_power(&pass.photons);
     let want = scene.total_power();
     // Per-photon weight w = falloff/E[falloff]: w ∈ [0, 1/E], E[falloff] = 0.51 here, so the
@@ -204,7 +218,8 @@ fn quad_light_irradiance_matches_lamberts_formula() {
     let scene = Scene::build(vec![mesh], vec![light], vec![], vec![]).unwrap();
     let settings = Settings { light_samples: 256, ..Default::default() };
     let maps = PhotonMaps::default();
-    let ctx = Context::new(&scene, &maps, &settings);
+    let job = job(&scene, &settings);
+    let ctx = Context::new(&scene, &maps, &job);
     let white = Bsdf::Lambert { kd: Vec3::ONE };
     for p in [Vec3::ZERO, Vec3::new(0.7, 0.0, 0.3), Vec3::new(2.0, 0.3, -1.0)] {
         let sp = SurfacePoint {
@@ -236,7 +251,8 @@ fn point_light_irradiance_is_inverse_square_cosine() {
     let scene = Scene::build(vec![mesh], vec![mat], vec![light], vec![]).unwrap();
     let settings = Settings::default();
     let maps = PhotonMaps::default();
-    let ctx = Context::new(&scene, &maps, &settings);
+    let job = job(&scene, &settings);
+    let ctx = Context::new(&scene, &maps, &job);
     let p = Vec3::new(1.5, 0.0, 0.0);
     let sp =
         SurfacePoint { p, p_error: Vec3::ZERO, frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y }, material: 0, tri: 0 };
@@ -285,11 +301,19 @@ fn directional_light_irradiance_is_cosine_weighted_by_both_methods() {
         let settings = Settings { photons: 400_000, max_depth: 1, ..Default::default() };
         let maps = PhotonMaps {
             global: PhotonMap::build(
-                trace_photons(&scene, &settings, Domain::GlobalPhoton, 400_000, 2, &NoProgress).photons,
+                trace_photons(
+                    &scene,
+                    &job(&scene, &Settings { threads: 2, ..settings.clone() }),
+                    Domain::GlobalPhoton,
+                    400_000,
+                    &NoProgress,
+                )
+                .photons,
             ),
             ..Default::default()
         };
-        let ctx = Context::new(&scene, &maps, &settings);
+        let job = job(&scene, &settings);
+        let ctx = Context::new(&scene, &maps, &job);
         let mut scratch = Vec::new();
         let mut photon_sum = 0.0;
         for i in 0..8 {

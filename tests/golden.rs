@@ -12,7 +12,7 @@ mod common;
 use common::*;
 use photonwave::engine::{render, Engine};
 use photonwave::film::Film;
-use photonwave::reference::NoProgress;
+use photonwave::progress::NoProgress;
 use photonwave::settings::Settings;
 use std::sync::Arc;
 

@@ -4,7 +4,7 @@ mod common;
 
 use glam::Vec3;
 use photonwave::engine::{render, Engine};
-use photonwave::reference::NoProgress;
+use photonwave::progress::NoProgress;
 use photonwave::scene::file::{load_scene, LoadedScene};
 use photonwave::settings::Settings;
 use std::path::PathBuf;
@@ -44,7 +44,7 @@ fn thin_wall_lets_nothing_through() {
     let mut lit = dark;
     (lit.eye, lit.target) = (Vec3::new(-0.95, 0.5, 0.0), Vec3::new(0.0, 0.5, 0.0));
     // Photons: none in the dark half; on the wall itself only on its lit face (normal toward −x).
-    let (maps, stats, _) = photonwave::reference::build_maps(&scene, &base);
+    let (maps, stats, _) = photonwave::reference::build_maps(&scene, &base).unwrap();
     assert!(stats.stored >= 20_000);
     for i in 0..maps.global.len() {
         let p = maps.global.photon(i);
@@ -98,7 +98,7 @@ fn grazing_light_follows_the_cosine_law() {
                 assert_eq!(t.indirect + t.caustic + t.specular, Vec3::ZERO, "{deg}°, {engine:?}, pixel {i}");
             }
         }
-        let (reference, _, _) = photonwave::reference::build_maps(&scene, &s);
+        let (reference, _, _) = photonwave::reference::build_maps(&scene, &s).unwrap();
         let (wavefront, _) = photonwave::wavefront::build_maps(scene.clone(), &s).unwrap();
         for (name, map) in [("reference", &reference.global), ("wavefront", &wavefront.global)] {
             let q = Lookup {
@@ -172,7 +172,7 @@ fn light_inside_glass_reaches_the_walls_only_as_caustics() {
     }
     let r = 0.6f32;
     let expected = 2.0 / (r * r) * (1.0 - 1.0 / (1.0 + r * r).sqrt());
-    let (reference, _, _) = photonwave::reference::build_maps(&scene, &s);
+    let (reference, _, _) = photonwave::reference::build_maps(&scene, &s).unwrap();
     let (wavefront, _) = photonwave::wavefront::build_maps(scene.clone(), &s).unwrap();
     for (name, map) in [("reference", &reference.caustic), ("wavefront", &wavefront.caustic)] {
         for (wall, p, n) in [("back", -Vec3::Z, Vec3::Z), ("floor", -Vec3::Y, Vec3::Y)] {
@@ -222,9 +222,10 @@ fn scale_changes_nothing() {
             .collect();
     let (unit, rest) = scenes.split_first().unwrap();
     for domain in [Domain::GlobalPhoton, Domain::CausticPhoton] {
-        let a = trace_photons(&unit.2, &s, domain, 20_000, 2, &NoProgress);
+        let s = Settings { threads: 2, ..s.clone() };
+        let a = trace_photons(&unit.2, &common::job(&unit.2, &s), domain, 20_000, &NoProgress);
         for (label, _, scene, _) in rest {
-            let b = trace_photons(scene, &s, domain, 20_000, 2, &NoProgress);
+            let b = trace_photons(scene, &common::job(scene, &s), domain, 20_000, &NoProgress);
             assert_eq!(a.photons.len(), b.photons.len(), "{domain:?}, scale {label}");
             let (da, db) = (unit.2.diagonal(), scene.diagonal());
             for (i, (p, q)) in a.photons.iter().zip(&b.photons).enumerate() {
@@ -280,8 +281,8 @@ fn scale_changes_nothing() {
 fn both_maps(
     scene: &Arc<photonwave::scene::Scene>,
     s: &Settings,
-) -> [(&'static str, photonwave::reference::PhotonMaps); 2] {
-    let (reference, _, _) = photonwave::reference::build_maps(scene, s);
+) -> [(&'static str, photonwave::transport::PhotonMaps); 2] {
+    let (reference, _, _) = photonwave::reference::build_maps(scene, s).unwrap();
     let (wavefront, _) = photonwave::wavefront::build_maps(scene.clone(), s).unwrap();
     [("reference", reference), ("wavefront", wavefront)]
 }
@@ -408,12 +409,13 @@ fn furnace_objects(name: &str) -> Vec<(String, f64)> {
         gather_rays: 16,
         ..Default::default()
     };
-    let path = photonwave::reference::path::render_path_traced(
+    let path = photonwave::path::render_path_traced(
         &scene,
         &rays,
         &Settings { spp: 512, max_depth: 64, ..s.clone() },
         &NoProgress,
     )
+    .unwrap()
     .0;
     let regions = |film: &photonwave::film::Film| -> Vec<(String, f64, f64)> {
         let grey = common::grey(film);

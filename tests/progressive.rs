@@ -5,8 +5,9 @@ mod common;
 
 use common::load;
 use photonwave::film::Film;
+use photonwave::job::{FixedRadii, Job, Pass, PixelRadii};
+use photonwave::progress::NoProgress;
 use photonwave::progressive::{radius2_scale, Progressive};
-use photonwave::reference::NoProgress;
 use photonwave::scene::camera::CameraRays;
 use photonwave::scene::Scene;
 use photonwave::settings::Settings;
@@ -42,8 +43,8 @@ fn progressive(
     passes: u32,
     mut at: impl FnMut(u32, Film),
 ) {
-    let mut p = Progressive::new(scene, cam, settings).unwrap();
-    let engine = |s: &Settings| photonwave::wavefront::render(scene.clone(), cam, s, &NoProgress);
+    let mut p = Progressive::new(scene, cam, &common::job(scene, settings));
+    let engine = |job: &Job| Ok(photonwave::wavefront::render_job(scene.clone(), cam, job, &NoProgress));
     for _ in 0..passes {
         p.step(&engine).unwrap();
         at(p.passes(), p.image());
@@ -247,9 +248,10 @@ fn cli_preset_reference_renders_progressive_passes() {
     assert!(err.contains("progressive: 2 passes, each 1 spp, 12500 global photons + 6250 caustic photons"), "{err}");
 }
 
-/// Settings of one fixed-radius pass of the small spheres scene with the given radii.
-fn fixed_pass(radii: photonwave::settings::FixedRadii) -> Settings {
-    Settings { fixed_radii: Some(radii), final_gather: false, ..small(11) }
+/// One fixed-radius pass of the small spheres scene with the given radii.
+fn fixed_pass(scene: &Scene, radii: FixedRadii) -> Job {
+    let job = common::job(scene, &Settings { final_gather: false, ..small(11) });
+    job.with_pass(Pass { seed: job.settings.seed, radii: Some(radii) }).unwrap()
 }
 
 /// Per-pixel radii reach the estimates pixel by pixel, in both engines: radii equal to the
@@ -257,8 +259,7 @@ fn fixed_pass(radii: photonwave::settings::FixedRadii) -> Settings {
 /// pixel's caustic and (final gathering off) indirect terms and no other pixel.
 #[test]
 fn per_pixel_radii_apply_to_their_own_pixel_only() {
-    use photonwave::engine::{render, Engine};
-    use photonwave::settings::{FixedRadii, PixelRadii};
+    use photonwave::engine::{render_job, Engine};
     let (scene, cam) = spheres();
     let n = 24 * 24;
     let uniform = FixedRadii { scale: 0.8, ..FixedRadii::uniform(0.03, 0.01) };
@@ -269,7 +270,7 @@ fn per_pixel_radii_apply_to_their_own_pixel_only() {
     // Pixel radii are scaled by `scale`; the uniform ones are already this pass's.
     let same = with(vec![0.03 / 0.8; n], vec![0.01 / 0.8; n]);
     for engine in [Engine::Wavefront, Engine::Reference] {
-        let image = |r: FixedRadii| render(&scene, &cam, &fixed_pass(r), engine, None, &NoProgress).unwrap().0;
+        let image = |r: FixedRadii| render_job(&scene, &cam, &fixed_pass(&scene, r), engine, &NoProgress).0;
         let base = image(uniform.clone());
         // The pixel that sees the brightest caustic directly (on the floor under the glass).
         let pixel = (0..n).max_by(|&a, &b| base.pixels[a].caustic.x.total_cmp(&base.pixels[b].caustic.x)).unwrap();
@@ -300,7 +301,7 @@ fn pixel_radii_follow_the_photon_density() {
     let s = Settings { caustic_photons: 20_000, ..small(5) };
     let d = scene.diagonal();
     let r_max = s.caustic_radius * d;
-    let first = initial_radii(&scene, &cam, &s);
+    let first = initial_radii(&scene, &cam, &common::job(&scene, &s));
     let pixels = first.pixels.as_deref().expect("per-pixel radii are on by default");
     assert_eq!((pixels.caustic.len(), pixels.global.len()), (24 * 24, 24 * 24));
     assert!(pixels.caustic.iter().all(|&r| r > 0.0 && r <= r_max));
@@ -313,10 +314,11 @@ fn pixel_radii_follow_the_photon_density() {
 
     // Final gathering reads the global map at gather hits only: no global radii per pixel.
     let gather = Settings { final_gather: true, ..s.clone() };
-    let (maps, _, _) = photonwave::reference::build_maps(&scene, &gather);
-    let uniform = photonwave::settings::FixedRadii::uniform(0.1, 0.1);
-    assert!(pixel_radii(&scene, &cam, &gather, &maps, &uniform).global.is_empty());
-    assert!(initial_radii(&scene, &cam, &Settings { per_pixel_radii: false, ..s }).pixels.is_none());
+    let (maps, _, _) = photonwave::reference::build_maps(&scene, &gather).unwrap();
+    let uniform = FixedRadii::uniform(0.1, 0.1);
+    assert!(pixel_radii(&scene, &cam, &common::job(&scene, &gather), &maps, &uniform).global.is_empty());
+    let uniform_only = common::job(&scene, &Settings { per_pixel_radii: false, ..s });
+    assert!(initial_radii(&scene, &cam, &uniform_only).pixels.is_none());
 }
 
 /// Progressive passes converge to the path tracer's indirect light (caustics included; the path
@@ -340,7 +342,7 @@ fn progressive_indirect_light_matches_the_path_tracer() {
             .unwrap();
     assert_eq!(stats.irradiance_points, 0, "progressive passes must not precompute irradiance");
     let pt =
-        photonwave::reference::path::render_path_traced(&scene, &cam, &Settings { spp: 2048, ..base }, &NoProgress).0;
+        photonwave::path::render_path_traced(&scene, &cam, &Settings { spp: 2048, ..base }, &NoProgress).unwrap().0;
     let grey = |v: glam::Vec3| v.element_sum() / 3.0;
     let pm: Vec<f32> = pm.pixels.iter().map(|t| grey(t.caustic + t.indirect)).collect();
     let pt: Vec<f32> = pt.pixels.iter().map(|t| grey(t.indirect)).collect();

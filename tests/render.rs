@@ -78,7 +78,7 @@ fn maps_are_built_only_where_the_scene_needs_them() {
     let cam = load("cornell-box.toml");
     let c = cam.camera.unwrap().prepare(8, 8).unwrap();
     let s = Settings { width: 8, height: 8, spp: 1, photons: 5_000, ..Default::default() };
-    let (_, stats) = photonwave::reference::render(&cam.scene, &c, &s, &photonwave::reference::NoProgress).unwrap();
+    let (_, stats) = photonwave::reference::render(&cam.scene, &c, &s, &photonwave::progress::NoProgress).unwrap();
     assert!(!stats.caustic_map.built && stats.caustic_map.stored == 0 && stats.caustic_map.emitted == 0);
     assert!(stats.global_map.stored >= 5_000);
 }

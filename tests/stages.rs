@@ -10,13 +10,12 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::system::RunSystemOnce;
 use common::*;
 use glam::Vec3;
-use photonwave::effects::Effects;
-use photonwave::film::Terms;
+use photonwave::film::{Term, Terms};
 use photonwave::photon_map::flags;
 use photonwave::reference::build_maps;
 use photonwave::rng::{Domain, Sampler};
 use photonwave::settings::Settings;
-use photonwave::wavefront::queues::{Classified, HitColumns, PathKind, PathQueue, Segment, ShadowQueue};
+use photonwave::wavefront::queues::{Classified, HitColumns, PathKind, PathQueue, PhotonLane, Segment, ShadowQueue};
 use photonwave::wavefront::*;
 use std::sync::Arc;
 
@@ -35,8 +34,8 @@ fn lanes() -> [(Vec3, Vec3); 5] {
 fn world(settings: Settings) -> World {
     let scene = Arc::new(load("cornell-spheres.toml").scene);
     let mut w = World::new();
-    let effects = Effects::plan(&scene, &settings);
-    w.insert_resource(Shared { scene, settings, effects, threads: 2 });
+    let job = job(&scene, &Settings { threads: 2, ..settings });
+    w.insert_resource(Shared { scene, job });
     w.insert_resource(StageStats::default());
     w
 }
@@ -45,7 +44,14 @@ fn photon_world(domain: Domain) -> World {
     let mut w = world(Settings::default());
     let mut work = PhotonWork { domain: Some(domain), ..Default::default() };
     for (i, (o, d)) in lanes().into_iter().enumerate() {
-        work.queue.push(o, d, 100 + i as u64, 0, Vec3::splat(2.0), true);
+        work.queue.push(PhotonLane {
+            origin: o,
+            dir: d,
+            path: 100 + i as u64,
+            bounce: 0,
+            power: Vec3::splat(2.0),
+            specular_only: true,
+        });
     }
     w.insert_resource(work);
     w
@@ -78,7 +84,7 @@ fn photon_stages_intersect_classify_deposit_scatter() {
     w.run_system_once(photonwave::wavefront::shade::refract_photons).unwrap();
     let next = &w.resource::<PhotonWork>().next;
     assert!(next.bounce.iter().all(|&b| b == 1));
-    assert!(next.specular_only.iter().zip(&next.path).all(|(&s, &p)| (s == 1) == (p == 101 || p == 102)));
+    assert!(next.specular_only.iter().zip(&next.path).all(|(&s, &p)| s == (p == 101 || p == 102)));
     for k in 0..next.len() {
         let d = next.rays.direction(k);
         match next.path[k] {
@@ -111,11 +117,11 @@ fn emit_photons_starts_a_batch_like_the_reference() {
     w.run_system_once(photonwave::wavefront::emit::emit_photons).unwrap();
     let shared = w.resource::<Shared>();
     let q = &w.resource::<PhotonWork>().queue;
-    assert_eq!(q.len(), photonwave::reference::photons::BATCH);
+    assert_eq!(q.len(), photonwave::transport::photon::BATCH);
     for k in [0usize, 777, 16_383] {
-        let p = photonwave::reference::photons::start_photon(
+        let p = photonwave::transport::photon::start_photon(
             &shared.scene,
-            &shared.settings,
+            shared.job.pass.seed,
             Domain::GlobalPhoton,
             q.path[k],
         )
@@ -137,7 +143,7 @@ fn camera_world(segments: &[(usize, PathKind)]) -> World {
     };
     let mut w = world(settings.clone());
     let scene = w.resource::<Shared>().scene.clone();
-    let (maps, _, _) = build_maps(&scene, &settings);
+    let (maps, _, _) = build_maps(&scene, &settings).unwrap();
     w.insert_resource(Maps(Arc::new(maps)));
     let camera = load("cornell-spheres.toml").camera.unwrap().prepare(2, 1).unwrap();
     let mut paths = PathQueue::default();
@@ -145,15 +151,15 @@ fn camera_world(segments: &[(usize, PathKind)]) -> World {
     for (sample, &(lane, kind)) in segments.iter().enumerate() {
         let (o, d) = all[lane];
         paths.push(Segment {
-            o,
-            d,
+            origin: o,
+            dir: d,
             sample: sample as u32,
             kind,
             key: Sampler::new(1, Domain::Camera, sample as u64).key(),
             base: if kind == PathKind::Gather { 0 } else { 1 },
             depth: 0,
             beta: Vec3::ONE,
-            slot: 4,
+            term: Term::Indirect,
             through_specular: false,
         });
     }
@@ -201,7 +207,7 @@ fn diffuse_camera_hits_queue_shadow_rays_gather_rays_and_estimates() {
     w.run_system_once(photonwave::wavefront::shade::shade_direct).unwrap();
     let shadows = w.resource::<CameraWork>().shadows.clone();
     assert_eq!(shadows.len(), 1, "one area-light sample for the camera lane");
-    assert_eq!((shadows.sample[0], shadows.slot[0]), (0, 1));
+    assert_eq!((shadows.sample[0], shadows.term[0]), (0, Term::Direct));
     w.run_system_once(photonwave::wavefront::intersect::trace_shadow_rays).unwrap();
     let work = w.resource::<CameraWork>();
     assert!(work.shadows.is_empty());
@@ -212,7 +218,10 @@ fn diffuse_camera_hits_queue_shadow_rays_gather_rays_and_estimates() {
     assert_eq!(next.len(), 3);
     let kd = Vec3::splat(0.73);
     for k in 0..3 {
-        assert_eq!((next.kind[k], next.sample[k], next.slot[k], next.depth[k]), (PathKind::Gather, 0, 4, 0));
+        assert_eq!(
+            (next.kind[k], next.sample[k], next.term[k], next.depth[k]),
+            (PathKind::Gather, 0, Term::Indirect, 0)
+        );
         assert!((next.beta[k] - kd / 3.0).abs().max_element() < 1e-6 && next.rays.direction(k).y > 0.0);
     }
 }
@@ -224,7 +233,7 @@ fn mirror_hits_continue_through_specular() {
     w.run_system_once(photonwave::wavefront::shade::reflect_paths).unwrap();
     let next = &w.resource::<CameraWork>().next;
     assert_eq!(next.len(), 1);
-    assert_eq!((next.depth[0], next.through_specular[0], next.kind[0]), (1, 1, PathKind::Camera));
+    assert_eq!((next.depth[0], next.through_specular[0], next.kind[0]), (1, true, PathKind::Camera));
     assert!((next.beta[0] - Vec3::splat(0.95)).abs().max_element() < 1e-6);
     assert!((next.rays.direction(0) - Vec3::Y).length() < 1e-3);
 }

@@ -5,7 +5,7 @@ mod common;
 
 use common::*;
 use photonwave::film::Film;
-use photonwave::reference::NoProgress;
+use photonwave::progress::NoProgress;
 use photonwave::scene::file::LoadedScene;
 use photonwave::settings::Settings;
 use photonwave::stats::RenderStats;
@@ -149,7 +149,7 @@ fn both_engines_emit_and_store_the_same_photons() {
     assert_eq!(r.irradiance_points, w.irradiance_points);
     // Photon by photon: same positions, powers, directions and flags, in the same order.
     let scene = Arc::new(load("cornell-spheres.toml").scene);
-    let (rm, _, _) = photonwave::reference::build_maps(&scene, &s);
+    let (rm, _, _) = photonwave::reference::build_maps(&scene, &s).unwrap();
     let (wm, _) = photonwave::wavefront::build_maps(scene, &s).unwrap();
     for (a, b) in [(&rm.global, &wm.global), (&rm.caustic, &wm.caustic), (&rm.irradiance, &wm.irradiance)] {
         assert_eq!(a.len(), b.len());

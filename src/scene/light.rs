@@ -8,6 +8,8 @@ use std::f32::consts::PI;
 
 /// A light source.
 #[derive(Clone, Copy, Debug, PartialEq)]
+// Each variant's doc names and explains its fields.
+#[allow(missing_docs)]
 pub enum Light {
     /// Emissive triangle `tri` (scene BVH order) with radiance `radiance` from its front face.
     Area { tri: u32, radiance: Vec3 },

@@ -3,10 +3,12 @@
 //! radiance. Reads the diffuse lane list and hits; writes deposits, survivors, or the wave's terms.
 
 use super::queues::PathKind;
-use super::{add_term, par_columns, slot, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
+use super::{par_columns, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
+use crate::film::Term;
 use crate::photon_map::Photon;
-use crate::reference::photons::{deposit_photon, PhotonRay};
 use crate::rng::Domain;
+use crate::transport::photon::{deposit_photon, PhotonRay};
+use crate::transport::specular::emission_toward;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use std::time::Instant;
@@ -33,7 +35,7 @@ pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
     par_columns(
         lanes.len(),
         CHUNK,
-        shared.threads,
+        shared.job.threads,
         |r, part: &mut DepositPart| {
             let mut out = Vec::new();
             for &lane in &lanes[r] {
@@ -44,7 +46,7 @@ pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
                     origin: queue.rays.origin(i),
                     dir: queue.rays.direction(i),
                     power: queue.power[i],
-                    specular_only: queue.specular_only[i] != 0,
+                    specular_only: queue.specular_only[i],
                 };
                 out.clear();
                 if deposit_photon(domain, &sp, &photon, queue.bounce[i], &mut out) {
@@ -73,13 +75,13 @@ pub fn deposit_emission(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut s
             continue;
         }
         let Some(hit) = w.paths.hits.get(i) else { continue };
-        let emission = scene.materials[scene.material[hit.tri as usize] as usize].emission;
-        if emission == Vec3::ZERO || w.paths.rays.direction(i).dot(scene.ng[hit.tri as usize]) >= 0.0 {
+        let emission = emission_toward(scene, hit.tri, -w.paths.rays.direction(i));
+        if emission == Vec3::ZERO {
             continue;
         }
         n += 1;
-        let s = if w.paths.through_specular[i] != 0 { slot::SPECULAR } else { slot::EMITTED };
-        add_term(&mut w.terms[w.paths.sample[i] as usize], s, w.paths.beta[i] * emission);
+        let term = Term::Emitted.seen(w.paths.through_specular[i]);
+        w.terms[w.paths.sample[i] as usize].add(term, w.paths.beta[i] * emission);
     }
     stats.record("deposit_emission", n, t);
 }

@@ -1,12 +1,13 @@
 //! Emit: new lanes. Reads the scene and settings; writes the photon queue (a batch of paths
 //! starting at lights) or the path queue (a wave of camera rays) and the wave's empty terms.
 
-use super::queues::{PathKind, PhotonQueue, Segment};
+use super::queues::{PathKind, PhotonLane, PhotonQueue, Segment};
 use super::{par_columns, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
-use crate::film::Terms;
-use crate::reference::camera::camera_sample;
-use crate::reference::photons::{start_photon, BATCH};
+use crate::film::{Term, Terms};
 use crate::rng::Domain;
+use crate::transport::camera::camera_sample;
+use crate::transport::photon::{start_photon, BATCH};
+use crate::transport::streams;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use std::time::Instant;
@@ -14,7 +15,7 @@ use std::time::Instant;
 /// Starts `batches` × [`BATCH`] photon paths at the wave's first path index.
 pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
-    let (scene, settings) = (&*shared.scene, &shared.settings);
+    let (scene, seed) = (&*shared.scene, shared.job.pass.seed);
     let domain = work.domain.unwrap_or(Domain::GlobalPhoton);
     let first = work.first_path;
     let n = work.batches.max(1) * BATCH;
@@ -25,11 +26,19 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
     par_columns(
         n,
         CHUNK,
-        shared.threads,
+        shared.job.threads,
         |r, part: &mut (PhotonQueue, u64)| {
             for i in r {
-                match start_photon(scene, settings, domain, first + i as u64) {
-                    Some(p) => part.0.push(p.origin, p.dir, first + i as u64, 0, p.power, true),
+                let path = first + i as u64;
+                match start_photon(scene, seed, domain, path) {
+                    Some(p) => part.0.push(PhotonLane {
+                        origin: p.origin,
+                        dir: p.dir,
+                        path,
+                        bounce: 0,
+                        power: p.power,
+                        specular_only: true,
+                    }),
                     None => part.1 += 1,
                 }
             }
@@ -47,7 +56,7 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
 /// (stratified when spp is a square) exactly as the reference engine does.
 pub fn emit_camera_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
-    let settings = &shared.settings;
+    let settings = &shared.job.settings;
     let w = &mut *work;
     let spp = settings.spp as u64;
     w.paths.clear();
@@ -59,18 +68,18 @@ pub fn emit_camera_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut s
         let g = w.first_sample + lane as u64;
         let pixel = g / spp;
         let (x, y) = ((pixel % settings.width as u64) as f32, (pixel / settings.width as u64) as f32);
-        let (sampler, (fx, fy)) = camera_sample(settings, g);
-        let (o, d) = w.camera.ray(x + fx, y + fy);
+        let (sampler, (fx, fy)) = camera_sample(&shared.job, g);
+        let (origin, dir) = w.camera.ray(x + fx, y + fy);
         w.paths.push(Segment {
-            o,
-            d,
+            origin,
+            dir,
             sample: lane as u32,
             kind: PathKind::Camera,
             key: sampler.key(),
-            base: 1,
+            base: streams::CAMERA_CHAIN_BOUNCE as u8,
             depth: 0,
             beta: Vec3::ONE,
-            slot: 0,
+            term: Term::Emitted,
             through_specular: false,
         });
     }

@@ -5,41 +5,35 @@
 //! terms in lane order.
 
 use super::queues::PathKind;
-use super::{add_term, par_lanes, slot, CameraWork, Maps, Shared, StageStats, GATHER_CHUNK};
+use super::{par_lanes, CameraWork, Maps, Shared, StageStats, GATHER_CHUNK};
+use crate::film::Term;
 use crate::material::Bsdf;
 use crate::photon_map::flags;
-use crate::reference::camera::{caustic_estimate, global_estimate, map_radiance, Context};
 use crate::scene::SurfacePoint;
+use crate::transport::estimate::{caustic_estimate, global_estimate, map_radiance};
+use crate::transport::Context;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use std::time::Instant;
 
-/// The term a camera lane's findings at its first diffuse hit go to.
-pub fn camera_slot(through_specular: u8, own: u8) -> u8 {
-    if through_specular != 0 {
-        slot::SPECULAR
-    } else {
-        own
-    }
-}
-
 /// Runs `estimate(ctx, point, bsdf, wo, kind, pixel, scratch)` at the diffuse hit of every lane
-/// whose kind passes `wanted` (`pixel` is the lane's pixel for camera lanes, `None` for others), in parallel, and adds `beta × value` to the lane's sample in lane order.
-/// `own_slot` is the term for camera lanes that did not pass through a mirror or glass; gather
-/// and glossy lanes use the slot they carry. Returns the number of estimates.
+/// whose kind passes `wanted` (`pixel` is the lane's pixel for camera lanes, `None` for
+/// others), in parallel, and adds `beta × value` to the lane's sample in lane order. `own` is
+/// the term of camera lanes (routed to specular behind a mirror or glass); gather and glossy
+/// lanes use the term they carry. Returns the number of estimates.
 fn estimate_at_diffuse_hits(
     shared: &Shared,
     maps: &Maps,
     work: &mut CameraWork,
     wanted: impl Fn(PathKind) -> bool,
-    own_slot: u8,
+    own: Term,
     estimate: impl Fn(&Context, &SurfacePoint, &Bsdf, Vec3, PathKind, Option<usize>, &mut Vec<(f32, u32)>) -> Vec3 + Sync,
 ) -> usize {
-    let ctx = Context::new(&shared.scene, &maps.0, &shared.settings);
-    let spp = u64::from(shared.settings.spp);
+    let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
+    let spp = u64::from(shared.job.settings.spp);
     let w = &*work;
     let lanes: Vec<u32> = w.classified.diffuse.iter().copied().filter(|&l| wanted(w.paths.kind[l as usize])).collect();
-    let out: Vec<(u32, u8, Vec3)> = par_lanes(lanes.len(), GATHER_CHUNK, shared.threads, |r| {
+    let out: Vec<(u32, Term, Vec3)> = par_lanes(lanes.len(), GATHER_CHUNK, shared.job.threads, |r| {
         let mut scratch = Vec::new();
         r.filter_map(|j| {
             let i = lanes[j] as usize;
@@ -49,16 +43,16 @@ fn estimate_at_diffuse_hits(
             let pixel =
                 (kind == PathKind::Camera).then(|| ((w.first_sample + u64::from(w.paths.sample[i])) / spp) as usize);
             let value = estimate(&ctx, &sp, bsdf, -w.paths.rays.direction(i), kind, pixel, &mut scratch);
-            let s = match kind {
-                PathKind::Camera => camera_slot(w.paths.through_specular[i], own_slot),
-                _ => w.paths.slot[i],
+            let term = match kind {
+                PathKind::Camera => own.seen(w.paths.through_specular[i]),
+                _ => w.paths.term[i],
             };
-            Some((w.paths.sample[i], s, w.paths.beta[i] * value))
+            Some((w.paths.sample[i], term, w.paths.beta[i] * value))
         })
         .collect()
     });
-    for &(sample, s, v) in &out {
-        add_term(&mut work.terms[sample as usize], s, v);
+    for &(sample, term, v) in &out {
+        work.terms[sample as usize].add(term, v);
     }
     work.numerics.photons_filtered += ctx.filtered();
     lanes.len()
@@ -77,7 +71,7 @@ pub fn gather_caustics(
         &maps,
         &mut work,
         |kind| kind != PathKind::Gather,
-        slot::CAUSTIC,
+        Term::Caustic,
         |ctx, sp, bsdf, wo, _, pixel, scratch| caustic_estimate(ctx, sp, bsdf, wo, pixel, scratch),
     );
     stats.record("gather_caustics", n, t);
@@ -93,13 +87,13 @@ pub fn gather_global(
     mut stats: ResMut<StageStats>,
 ) {
     let t = Instant::now();
-    let gather_on = shared.effects.final_gather.on;
+    let gather_on = shared.job.plan.final_gather.on;
     let n = estimate_at_diffuse_hits(
         &shared,
         &maps,
         &mut work,
         |kind| !(kind == PathKind::Camera && gather_on),
-        slot::INDIRECT,
+        Term::Indirect,
         |ctx, sp, bsdf, wo, kind, pixel, scratch| match kind {
             PathKind::Gather => map_radiance(ctx, sp, bsdf, wo, scratch),
             _ => global_estimate(ctx, sp, bsdf, wo, flags::DIRECT | flags::CAUSTIC, pixel, scratch),

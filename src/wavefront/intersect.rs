@@ -5,7 +5,7 @@
 
 use super::queues::PathKind;
 use super::queues::{HitColumns, RayColumns};
-use super::{add_term, par_columns, par_lanes, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
+use super::{par_columns, par_lanes, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
 use crate::geometry::RayQuery;
 use bevy_ecs::prelude::*;
 use std::time::Instant;
@@ -18,12 +18,13 @@ fn closest_hits(shared: &Shared, rays: &RayColumns, hits: &mut HitColumns) {
     par_columns(
         rays.len(),
         CHUNK,
-        shared.threads,
+        shared.job.threads,
         |r, part: &mut HitColumns| {
             part.reserve(r.len());
             let queries: Vec<RayQuery> =
                 r.map(|i| RayQuery::new(rays.origin(i), rays.direction(i), f32::INFINITY)).collect();
-            let hits = shared.settings.kernels.closest_coherent(scene.bvh(), scene.columns(), &queries, scene.bounds);
+            let hits =
+                shared.job.settings.kernels.closest_coherent(scene.bvh(), scene.columns(), &queries, scene.bounds);
             part.extend(hits.into_iter())
         },
         |part| hits.append(part),
@@ -61,18 +62,18 @@ pub fn trace_shadow_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
     let w = &mut *work;
     let q = &w.shadows;
     let n = q.len();
-    let blocked = par_lanes(n, CHUNK, shared.threads, |r| {
+    let blocked = par_lanes(n, CHUNK, shared.job.threads, |r| {
         let queries: Vec<RayQuery> =
             r.map(|i| RayQuery::new(q.rays.origin(i), q.rays.direction(i), q.t_max[i])).collect();
         // Shadow rays are queued in camera-lane order, from neighbouring hits toward the same
         // lights: already coherent, and sorting them cost more than it saved (BENCHMARKS.md).
         let mut blocked = vec![false; queries.len()];
-        shared.settings.kernels.occluded(scene.bvh(), scene.columns(), &queries, &mut blocked);
+        shared.job.settings.kernels.occluded(scene.bvh(), scene.columns(), &queries, &mut blocked);
         blocked
     });
     for (i, b) in blocked.into_iter().enumerate() {
         if !b {
-            add_term(&mut w.terms[q.sample[i] as usize], q.slot[i], q.contribution[i]);
+            w.terms[q.sample[i] as usize].add(q.term[i], q.contribution[i]);
         }
     }
     w.rays.shadow += n as u64;

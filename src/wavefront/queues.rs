@@ -1,15 +1,19 @@
 //! Structure-of-arrays queues: every ray or photon in flight is one lane, every field one column.
-//! Kernels see plain slices; a bounce reads one queue and writes the next.
+//! Kernels see plain slices; a bounce reads one queue and writes the next. Each queue is
+//! declared once, with [`soa_queue!`], from the fields of its work item (in the spirit of
+//! pbrt-v4's `.soa` files), so every queue has the same `push`, `append`, `reserve`, `clear`
+//! and `len`.
 //!
 //! Bytes per lane (why each field is there):
 //! - rays: origin 12, direction 12 (f32 columns, as traversal reads them);
 //! - hits: triangle 4 (u32::MAX = escaped), t 4, barycentrics 12 (all three, exactly as the
 //!   triangle test returned them, so surface points match the reference engine's bit for bit);
 //! - photons: path index 8, bounce 4, power 12, specular-only flag 1 → 61 B a lane with ray and hit;
-//! - camera-pass paths: sample 4, kind 1, sampler key 8, bounce base 1, depth 4, term slot 1,
+//! - camera-pass paths: sample 4, kind 1, sampler key 8, bounce base 1, depth 4, term 1,
 //!   throughput 12, through-specular flag 1 → 64 B a lane with ray and hit;
-//! - shadow rays: sample 4, slot 1, t_max 4, contribution 12, plus the ray.
+//! - shadow rays: sample 4, term 1, t_max 4, contribution 12, plus the ray.
 
+use crate::film::Term;
 use crate::geometry::Hit;
 use glam::Vec3;
 
@@ -66,6 +70,12 @@ impl RayColumns {
     pub fn clear(&mut self) {
         for c in [&mut self.ox, &mut self.oy, &mut self.oz, &mut self.dx, &mut self.dy, &mut self.dz] {
             c.clear();
+        }
+    }
+    /// Reserves room for `n` more lanes.
+    pub fn reserve(&mut self, n: usize) {
+        for c in [&mut self.ox, &mut self.oy, &mut self.oz, &mut self.dx, &mut self.dy, &mut self.dz] {
+            c.reserve(n);
         }
     }
     /// Moves `other`'s lanes to the end (column copies).
@@ -171,57 +181,96 @@ impl Classified {
     }
 }
 
-/// Photons in flight.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct PhotonQueue {
-    /// Rays.
-    pub rays: RayColumns,
-    /// Closest hits of `rays`.
-    pub hits: HitColumns,
-    /// Path index (the reference engine's photon index).
-    pub path: Vec<u64>,
-    /// Bounces so far.
-    pub bounce: Vec<u32>,
-    /// Power per channel.
-    pub power: Vec<Vec3>,
-    /// 1 while every bounce so far was specular.
-    pub specular_only: Vec<u8>,
+/// Declares a structure-of-arrays queue and its work item: the item is a struct with a ray
+/// (`origin`, `dir`) and the given fields; the queue has the ray as [`RayColumns`], one `Vec`
+/// column per field, and — with `+ hits` — the closest hits of its rays as [`HitColumns`]
+/// (written by the intersect stage, so `push` and `append` leave them alone). Every queue gets
+/// `len`, `is_empty`, `push`, `append`, `reserve`, `clear` and `item`.
+#[macro_export]
+macro_rules! soa_queue {
+    (
+        $(#[$qmeta:meta])* queue $queue:ident $(+ $hits:ident)?;
+        $(#[$imeta:meta])* item $item:ident {
+            $($(#[$fmeta:meta])* $field:ident: $ty:ty),* $(,)?
+        }
+    ) => {
+        $(#[$imeta])*
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct $item {
+            /// Ray origin.
+            pub origin: glam::Vec3,
+            /// Ray direction.
+            pub dir: glam::Vec3,
+            $($(#[$fmeta])* pub $field: $ty,)*
+        }
+
+        $(#[$qmeta])*
+        #[derive(Clone, Debug, Default, PartialEq)]
+        pub struct $queue {
+            /// Rays, one per lane.
+            pub rays: $crate::wavefront::queues::RayColumns,
+            $(
+                /// Closest hits of `rays`, one per lane, as the last intersect stage found them.
+                pub $hits: $crate::wavefront::queues::HitColumns,
+            )?
+            $($(#[$fmeta])* pub $field: Vec<$ty>,)*
+        }
+
+        impl $queue {
+            /// Number of lanes.
+            #[must_use]
+            pub fn len(&self) -> usize {
+                self.rays.len()
+            }
+            /// True if no lane is queued.
+            #[must_use]
+            pub fn is_empty(&self) -> bool {
+                self.rays.is_empty()
+            }
+            /// Appends a lane.
+            #[inline]
+            pub fn push(&mut self, item: $item) {
+                self.rays.push(item.origin, item.dir);
+                $(self.$field.push(item.$field);)*
+            }
+            /// Moves `other`'s lanes to the end (column copies).
+            pub fn append(&mut self, other: &mut $queue) {
+                self.rays.append(&mut other.rays);
+                $(self.$field.append(&mut other.$field);)*
+            }
+            /// Reserves room for `n` more lanes.
+            pub fn reserve(&mut self, n: usize) {
+                self.rays.reserve(n);
+                $(self.$field.reserve(n);)*
+            }
+            /// Removes every lane, keeping capacity.
+            pub fn clear(&mut self) {
+                self.rays.clear();
+                $(self.$hits.clear();)?
+                $(self.$field.clear();)*
+            }
+            /// Lane `i` as a work item.
+            #[must_use]
+            pub fn item(&self, i: usize) -> $item {
+                $item { origin: self.rays.origin(i), dir: self.rays.direction(i), $($field: self.$field[i],)* }
+            }
+        }
+    };
 }
 
-impl PhotonQueue {
-    /// Number of lanes.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.path.len()
-    }
-    /// True if empty.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.path.is_empty()
-    }
-    /// Appends a lane.
-    pub fn push(&mut self, o: Vec3, d: Vec3, path: u64, bounce: u32, power: Vec3, specular_only: bool) {
-        self.rays.push(o, d);
-        self.path.push(path);
-        self.bounce.push(bounce);
-        self.power.push(power);
-        self.specular_only.push(specular_only as u8);
-    }
-    /// Removes every lane.
-    pub fn clear(&mut self) {
-        self.rays.clear();
-        self.path.clear();
-        self.bounce.clear();
-        self.power.clear();
-        self.specular_only.clear();
-    }
-    /// Moves `other`'s lanes (rays and their columns, not hits) to the end.
-    pub fn append(&mut self, other: &mut PhotonQueue) {
-        self.rays.append(&mut other.rays);
-        self.path.append(&mut other.path);
-        self.bounce.append(&mut other.bounce);
-        self.power.append(&mut other.power);
-        self.specular_only.append(&mut other.specular_only);
+soa_queue! {
+    /// Photons in flight.
+    queue PhotonQueue + hits;
+    /// One photon in flight.
+    item PhotonLane {
+        /// Path index (the reference engine's photon index).
+        path: u64,
+        /// Bounces so far.
+        bounce: u32,
+        /// Power per channel.
+        power: Vec3,
+        /// True while every bounce so far was specular.
+        specular_only: bool,
     }
 }
 
@@ -237,177 +286,42 @@ pub enum PathKind {
     Glossy = 2,
 }
 
-/// Camera-pass path segments in flight.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct PathQueue {
-    /// Rays.
-    pub rays: RayColumns,
-    /// Closest hits of `rays`.
-    pub hits: HitColumns,
-    /// Sample (lane of the wave) the segment adds to.
-    pub sample: Vec<u32>,
-    /// [`PathKind`].
-    pub kind: Vec<PathKind>,
-    /// Random stream key.
-    pub key: Vec<u64>,
-    /// Bounce index of the first specular sample of this segment's chain.
-    pub base: Vec<u8>,
-    /// Segments traced so far in this chain.
-    pub depth: Vec<u32>,
-    /// Throughput (camera) or weight of what the segment finds (gather, glossy).
-    pub beta: Vec<Vec3>,
-    /// Film term the segment's findings go to (gather, glossy), see [`crate::film::TERM_NAMES`].
-    pub slot: Vec<u8>,
-    /// 1 once a camera path went through a mirror or glass.
-    pub through_specular: Vec<u8>,
-}
-
-/// One segment to enqueue.
-#[derive(Clone, Copy, Debug)]
-pub struct Segment {
-    /// Origin.
-    pub o: Vec3,
-    /// Direction.
-    pub d: Vec3,
-    /// Sample.
-    pub sample: u32,
-    /// Kind.
-    pub kind: PathKind,
-    /// Random stream key.
-    pub key: u64,
-    /// Bounce base.
-    pub base: u8,
-    /// Depth.
-    pub depth: u32,
-    /// Throughput or weight.
-    pub beta: Vec3,
-    /// Film term.
-    pub slot: u8,
-    /// Through-specular flag.
-    pub through_specular: bool,
-}
-
-impl PathQueue {
-    /// Number of lanes.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.sample.len()
-    }
-    /// True if empty.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.sample.is_empty()
-    }
-    /// Reserves room for `n` more lanes.
-    pub fn reserve(&mut self, n: usize) {
-        for c in [
-            &mut self.rays.ox,
-            &mut self.rays.oy,
-            &mut self.rays.oz,
-            &mut self.rays.dx,
-            &mut self.rays.dy,
-            &mut self.rays.dz,
-        ] {
-            c.reserve(n);
-        }
-        self.sample.reserve(n);
-        self.kind.reserve(n);
-        self.key.reserve(n);
-        self.base.reserve(n);
-        self.depth.reserve(n);
-        self.beta.reserve(n);
-        self.slot.reserve(n);
-        self.through_specular.reserve(n);
-    }
-
-    /// Moves `other`'s lanes to the end (column copies; hits are not moved).
-    pub fn append(&mut self, other: &mut PathQueue) {
-        self.rays.append(&mut other.rays);
-        self.sample.append(&mut other.sample);
-        self.kind.append(&mut other.kind);
-        self.key.append(&mut other.key);
-        self.base.append(&mut other.base);
-        self.depth.append(&mut other.depth);
-        self.beta.append(&mut other.beta);
-        self.slot.append(&mut other.slot);
-        self.through_specular.append(&mut other.through_specular);
-    }
-
-    /// Appends a segment.
-    pub fn push(&mut self, s: Segment) {
-        self.rays.push(s.o, s.d);
-        self.sample.push(s.sample);
-        self.kind.push(s.kind);
-        self.key.push(s.key);
-        self.base.push(s.base);
-        self.depth.push(s.depth);
-        self.beta.push(s.beta);
-        self.slot.push(s.slot);
-        self.through_specular.push(s.through_specular as u8);
-    }
-    /// Removes every lane.
-    pub fn clear(&mut self) {
-        self.rays.clear();
-        self.sample.clear();
-        self.kind.clear();
-        self.key.clear();
-        self.base.clear();
-        self.depth.clear();
-        self.beta.clear();
-        self.slot.clear();
-        self.through_specular.clear();
+soa_queue! {
+    /// Camera-pass path segments in flight.
+    queue PathQueue + hits;
+    /// One camera-pass path segment.
+    item Segment {
+        /// Sample (lane of the wave) the segment adds to.
+        sample: u32,
+        /// What the segment is for.
+        kind: PathKind,
+        /// Random stream key.
+        key: u64,
+        /// Bounce index of the first specular sample of this segment's chain.
+        base: u8,
+        /// Segments traced so far in this chain.
+        depth: u32,
+        /// Throughput (camera) or weight of what the segment finds (gather, glossy).
+        beta: Vec3,
+        /// Film term the segment's findings go to (gather, glossy).
+        term: Term,
+        /// True once a camera path went through a mirror or glass.
+        through_specular: bool,
     }
 }
 
-/// Shadow rays waiting for an any-hit test.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct ShadowQueue {
-    /// Rays.
-    pub rays: RayColumns,
-    /// Blocked by hits with t below this.
-    pub t_max: Vec<f32>,
-    /// Sample the light goes to.
-    pub sample: Vec<u32>,
-    /// Film term.
-    pub slot: Vec<u8>,
-    /// Contribution when unblocked.
-    pub contribution: Vec<Vec3>,
-}
-
-impl ShadowQueue {
-    /// Number of lanes.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.sample.len()
-    }
-    /// True if empty.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.sample.is_empty()
-    }
-    /// Moves `other`'s lanes to the end (column copies).
-    pub fn append(&mut self, other: &mut ShadowQueue) {
-        self.rays.append(&mut other.rays);
-        self.t_max.append(&mut other.t_max);
-        self.sample.append(&mut other.sample);
-        self.slot.append(&mut other.slot);
-        self.contribution.append(&mut other.contribution);
-    }
-
-    /// Appends a shadow ray.
-    pub fn push(&mut self, o: Vec3, d: Vec3, t_max: f32, sample: u32, slot: u8, contribution: Vec3) {
-        self.rays.push(o, d);
-        self.t_max.push(t_max);
-        self.sample.push(sample);
-        self.slot.push(slot);
-        self.contribution.push(contribution);
-    }
-    /// Removes every lane.
-    pub fn clear(&mut self) {
-        self.rays.clear();
-        self.t_max.clear();
-        self.sample.clear();
-        self.slot.clear();
-        self.contribution.clear();
+soa_queue! {
+    /// Shadow rays waiting for an any-hit test.
+    queue ShadowQueue;
+    /// One shadow ray.
+    item ShadowLane {
+        /// Blocked by hits with t below this.
+        t_max: f32,
+        /// Sample the light goes to.
+        sample: u32,
+        /// Film term.
+        term: Term,
+        /// Contribution when unblocked.
+        contribution: Vec3,
     }
 }

@@ -4,26 +4,26 @@
 //! `resolve_wave` turns the wave's samples into pixels. Reads classified lanes and hits; writes
 //! the next queues, the shadow queue and the film.
 
-use super::gather::camera_slot;
-use super::queues::{PathKind, PathQueue, PhotonQueue, Segment, ShadowQueue};
-use super::{par_columns, par_lanes, slot, CameraWork, Maps, PhotonWork, Shared, StageStats, CHUNK};
-use crate::film::PixelMean;
-use crate::geometry::offset::offset_ray_origin;
-use crate::material::{Bsdf, Transport};
-use crate::reference::camera::{direct_light_rays, Context, ShadowRay, TAG_GATHER, TAG_GLOSSY, TAG_LIGHT};
-use crate::reference::photons::{scatter_photon, PhotonRay, Scattered};
+use super::queues::{PathKind, PathQueue, PhotonLane, PhotonQueue, Segment, ShadowLane, ShadowQueue};
+use super::{par_columns, par_lanes, CameraWork, Maps, PhotonWork, Shared, StageStats, CHUNK};
+use crate::film::{PixelMean, Term};
 use crate::rng::{Domain, Sampler};
-use crate::sampling::{cosine_hemisphere, Frame};
+use crate::stats::Numerics;
+use crate::transport::direct::{direct_light_rays, ShadowRay};
+use crate::transport::gather::{gather_rays, glossy_ray};
+use crate::transport::photon::{scatter_photon, PhotonRay, Scattered};
+use crate::transport::specular::continue_ray;
+use crate::transport::{streams, Context};
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
 /// Scatters the photon lanes `lanes` into `next`; returns the paths dropped (the photon fields of
 /// [`Numerics`](crate::stats::Numerics)).
-fn scatter_lanes(shared: &Shared, work: &PhotonWork, lanes: &[u32], next: &mut PhotonQueue) -> crate::stats::Numerics {
+fn scatter_lanes(shared: &Shared, work: &PhotonWork, lanes: &[u32], next: &mut PhotonQueue) -> Numerics {
     let scene = &*shared.scene;
     let domain = work.domain.unwrap_or(Domain::GlobalPhoton);
     let q = &work.queue;
-    let results = par_lanes(lanes.len(), CHUNK, shared.threads, |r| {
+    let results = par_lanes(lanes.len(), CHUNK, shared.job.threads, |r| {
         r.filter_map(|j| {
             let i = lanes[j] as usize;
             let sp = scene.surface(&q.hits.get(i)?);
@@ -32,18 +32,25 @@ fn scatter_lanes(shared: &Shared, work: &PhotonWork, lanes: &[u32], next: &mut P
                 origin: q.rays.origin(i),
                 dir: q.rays.direction(i),
                 power: q.power[i],
-                specular_only: q.specular_only[i] != 0,
+                specular_only: q.specular_only[i],
             };
-            let s = Sampler::new(shared.settings.seed, domain, q.path[i]);
+            let s = Sampler::new(shared.job.pass.seed, domain, q.path[i]);
             Some((i, scatter_photon(&s, &sp, &bsdf, &photon, q.bounce[i])))
         })
         .collect()
     });
-    let mut dropped = crate::stats::Numerics::default();
+    let mut dropped = Numerics::default();
     for (i, r) in results {
         match r {
-            Scattered::Continue(p) if q.bounce[i] + 1 < shared.settings.max_depth => {
-                next.push(p.origin, p.dir, q.path[i], q.bounce[i] + 1, p.power, p.specular_only);
+            Scattered::Continue(p) if q.bounce[i] + 1 < shared.job.settings.max_depth => {
+                next.push(PhotonLane {
+                    origin: p.origin,
+                    dir: p.dir,
+                    path: q.path[i],
+                    bounce: q.bounce[i] + 1,
+                    power: p.power,
+                    specular_only: p.specular_only,
+                });
             }
             Scattered::NonFinite => dropped.photon_scatter += 1,
             Scattered::ZeroPdf => dropped.photon_zero_pdf += 1,
@@ -78,7 +85,7 @@ pub fn refract_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
 /// Diffuse lanes of camera and glossy rays queue their shadow rays (direct light).
 pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
-    let ctx = Context::new(&shared.scene, &maps.0, &shared.settings);
+    let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
     let w = &*work;
     let lanes: Vec<u32> =
         w.classified.diffuse.iter().copied().filter(|&l| w.paths.kind[l as usize] != PathKind::Gather).collect();
@@ -86,7 +93,7 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
     par_columns(
         lanes.len(),
         CHUNK,
-        shared.threads,
+        shared.job.threads,
         |r, part: &mut ShadowQueue| {
             for j in r {
                 let i = lanes[j] as usize;
@@ -94,16 +101,22 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
                 let sp = ctx.scene.surface(&hit);
                 let bsdf = &ctx.scene.materials[sp.material as usize].bsdf;
                 let s = Sampler::from_key(w.paths.key[i]);
-                let (stream, target) = match w.paths.kind[i] {
-                    PathKind::Camera => (
-                        s.fork(TAG_LIGHT + w.paths.depth[i] as u64),
-                        camera_slot(w.paths.through_specular[i], slot::DIRECT),
-                    ),
-                    _ => (s.fork(7), w.paths.slot[i]),
+                let (stream, term) = match w.paths.kind[i] {
+                    PathKind::Camera => {
+                        (s.fork(streams::light(w.paths.depth[i])), Term::Direct.seen(w.paths.through_specular[i]))
+                    }
+                    _ => (s.fork(streams::GLOSSY_HIT_LIGHT), w.paths.term[i]),
                 };
                 let (beta, sample) = (w.paths.beta[i], w.paths.sample[i]);
                 direct_light_rays(&ctx, &sp, bsdf, -w.paths.rays.direction(i), &stream, |ray: ShadowRay| {
-                    part.push(ray.origin, ray.direction, ray.t_max, sample, target, ray.contribution * beta);
+                    part.push(ShadowLane {
+                        origin: ray.origin,
+                        dir: ray.direction,
+                        t_max: ray.t_max,
+                        sample,
+                        term,
+                        contribution: ray.contribution * beta,
+                    });
                 });
             }
         },
@@ -118,7 +131,7 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
 pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let scene = &*shared.scene;
-    let n = shared.settings.gather_rays;
+    let n = shared.job.settings.gather_rays;
     // Chunks append straight to the next queue (disjoint fields of the work resource).
     let CameraWork { paths, classified, next, .. } = &mut *work;
     let w = &*paths;
@@ -129,7 +142,7 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
     par_columns(
         lanes.len(),
         CHUNK,
-        shared.threads,
+        shared.job.threads,
         |r, out: &mut PathQueue| {
             out.reserve(r.len() * n as usize);
             for j in r {
@@ -140,29 +153,23 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
                 if kd == glam::Vec3::ZERO {
                     continue;
                 }
-                let wo = -w.rays.direction(i);
-                let (ng, ns) = sp.frame.oriented(wo);
-                let frame = Frame::new(ns);
-                let gs = Sampler::from_key(w.key[i]).fork(TAG_GATHER + w.depth[i] as u64);
+                let gs = Sampler::from_key(w.key[i]).fork(streams::gather(w.depth[i]));
                 let weight = w.beta[i] * kd / n as f32;
-                for g in 0..n {
-                    let wi = frame.to_world(cosine_hemisphere([gs.get(g, 0), gs.get(g, 1)]));
-                    if wi.dot(ng) <= 0.0 {
-                        continue;
-                    }
+                let term = Term::Indirect.seen(w.through_specular[i]);
+                gather_rays(&sp, -w.rays.direction(i), n, &gs, |g, origin, dir| {
                     out.push(Segment {
-                        o: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, wi),
-                        d: wi,
+                        origin,
+                        dir,
                         sample: w.sample[i],
                         kind: PathKind::Gather,
-                        key: gs.fork(g as u64).key(),
-                        base: 0,
+                        key: gs.fork(streams::gather_ray(g)).key(),
+                        base: streams::GATHER_CHAIN_BOUNCE as u8,
                         depth: 0,
                         beta: weight,
-                        slot: camera_slot(w.through_specular[i], slot::INDIRECT),
+                        term,
                         through_specular: false,
                     });
-                }
+                });
             }
         },
         |part| next.append(part),
@@ -185,22 +192,18 @@ pub fn spawn_glossy_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
         let Some(hit) = w.paths.hits.get(i) else { continue };
         let sp = scene.surface(&hit);
         let bsdf = &scene.materials[sp.material as usize].bsdf;
-        if !matches!(bsdf, Bsdf::Glossy { .. }) {
-            continue;
-        }
-        let gls = Sampler::from_key(w.paths.key[i]).fork(TAG_GLOSSY + w.paths.depth[i] as u64);
-        let wo = -w.paths.rays.direction(i);
-        let Some(bs) = bsdf.sample_glossy(&sp.frame, wo, [gls.get(0, 0), gls.get(0, 1)]) else { continue };
+        let gls = Sampler::from_key(w.paths.key[i]).fork(streams::glossy(w.paths.depth[i]));
+        let Some(ray) = glossy_ray(&sp, bsdf, -w.paths.rays.direction(i), &gls) else { continue };
         segments.push(Segment {
-            o: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi),
-            d: bs.wi,
+            origin: ray.origin,
+            dir: ray.dir,
             sample: w.paths.sample[i],
             kind: PathKind::Glossy,
             key: gls.key(),
-            base: 1,
+            base: streams::GLOSSY_CHAIN_BOUNCE as u8,
             depth: 0,
-            beta: w.paths.beta[i] * bs.weight,
-            slot: slot::SPECULAR,
+            beta: w.paths.beta[i] * ray.weight,
+            term: Term::Specular,
             through_specular: false,
         });
     }
@@ -215,13 +218,13 @@ pub fn spawn_glossy_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
 /// random numbers of bounce `base + depth`; chains stop after `max_depth` bounces.
 fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32]) -> PathQueue {
     let scene = &*shared.scene;
-    let max_depth = shared.settings.max_depth;
+    let max_depth = shared.job.settings.max_depth;
     let w = work;
     let mut out = PathQueue::default();
     par_columns(
         lanes.len(),
         CHUNK,
-        shared.threads,
+        shared.job.threads,
         |r, part: &mut PathQueue| {
             part.reserve(r.len());
             for s in r.filter_map(|j| {
@@ -232,24 +235,15 @@ fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32]) -> PathQ
                 let sp = scene.surface(&w.paths.hits.get(i)?);
                 let bsdf = &scene.materials[sp.material as usize].bsdf;
                 let s = Sampler::from_key(w.paths.key[i]);
-                let b = w.paths.base[i] as u32 + w.paths.depth[i];
-                let bs = bsdf.sample(
-                    &sp.frame,
-                    -w.paths.rays.direction(i),
-                    [s.get(b, 0), s.get(b, 1), s.get(b, 2)],
-                    Transport::Radiance,
-                )?;
+                let bounce = u32::from(w.paths.base[i]) + w.paths.depth[i];
+                let next = continue_ray(&sp, bsdf, -w.paths.rays.direction(i), &s, bounce)?;
                 Some(Segment {
-                    o: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi),
-                    d: bs.wi,
-                    sample: w.paths.sample[i],
-                    kind: w.paths.kind[i],
-                    key: w.paths.key[i],
-                    base: w.paths.base[i],
+                    origin: next.origin,
+                    dir: next.dir,
                     depth: w.paths.depth[i] + 1,
-                    beta: w.paths.beta[i] * bs.weight,
-                    slot: w.paths.slot[i],
+                    beta: w.paths.beta[i] * next.weight,
                     through_specular: w.paths.kind[i] == PathKind::Camera,
+                    ..w.paths.item(i)
                 })
             }) {
                 part.push(s);
@@ -281,7 +275,7 @@ pub fn refract_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stat
 /// Averages each pixel's samples (dropping non-finite ones, as the reference does) into the film.
 pub fn resolve_wave(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
-    let spp = shared.settings.spp as usize;
+    let spp = shared.job.settings.spp as usize;
     let w = &mut *work;
     let first_pixel = (w.first_sample / spp as u64) as usize;
     for (k, samples) in w.terms.chunks(spp).enumerate() {

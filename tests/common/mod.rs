@@ -3,7 +3,8 @@
 
 use glam::Vec3;
 use photonwave::film::Film;
-use photonwave::reference::{self, NoProgress};
+use photonwave::progress::NoProgress;
+use photonwave::reference;
 use photonwave::scene::file::{load_scene, LoadedScene};
 use photonwave::settings::Settings;
 use std::path::PathBuf;
@@ -18,6 +19,11 @@ pub fn load(name: &str) -> LoadedScene {
     load_scene(&bundled(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
+/// The job of a single render of `scene` with `settings` (which must be valid).
+pub fn job(scene: &photonwave::scene::Scene, settings: &Settings) -> photonwave::job::Job {
+    photonwave::job::Job::new(scene, settings).unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// Renders a loaded scene with the reference engine.
 pub fn render(loaded: &LoadedScene, settings: &Settings) -> Film {
     let cam = loaded.camera.expect("bundled scenes have cameras").prepare(settings.width, settings.height).unwrap();
@@ -27,7 +33,7 @@ pub fn render(loaded: &LoadedScene, settings: &Settings) -> Film {
 /// Renders with the path tracer.
 pub fn render_path(loaded: &LoadedScene, settings: &Settings) -> Film {
     let cam = loaded.camera.unwrap().prepare(settings.width, settings.height).unwrap();
-    reference::path::render_path_traced(&loaded.scene, &cam, settings, &NoProgress).0
+    photonwave::path::render_path_traced(&loaded.scene, &cam, settings, &NoProgress).unwrap().0
 }
 
 /// Mean and standard error of the mean of a per-pixel scalar.

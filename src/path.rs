@@ -8,67 +8,79 @@
 //! glass), `indirect` (everything else; the photon mapper splits it into caustic, indirect and the
 //! glossy lobe's share of specular).
 
-use super::camera::{direct_light, render_pixels};
-use super::Progress;
-use crate::film::{Film, Terms};
-use crate::geometry::offset::offset_ray_origin;
-use crate::material::Transport;
+use crate::error::Result;
+use crate::film::{Film, Term, Terms};
+use crate::job::Job;
+use crate::progress::Progress;
 use crate::rng::Sampler;
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::Settings;
-use crate::stats::RayCounts;
+use crate::stats::{MapStats, Numerics, PhaseTimes, RayCounts, RenderStats};
+use crate::transport::camera::render_pixels;
+use crate::transport::direct::direct_light;
+use crate::transport::specular::{continue_ray, emission_toward};
+use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
 
 /// Path depth after which Russian roulette starts.
 const RR_DEPTH: u32 = 3;
 
-/// Renders the scene by path tracing (`max_depth` bounces).
+/// Renders the scene by path tracing (`max_depth` bounces) with `settings` (validated here).
 pub fn render_path_traced(
     scene: &Scene,
     camera: &CameraRays,
     settings: &Settings,
     progress: &dyn Progress,
-) -> (Film, RayCounts, crate::stats::Numerics) {
-    let empty = super::PhotonMaps::default();
-    let ctx = super::camera::Context::new(scene, &empty, settings);
-    render_pixels(settings, camera, settings.thread_count(), progress, |_, o, d, s, rays, _| {
-        trace_path(&ctx, o, d, s, rays)
-    })
+) -> Result<(Film, RayCounts, Numerics)> {
+    Ok(trace_image(scene, camera, &Job::new(scene, settings)?, progress))
 }
 
-/// [`render_path_traced`] with the CLI's summary.
-pub fn render_path_traced_with_stats(
-    scene: &Scene,
-    camera: &CameraRays,
-    settings: &Settings,
-    progress: &dyn Progress,
-) -> crate::Result<(Film, crate::stats::RenderStats)> {
-    settings.validate()?;
+/// The path-traced image of `job`, the rays traced and the numerics.
+fn trace_image(scene: &Scene, camera: &CameraRays, job: &Job, progress: &dyn Progress) -> (Film, RayCounts, Numerics) {
+    let empty = PhotonMaps::default();
+    let ctx = Context::new(scene, &empty, job);
+    render_pixels(job, camera, progress, |_, o, d, s, rays, _| trace_path(&ctx, o, d, s, rays))
+}
+
+/// Renders `job` by path tracing, with the CLI's summary.
+#[must_use]
+pub fn render_job(scene: &Scene, camera: &CameraRays, job: &Job, progress: &dyn Progress) -> (Film, RenderStats) {
     let t = std::time::Instant::now();
-    let (film, rays, numerics) = render_path_traced(scene, camera, settings, progress);
-    let none = |name: &str| crate::stats::MapStats {
+    let (film, rays, numerics) = trace_image(scene, camera, job, progress);
+    let none = |name: &str| MapStats {
         reason: format!("the path tracer builds no {name} map: it samples every path from the camera"),
         ..Default::default()
     };
-    let stats = crate::stats::RenderStats {
+    let stats = RenderStats {
         phases: vec!["path tracing with next-event estimation".into()],
         global_map: none("global"),
         caustic_map: none("caustic"),
         rays,
-        numerics: crate::stats::Numerics { load_normals: scene.zero_normals, ..numerics },
-        times: crate::stats::PhaseTimes {
+        numerics: Numerics { load_normals: scene.zero_normals, ..numerics },
+        times: PhaseTimes {
             camera_s: t.elapsed().as_secs_f64(),
             total_s: t.elapsed().as_secs_f64(),
             ..Default::default()
         },
         mean_rgb: film.mean().to_array(),
-        ..crate::stats::RenderStats::new("path", scene, settings, settings.thread_count())
+        ..RenderStats::new("path", scene, &job.settings, job.threads)
     };
-    Ok((film, stats))
+    (film, stats)
 }
 
-fn trace_path(ctx: &super::camera::Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut RayCounts) -> Terms {
+/// The term light found at `depth` goes to: `first` (emitted or direct) at the camera's first
+/// hit, `specular` on a path whose first hit was a mirror or glass, `indirect` otherwise.
+fn path_term(first: Term, depth: u32, via_specular: bool) -> Term {
+    match (depth, via_specular) {
+        (_, true) => Term::Specular,
+        (0, false) => first,
+        _ => Term::Indirect,
+    }
+}
+
+/// Radiance along one camera ray, split into the path tracer's terms.
+fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut RayCounts) -> Terms {
     let scene = ctx.scene;
     let mut terms = Terms::default();
     let mut beta = Vec3::ONE;
@@ -82,27 +94,18 @@ fn trace_path(ctx: &super::camera::Context, mut o: Vec3, mut d: Vec3, s: &Sample
         let sp = scene.surface(&hit);
         let mat = &scene.materials[sp.material as usize];
         let wo = -d;
-        if last_delta && mat.emission != Vec3::ZERO && wo.dot(sp.frame.ng) > 0.0 {
-            let e = beta * mat.emission;
-            match (depth, via_specular) {
-                (0, _) => terms.emitted += e,
-                (_, true) => terms.specular += e,
-                _ => terms.indirect += e,
-            }
+        let e = emission_toward(scene, hit.tri, wo);
+        if last_delta && e != Vec3::ZERO {
+            terms.add(path_term(Term::Emitted, depth, via_specular), beta * e);
         }
         if depth == ctx.settings.max_depth {
             break;
         }
         if !mat.bsdf.is_delta() {
-            let l = beta * direct_light(ctx, &sp, &mat.bsdf, wo, &s.fork(((depth as u64) << 32) | 0xd1), rays);
-            match (depth, via_specular) {
-                (_, true) => terms.specular += l,
-                (0, _) => terms.direct += l,
-                _ => terms.indirect += l,
-            }
+            let l = beta * direct_light(ctx, &sp, &mat.bsdf, wo, &s.fork(streams::path_light(depth)), rays);
+            terms.add(path_term(Term::Direct, depth, via_specular), l);
         }
-        let u = [s.get(depth + 1, 0), s.get(depth + 1, 1), s.get(depth + 1, 2)];
-        let Some(bs) = mat.bsdf.sample(&sp.frame, wo, u, Transport::Radiance) else { break };
+        let Some(bs) = continue_ray(&sp, &mat.bsdf, wo, s, streams::CAMERA_CHAIN_BOUNCE + depth) else { break };
         beta *= bs.weight;
         last_delta = bs.delta;
         if depth == 0 && bs.delta {
@@ -115,8 +118,7 @@ fn trace_path(ctx: &super::camera::Context, mut o: Vec3, mut d: Vec3, s: &Sample
             }
             beta /= q;
         }
-        o = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi);
-        d = bs.wi;
+        (o, d) = (bs.origin, bs.dir);
     }
     terms
 }

@@ -1,0 +1,121 @@
+//! Photon-map density estimates at a surface point: the caustic and global maps' reflected
+//! radiance (k nearest photons, or every photon within a progressive pass's fixed radii,
+//! optionally only the visible ones), and the radiance a final-gather ray reads where it lands
+//! (precomputed irradiance where that applies).
+
+use super::Context;
+use crate::material::Bsdf;
+use crate::photon_map::{Filter, Lookup, PhotonMap, Reflectance};
+use crate::scene::{Scene, SurfacePoint};
+use glam::Vec3;
+use std::sync::atomic::Ordering;
+
+/// Radiance estimate from `map` at `sp` toward `wo` with `k` photons within `radius`, ignoring
+/// photons with any `mask` flag.
+#[allow(clippy::too_many_arguments)]
+fn map_estimate(
+    ctx: &Context,
+    map: &PhotonMap,
+    k: u32,
+    radius: f32,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    mask: u8,
+    fixed: Option<f32>,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Vec3 {
+    let (ng, _) = sp.frame.oriented(wo);
+    let lookup = Lookup {
+        p: sp.p,
+        k: k as usize,
+        r_max: radius,
+        kernel: ctx.settings.kernel,
+        filter: Filter { n: ng, flags_mask: mask },
+    };
+    let eval = |wi| bsdf.eval(&sp.frame, wo, wi);
+    let f = match *bsdf {
+        // Lambertian: f = kd/π above the surface, 0 below — no per-photon call.
+        Bsdf::Lambert { kd } => Reflectance::Hemisphere { value: kd * std::f32::consts::FRAC_1_PI, ng },
+        _ => Reflectance::PerPhoton(&eval),
+    };
+    let set = ctx.settings.kernels;
+    let e = match (fixed, ctx.settings.visibility) {
+        (Some(r), false) => map.estimate_radius(set, &Lookup { r_max: r, ..lookup }, f),
+        (None, false) => map.estimate(set, &lookup, f, scratch),
+        (fixed, true) => {
+            let lookup = fixed.map_or(lookup, |r| Lookup { r_max: r, k: 0, ..lookup });
+            let visible = photon_visibility(ctx.scene, sp.p, ng, lookup.r_max);
+            map.estimate_visible(set, &lookup, f, scratch, &visible)
+        }
+    };
+    if e.rejected > 0 {
+        ctx.filtered.fetch_add(u64::from(e.rejected), Ordering::Relaxed);
+    }
+    e.radiance
+}
+
+/// Whether a photon (position, normal) is visible from the point `q` (normal `n`, on the side
+/// the estimate looks from), for [`Settings::visibility`]: the segment between them, both lifted
+/// off their surfaces by 10⁻³ of the search radius `r` (far above rounding, far below any wall
+/// worth stopping light), meets nothing.
+pub fn photon_visibility(scene: &Scene, q: Vec3, n: Vec3, r: f32) -> impl Fn(Vec3, Vec3) -> bool + '_ {
+    let lift = 1e-3 * r;
+    let from = q + n * lift;
+    move |p, m| !scene.occluded(from, p + m * lift - from, 1.0)
+}
+
+/// Caustic-map radiance estimate at `sp` toward `wo`; `pixel` when `sp` is a camera path's first
+/// non-specular hit (progressive passes may give each pixel its own radius).
+pub fn caustic_estimate(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    pixel: Option<usize>,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Vec3 {
+    let fixed = ctx.fixed.map(|r| r.caustic_at(pixel));
+    map_estimate(ctx, &ctx.maps.caustic, ctx.settings.caustic_k, ctx.caustic_radius, sp, bsdf, wo, 0, fixed, scratch)
+}
+
+/// Global-map radiance estimate at `sp` toward `wo`, ignoring photons with any `mask` flag;
+/// `pixel` as for [`caustic_estimate`].
+pub fn global_estimate(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    mask: u8,
+    pixel: Option<usize>,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Vec3 {
+    let fixed = ctx.fixed.map(|r| r.global_at(pixel));
+    map_estimate(ctx, &ctx.maps.global, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, fixed, scratch)
+}
+
+/// Radiance leaving a non-specular point toward `wo` as the photon maps see it: kd/π × the
+/// nearest precomputed irradiance for Lambertian surfaces when that is available (and a point
+/// with a similar normal lies within the global radius), the full global-map estimate otherwise.
+pub fn map_radiance(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, scratch: &mut Vec<(f32, u32)>) -> Vec3 {
+    let irr = &ctx.maps.irradiance;
+    if let (Bsdf::Lambert { kd }, false) = (bsdf, irr.is_empty()) {
+        let (ng, _) = sp.frame.oriented(wo);
+        let lookup = Lookup {
+            p: sp.p,
+            k: 1,
+            r_max: ctx.global_radius,
+            kernel: ctx.settings.kernel,
+            filter: Filter { n: ng, flags_mask: 0 },
+        };
+        irr.nearest(ctx.settings.kernels, &lookup, scratch);
+        if let Some(&(_, i)) = scratch.first() {
+            // With visibility on, a point behind a wall is not read: the full estimate below is.
+            let p = irr.photon(i as usize);
+            if !ctx.settings.visibility || photon_visibility(ctx.scene, sp.p, ng, lookup.r_max)(p.position, p.normal) {
+                return *kd * std::f32::consts::FRAC_1_PI * irr.power(i as usize);
+            }
+        }
+    }
+    global_estimate(ctx, sp, bsdf, wo, 0, None, scratch)
+}

@@ -1,0 +1,104 @@
+//! The photon maps of one render: the global and caustic kd-trees, and the irradiance
+//! precomputed at global photons for final gathering (Christensen 1999).
+
+use super::estimate::photon_visibility;
+use crate::job::Job;
+use crate::parallel::map_chunks;
+use crate::photon_map::{Filter, Lookup, Photon, PhotonMap, Reflectance};
+use crate::scene::Scene;
+use crate::settings::Settings;
+use glam::Vec3;
+
+/// Both photon maps (empty where the plan skipped one), and the irradiance precomputed at
+/// global photons for final gathering.
+#[derive(Default)]
+pub struct PhotonMaps {
+    /// Global map (all non-specular hits).
+    pub global: PhotonMap,
+    /// Caustic map (`LS+D` paths).
+    pub caustic: PhotonMap,
+    /// Irradiance at every [`IRRADIANCE_STRIDE`]-th global photon (`power` holds E); empty unless
+    /// `precompute_irradiance` is on.
+    pub irradiance: PhotonMap,
+}
+
+/// Irradiance is precomputed at every this-many-th global photon (Christensen 1999 used 4).
+pub const IRRADIANCE_STRIDE: usize = 4;
+
+impl PhotonMaps {
+    /// Builds the kd-trees and, if the job asks for final gathering with precomputed irradiance
+    /// (and is not a progressive pass), the irradiance map.
+    #[must_use]
+    pub fn build(scene: &Scene, job: &Job, global: Vec<Photon>, caustic: Vec<Photon>) -> Self {
+        // The two trees are independent: built side by side when there is a second thread.
+        let (global, caustic) = if job.threads > 1 {
+            std::thread::scope(|s| {
+                let c = s.spawn(|| PhotonMap::build(caustic));
+                let g = PhotonMap::build(global);
+                (g, c.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            })
+        } else {
+            (PhotonMap::build(global), PhotonMap::build(caustic))
+        };
+        let mut maps = PhotonMaps { global, caustic, irradiance: PhotonMap::default() };
+        // Not under a progressive pass's fixed radii: reading the nearest precomputed point is
+        // biased low there (see `precompute_irradiance`).
+        if job.plan.final_gather.on
+            && job.settings.precompute_irradiance
+            && job.pass.radii.is_none()
+            && !maps.global.is_empty()
+        {
+            maps.irradiance = precompute_irradiance(&maps.global, scene, &job.settings, job.threads);
+        }
+        maps
+    }
+}
+
+/// Christensen's precomputation: the global-map irradiance estimate E at every
+/// [`IRRADIANCE_STRIDE`]-th photon, stored as a photon whose `power` is E. A final-gather ray that
+/// ends on a Lambertian surface then reads kd/π·E of the nearest such point (one nearest-neighbour
+/// search instead of a k-nearest density estimate).
+///
+/// Only with k-nearest-neighbour estimates. Under a progressive pass's small fixed radii it is
+/// biased: a point's estimate and how often gather rays read it (its nearest-neighbour cell among
+/// the other points) both follow the same local clustering of photons — a point in a chance
+/// cluster reads high but has a small cell — so the rays read low values more often. Measured on
+/// the glass-sphere box against the path tracer: caustic + indirect 3.6 % low after 64 passes,
+/// 5.2 % after 512, growing as the radius shrinks; the estimate at each point itself was
+/// unbiased (leaving the point's own photon out, it matched an independent map within 0.4 %).
+/// Full fixed-radius estimates at the gather hits are unbiased (0.04 % off) and cost ~18 % more
+/// per pass, so progressive passes use those.
+fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings, threads: usize) -> PhotonMap {
+    let radius = settings.global_radius * scene.diagonal();
+    let picks: Vec<usize> = (0..global.len()).step_by(IRRADIANCE_STRIDE).collect();
+    let chunks = map_chunks(
+        picks.len(),
+        4096,
+        threads,
+        |range| {
+            let mut scratch = Vec::new();
+            range
+                .map(|j| {
+                    let src = global.photon(picks[j]);
+                    let lookup = Lookup {
+                        p: src.position,
+                        k: settings.k as usize,
+                        r_max: radius,
+                        kernel: settings.kernel,
+                        filter: Filter { n: src.normal, flags_mask: 0 },
+                    };
+                    let f = Reflectance::Constant(Vec3::ONE);
+                    let e = if settings.visibility {
+                        let visible = photon_visibility(scene, src.position, src.normal, radius);
+                        global.estimate_visible(settings.kernels, &lookup, f, &mut scratch, &visible)
+                    } else {
+                        global.estimate(settings.kernels, &lookup, f, &mut scratch)
+                    };
+                    Photon { position: src.position, power: e.radiance, wi: src.normal, normal: src.normal, flags: 0 }
+                })
+                .collect::<Vec<_>>()
+        },
+        |_| {},
+    );
+    PhotonMap::build(chunks.into_iter().flatten().collect())
+}

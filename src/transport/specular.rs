@@ -1,0 +1,78 @@
+//! Ray continuation: a ray leaving a surface by sampling its BSDF, the chain of mirrors and
+//! glass a camera-side ray follows to its first non-specular hit, and emission seen along a
+//! ray.
+
+use super::Context;
+use crate::geometry::offset::offset_ray_origin;
+use crate::material::{Bsdf, Transport};
+use crate::rng::Sampler;
+use crate::scene::{Scene, SurfacePoint};
+use crate::stats::RayCounts;
+use glam::Vec3;
+
+/// A ray leaving a surface point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounce {
+    /// Origin, offset off the surface to the side the ray leaves on.
+    pub origin: Vec3,
+    /// Unit direction.
+    pub dir: Vec3,
+    /// Throughput factor f·|cos|/pdf (radiance transport).
+    pub weight: Vec3,
+    /// Sampled from a delta lobe (mirror or glass).
+    pub delta: bool,
+}
+
+/// Samples the BSDF at `sp` toward `wo` with the numbers of bounce `bounce` (dims 0–2), for
+/// radiance: the ray that continues the path, or `None` where the sample is absorbed.
+#[must_use]
+pub fn continue_ray(sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler, bounce: u32) -> Option<Bounce> {
+    let u = [s.get(bounce, 0), s.get(bounce, 1), s.get(bounce, 2)];
+    let bs = bsdf.sample(&sp.frame, wo, u, Transport::Radiance)?;
+    Some(Bounce {
+        origin: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi),
+        dir: bs.wi,
+        weight: bs.weight,
+        delta: bs.delta,
+    })
+}
+
+/// Follows a ray through mirrors and glass (at most `max_depth` bounces, sampling each with `s`
+/// at bounce `first_bounce + depth`) to its first non-specular hit: that point, the incoming
+/// direction and the throughput of the specular chain. `None` if it escapes or is absorbed.
+pub fn first_non_specular(
+    ctx: &Context,
+    mut o: Vec3,
+    mut d: Vec3,
+    s: &Sampler,
+    first_bounce: u32,
+    rays: &mut RayCounts,
+) -> Option<(SurfacePoint, Vec3, Vec3)> {
+    let scene = ctx.scene;
+    let mut beta = Vec3::ONE;
+    for depth in 0..=ctx.settings.max_depth {
+        rays.gather += 1;
+        let hit = scene.intersect(o, d, f32::INFINITY)?;
+        let sp = scene.surface(&hit);
+        let bsdf = &scene.materials[sp.material as usize].bsdf;
+        if !bsdf.is_delta() {
+            return Some((sp, d, beta));
+        }
+        let next = continue_ray(&sp, bsdf, -d, s, first_bounce + depth)?;
+        beta *= next.weight;
+        (o, d) = (next.origin, next.dir);
+    }
+    None
+}
+
+/// Radiance emitted by triangle `tri` toward `wo` (zero from its back face or a non-emitter).
+#[inline]
+#[must_use]
+pub fn emission_toward(scene: &Scene, tri: u32, wo: Vec3) -> Vec3 {
+    let e = scene.materials[scene.material[tri as usize] as usize].emission;
+    if e != Vec3::ZERO && wo.dot(scene.ng[tri as usize]) > 0.0 {
+        e
+    } else {
+        Vec3::ZERO
+    }
+}

@@ -1,0 +1,68 @@
+//! The random-stream layout, in one place. Every number a render draws is
+//! `Sampler::get(bounce, dimension)` of a stream keyed by (seed, domain, path index), or of a
+//! sub-stream forked from one with a tag below. Both photon-mapping engines and the path tracer
+//! draw the same numbers for the same decision, which is what makes their images agree.
+//!
+//! Camera path of sample `i` (`Domain::Camera`, index `i`):
+//! - bounce 0, dims 0–1: the jitter inside the pixel;
+//! - bounce `d + 1`, dims 0–2: the BSDF sample leaving the `d`-th hit (mirror, glass, or in the
+//!   path tracer any surface); dim 3: the path tracer's Russian roulette;
+//! - fork [`light`]`(d)`: direct light at the `d`-th hit, bounce `j` = light sample `j`
+//!   (dim 0 picks the light, dims 1–2 the point on it);
+//! - fork [`gather`]`(d)`: final gather at the `d`-th hit, bounce `g` dims 0–1 = direction of
+//!   gather ray `g`; the ray's own specular chain forks [`gather_ray`]`(g)` and samples from bounce 0;
+//! - fork [`glossy`]`(d)`: the glossy lobe at the `d`-th hit, bounce 0 dims 0–1 = its direction;
+//!   its specular chain samples from bounce 1; direct light where it lands forks
+//!   [`GLOSSY_HIT_LIGHT`].
+//!
+//! Photon path `i` (`Domain::GlobalPhoton` or `Domain::CausticPhoton`, index `i`): bounce 0
+//! dim 0 picks the light, dims 1–4 sample its emission; bounce `b + 1` dims 0–2 sample the BSDF
+//! at the `b`-th hit and dim 3 decides Russian roulette.
+//!
+//! The path tracer's direct light at depth `d` forks [`path_light`]`(d)`.
+
+/// Tags of the per-hit sub-streams of a camera path (added to the hit's depth).
+const GATHER: u64 = 1 << 32;
+const GLOSSY: u64 = 2 << 32;
+const LIGHT: u64 = 3 << 32;
+
+/// Bounce of a camera stream whose dimensions 0–1 jitter the sample in its pixel.
+pub const JITTER_BOUNCE: u32 = 0;
+/// Bounce at which a glossy ray's specular chain starts drawing (bounce 0 chose its direction).
+pub const GLOSSY_CHAIN_BOUNCE: u32 = 1;
+/// Bounce at which a camera path's specular chain starts drawing (bounce 0 jittered it).
+pub const CAMERA_CHAIN_BOUNCE: u32 = 1;
+/// Bounce at which a gather ray's own stream starts drawing for its specular chain.
+pub const GATHER_CHAIN_BOUNCE: u32 = 0;
+/// Fork of a glossy ray's stream for the direct light where it lands.
+pub const GLOSSY_HIT_LIGHT: u64 = 7;
+
+/// Fork tag of direct light at a camera path's `depth`-th hit.
+#[must_use]
+pub const fn light(depth: u32) -> u64 {
+    LIGHT + depth as u64
+}
+
+/// Fork tag of the final gather at a camera path's `depth`-th hit.
+#[must_use]
+pub const fn gather(depth: u32) -> u64 {
+    GATHER + depth as u64
+}
+
+/// Fork tag of gather ray `g`'s own stream (forked from the gather stream).
+#[must_use]
+pub const fn gather_ray(g: u32) -> u64 {
+    g as u64
+}
+
+/// Fork tag of the glossy lobe's ray at a camera path's `depth`-th hit.
+#[must_use]
+pub const fn glossy(depth: u32) -> u64 {
+    GLOSSY + depth as u64
+}
+
+/// Fork tag of the path tracer's direct light at depth `depth`.
+#[must_use]
+pub const fn path_light(depth: u32) -> u64 {
+    ((depth as u64) << 32) | 0xd1
+}

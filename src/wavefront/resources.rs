@@ -1,0 +1,80 @@
+//! The resources the wavefront systems share: what every system reads ([`Shared`], [`Maps`])
+//! and the state of the photon pass and of a camera wave, with their queues.
+
+use super::queues::{Classified, PathQueue, PhotonQueue, ShadowQueue};
+use crate::film::Terms;
+use crate::job::Job;
+use crate::photon_map::Photon;
+use crate::rng::Domain;
+use crate::scene::camera::CameraRays;
+use crate::scene::Scene;
+use crate::stats::{Numerics, RayCounts};
+use crate::transport::PhotonMaps;
+use bevy_ecs::prelude::*;
+use std::sync::Arc;
+
+/// What every system reads.
+#[derive(Resource)]
+pub struct Shared {
+    /// The scene.
+    pub scene: Arc<Scene>,
+    /// The render job: settings, plan, worker threads and the pass.
+    pub job: Job,
+}
+
+/// The photon maps (empty until the photon passes are done).
+#[derive(Resource, Default)]
+pub struct Maps(pub Arc<PhotonMaps>);
+
+/// Photon-pass state.
+#[derive(Resource, Default)]
+pub struct PhotonWork {
+    /// Which map this pass fills.
+    pub domain: Option<Domain>,
+    /// Path index of the wave's first photon.
+    pub first_path: u64,
+    /// Batches ([`BATCH`](crate::transport::photon::BATCH) paths each) in this wave.
+    pub batches: usize,
+    /// Photons to trace this bounce.
+    pub queue: PhotonQueue,
+    /// Photons for the next bounce.
+    pub next: PhotonQueue,
+    /// The queue's lanes by outcome.
+    pub classified: Classified,
+    /// Diffuse lanes whose path goes on after deposit.
+    pub survivors: Vec<u32>,
+    /// Stored photons keyed by (path, bounce), the reference engine's order.
+    pub deposits: Vec<(u64, u32, Photon)>,
+    /// Ray segments traced.
+    pub rays: u64,
+    /// Paths dropped for non-finite power, at emission and at a bounce (the photon fields of
+    /// [`Numerics`](Numerics)).
+    pub numerics: Numerics,
+}
+
+/// Camera-pass state for one wave of samples.
+#[derive(Resource)]
+pub struct CameraWork {
+    /// Primary-ray generator.
+    pub camera: CameraRays,
+    /// Global index of the wave's first sample.
+    pub first_sample: u64,
+    /// Samples in the wave.
+    pub count: usize,
+    /// Segments to trace this bounce.
+    pub paths: PathQueue,
+    /// Segments for the next bounce.
+    pub next: PathQueue,
+    /// `paths` lanes by outcome.
+    pub classified: Classified,
+    /// Shadow rays waiting for the next intersect stage.
+    pub shadows: ShadowQueue,
+    /// Per-sample terms of the wave.
+    pub terms: Vec<Terms>,
+    /// The image (per pixel), filled wave by wave.
+    pub film: Vec<Terms>,
+    /// Rays traced.
+    pub rays: RayCounts,
+    /// Samples dropped as non-finite, and pixel sums that overflowed.
+    pub numerics: Numerics,
+}
