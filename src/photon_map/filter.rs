@@ -1,0 +1,67 @@
+//! Which photons a lookup may use: the distance, flags and normal tests of one photon, and the
+//! 8-wide twin that tests a bucket's photons at once with the same operations.
+
+use super::packing::{dequantise8, key_flags, key_normal, oct_decode8, NORMAL_STEPS};
+use super::{Filter, PhotonMap, Test};
+use glam::Vec3;
+use wide::{f32x8, u32x8};
+
+impl PhotonMap {
+    /// Whether photon `key` passes `filter`: flags, and the normal test n·m > 0.7·|m| evaluated as
+    /// n·m > 0 ∧ (n·m)² > 0.49·|m|² (no square root), the same operations as the 8-wide form;
+    /// a rejection says which test failed.
+    #[inline]
+    pub(super) fn test(key: u32, filter: &Filter) -> Test {
+        if key_flags(key) & filter.flags_mask != 0 {
+            return Test::Flags;
+        }
+        let m = key_normal(key);
+        let dot = m.x * filter.n.x + m.y * filter.n.y + m.z * filter.n.z;
+        let len2 = m.x * m.x + m.y * m.y + m.z * m.z;
+        if dot > 0.0 && dot * dot > 0.49 * len2 {
+            Test::Accepted
+        } else {
+            Test::Normal
+        }
+    }
+
+    /// The 8 keys from `base`.
+    #[inline]
+    pub(super) fn key8(&self, base: usize) -> u32x8 {
+        u32x8::from(<[u32; 8]>::try_from(&self.key[base..base + 8]).expect("padded column"))
+    }
+
+    /// The 8 RGBE powers from `base`.
+    #[inline]
+    pub(super) fn power8(&self, base: usize) -> u32x8 {
+        u32x8::from(<[u32; 8]>::try_from(&self.power[base..base + 8]).expect("padded column"))
+    }
+
+    /// Lanes of the 8 photons from `base` that lie within `r2` of `p` and pass `filter`, and the
+    /// lanes within `r2` that pass its flags but fail its normal test.
+    #[inline]
+    pub(super) fn accepts8(&self, base: usize, p: Vec3, r2: f32, filter: &Filter) -> (u32, u32, f32x8) {
+        let load = |c: &[f32]| f32x8::from(<[f32; 8]>::try_from(&c[base..base + 8]).expect("padded column"));
+        let (dx, dy, dz) =
+            (load(&self.x) - f32x8::splat(p.x), load(&self.y) - f32x8::splat(p.y), load(&self.z) - f32x8::splat(p.z));
+        let d2 = dx * dx + dy * dy + dz * dz;
+        let near = d2.simd_lt(f32x8::splat(r2));
+        if !near.any() {
+            return (0, 0, d2);
+        }
+        let key = self.key8(base);
+        let flags = (key >> 12_u32) & u32x8::splat(3);
+        let flags_ok = (flags & u32x8::splat(u32::from(filter.flags_mask))).simd_eq(u32x8::ZERO);
+        let [mx, my, mz] = oct_decode8(
+            dequantise8(key & u32x8::splat(63), NORMAL_STEPS),
+            dequantise8((key >> 6_u32) & u32x8::splat(63), NORMAL_STEPS),
+        );
+        let dot = mx * f32x8::splat(filter.n.x) + my * f32x8::splat(filter.n.y) + mz * f32x8::splat(filter.n.z);
+        let len2 = mx * mx + my * my + mz * mz;
+        let normal_ok = dot.simd_gt(f32x8::ZERO) & (dot * dot).simd_gt(f32x8::splat(0.49) * len2);
+        let inside = near & normal_ok;
+        let flags_bits = flags_ok.to_bitmask();
+        let turned = (near & !normal_ok).to_bitmask() & flags_bits;
+        (inside.to_bitmask() & flags_bits, turned, d2)
+    }
+}

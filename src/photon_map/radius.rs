@@ -1,0 +1,62 @@
+//! Fixed-radius density estimates (progressive passes): every photon within the radius, summed
+//! as the walk finds them — 8 at a time by the SIMD kernel, one at a time by its scalar twin.
+
+use super::{Estimate, Lookup, PhotonMap, Reflectance, Test};
+use crate::kernels::KernelSet;
+use glam::Vec3;
+use wide::f32x8;
+
+impl PhotonMap {
+    /// Reflected radiance at `q.p` from every photon within the fixed radius `q.r_max`.
+    pub fn estimate_radius(&self, set: KernelSet, q: &Lookup, f: Reflectance<'_>) -> Estimate {
+        let r2 = q.r_max * q.r_max;
+        if self.is_empty() || !(r2 > 0.0) || !r2.is_finite() {
+            return Estimate { radius: q.r_max, ..Default::default() };
+        }
+        let (mut count, mut rejected) = (0u32, 0u32);
+        let mut sum = Vec3::ZERO;
+        let mut sum8 = [f32x8::ZERO; 3];
+        let mut r2_walk = r2;
+        self.walk(q.p, &mut r2_walk, |lo, hi, simd_ok, _| {
+            if simd_ok && set == KernelSet::Simd {
+                for base in (lo..hi).step_by(8) {
+                    let (mut m, turned, d2) = self.accepts8(base, q.p, r2, &q.filter);
+                    let valid = (1u32 << (hi - base).min(8)) - 1;
+                    m &= valid;
+                    rejected += (turned & valid).count_ones();
+                    if m == 0 {
+                        continue;
+                    }
+                    count += m.count_ones();
+                    let lanes = f32x8::from(std::array::from_fn::<f32, 8, _>(|l| {
+                        if m >> l & 1 == 1 {
+                            f32::from_bits(u32::MAX)
+                        } else {
+                            0.0
+                        }
+                    }));
+                    let c = Self::contribution8(self.key8(base), self.power8(base), lanes, d2, r2, q.kernel, f);
+                    for (s, v) in sum8.iter_mut().zip(c) {
+                        *s += v;
+                    }
+                }
+            } else {
+                for i in lo..hi {
+                    let d2 = self.d2(i, q.p);
+                    if d2 < r2 {
+                        match Self::test(self.key[i], &q.filter) {
+                            Test::Accepted => {
+                                sum += self.contribution(i, d2, r2, q.kernel, f);
+                                count += 1;
+                            }
+                            Test::Normal => rejected += 1,
+                            Test::Flags => {}
+                        }
+                    }
+                }
+            }
+        });
+        let simd = Vec3::new(sum8[0].reduce_add(), sum8[1].reduce_add(), sum8[2].reduce_add());
+        Estimate { radiance: (sum + simd) * q.kernel.normalisation(r2), radius: q.r_max, count, rejected }
+    }
+}

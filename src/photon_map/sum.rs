@@ -1,0 +1,133 @@
+//! The kernel sum of an estimate: Σ f(ωᵢ)·Φ·K over the photons found, normalised — per photon
+//! in the scalar twin, 8 photons per step in the SIMD kernel.
+
+use super::packing::{dequantise8, key_wi, oct_decode8, rgbe_decode, rgbe_decode8, DIR_STEPS};
+use super::{Estimate, Kernel, Lookup, PhotonMap, Reflectance};
+use crate::kernels::KernelSet;
+use glam::Vec3;
+use wide::{f32x8, u32x8};
+
+impl PhotonMap {
+    /// The kernel estimate over `found` within squared radius `r2`.
+    pub(super) fn sum_estimate(
+        &self,
+        set: KernelSet,
+        q: &Lookup,
+        r2: f32,
+        f: Reflectance<'_>,
+        found: &[(f32, u32)],
+    ) -> Estimate {
+        let sum = match set {
+            KernelSet::Scalar => self.sum_scalar(found, r2, q.kernel, f),
+            KernelSet::Simd => self.sum_simd(found, r2, q.kernel, f),
+        };
+        Estimate {
+            radiance: sum * q.kernel.normalisation(r2),
+            radius: r2.sqrt(),
+            count: found.len() as u32,
+            rejected: 0,
+        }
+    }
+
+    /// f(wi)·Φ·weight of photon `i` at squared distance `d2` (scalar twin of [`Self::contribution8`]).
+    #[inline]
+    pub(super) fn contribution(&self, i: usize, d2: f32, r2: f32, kernel: Kernel, f: Reflectance<'_>) -> Vec3 {
+        let key = self.key[i];
+        let w = kernel.weight(d2, r2);
+        let fp = match f {
+            Reflectance::Constant(v) => v,
+            Reflectance::Hemisphere { value, ng } => {
+                let wi = key_wi(key);
+                if wi.x * ng.x + wi.y * ng.y + wi.z * ng.z > 0.0 {
+                    value
+                } else {
+                    Vec3::ZERO
+                }
+            }
+            Reflectance::PerPhoton(g) => g(key_wi(key).normalize_or_zero()),
+        };
+        fp * rgbe_decode(self.power[i]) * w
+    }
+
+    /// f(wi)·Φ·weight of 8 photons (`key`, `power` columns, squared distances `d2`) in the lanes
+    /// of `lanes` (others 0), per channel.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn contribution8(
+        key: u32x8,
+        power: u32x8,
+        lanes: f32x8,
+        d2: f32x8,
+        r2: f32,
+        kernel: Kernel,
+        f: Reflectance<'_>,
+    ) -> [f32x8; 3] {
+        let w = lanes.select(kernel.weight8(d2, f32x8::splat(r2)), f32x8::ZERO);
+        let [pr, pg, pb] = rgbe_decode8(power);
+        let (pr, pg, pb) = (pr * w, pg * w, pb * w);
+        match f {
+            Reflectance::Constant(v) => [pr * f32x8::splat(v.x), pg * f32x8::splat(v.y), pb * f32x8::splat(v.z)],
+            Reflectance::Hemisphere { value, ng } => {
+                let [wx, wy, wz] = oct_decode8(
+                    dequantise8((key >> 16_u32) & u32x8::splat(255), DIR_STEPS),
+                    dequantise8(key >> 24_u32, DIR_STEPS),
+                );
+                let up =
+                    (wx * f32x8::splat(ng.x) + wy * f32x8::splat(ng.y) + wz * f32x8::splat(ng.z)).simd_gt(f32x8::ZERO);
+                let zero = f32x8::ZERO;
+                [
+                    up.select(pr * f32x8::splat(value.x), zero),
+                    up.select(pg * f32x8::splat(value.y), zero),
+                    up.select(pb * f32x8::splat(value.z), zero),
+                ]
+            }
+            Reflectance::PerPhoton(g) => {
+                let (pr, pg, pb) = (pr.to_array(), pg.to_array(), pb.to_array());
+                let (keys, on) = (key.to_array(), lanes.to_bitmask());
+                let mut out = [[0f32; 8]; 3];
+                for l in 0..8 {
+                    if on >> l & 1 == 1 {
+                        let fp = g(key_wi(keys[l]).normalize_or_zero());
+                        out[0][l] = fp.x * pr[l];
+                        out[1][l] = fp.y * pg[l];
+                        out[2][l] = fp.z * pb[l];
+                    }
+                }
+                out.map(f32x8::from)
+            }
+        }
+    }
+
+    pub(super) fn sum_scalar(&self, found: &[(f32, u32)], r2: f32, kernel: Kernel, f: Reflectance<'_>) -> Vec3 {
+        found.iter().map(|&(d2, i)| self.contribution(i as usize, d2, r2, kernel, f)).sum()
+    }
+
+    pub(super) fn sum_simd(&self, found: &[(f32, u32)], r2: f32, kernel: Kernel, f: Reflectance<'_>) -> Vec3 {
+        let mut acc = [f32x8::ZERO; 3];
+        for chunk in found.chunks(8) {
+            let mut key = [0u32; 8];
+            let mut power = [0u32; 8];
+            let mut d2 = [0f32; 8];
+            let mut lanes = [0f32; 8];
+            for (l, &(d, i)) in chunk.iter().enumerate() {
+                key[l] = self.key[i as usize];
+                power[l] = self.power[i as usize];
+                d2[l] = d;
+                lanes[l] = f32::from_bits(u32::MAX);
+            }
+            let c = Self::contribution8(
+                u32x8::from(key),
+                u32x8::from(power),
+                f32x8::from(lanes),
+                f32x8::from(d2),
+                r2,
+                kernel,
+                f,
+            );
+            for (a, v) in acc.iter_mut().zip(c) {
+                *a += v;
+            }
+        }
+        Vec3::new(acc[0].reduce_add(), acc[1].reduce_add(), acc[2].reduce_add())
+    }
+}
