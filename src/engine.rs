@@ -50,11 +50,7 @@ pub fn render_job(
     }
 }
 
-/// Renders `scene`: once, or — when `settings.passes > 1` or a budget is given — progressive
-/// passes with `settings` as each pass's settings (see [`crate::progressive::per_pass`]). The
-/// settings are validated and the effects plan made here, once for the whole render.
-/// `progress` sees one phase per pass in a single render, or one bar over the passes (or the
-/// budget's milliseconds) in a progressive one.
+/// Renders `scene` with `settings` (validated and planned here, once): see [`render_planned`].
 pub fn render(
     scene: &Arc<Scene>,
     rays: &CameraRays,
@@ -63,7 +59,22 @@ pub fn render(
     budget: Option<Budget>,
     progress: &dyn Progress,
 ) -> Result<(Film, RenderStats)> {
-    let job = Job::new(scene, settings)?;
+    render_planned(scene, rays, &Job::new(scene, settings)?, engine, budget, progress)
+}
+
+/// Renders `scene` as `job` says: once, or — when `settings.passes > 1` or a budget is given —
+/// progressive passes with the job's settings as each pass's (see
+/// [`crate::progressive::per_pass`]). `progress` sees one phase per pass in a single render, or
+/// one bar over the passes (or the budget's milliseconds) in a progressive one.
+pub fn render_planned(
+    scene: &Arc<Scene>,
+    rays: &CameraRays,
+    job: &Job,
+    engine: Engine,
+    budget: Option<Budget>,
+    progress: &dyn Progress,
+) -> Result<(Film, RenderStats)> {
+    let settings = &job.settings;
     if engine != Engine::Path {
         job.plan.check(settings)?;
     }
@@ -78,11 +89,11 @@ pub fn render(
         crate::memory::check(settings.width, settings.height, photons, available, total)?;
     }
     if !is_progressive(settings, budget) {
-        return Ok(render_job(scene, rays, &job, engine, progress));
+        return Ok(render_job(scene, rays, job, engine, progress));
     }
     if engine == Engine::Path {
         return Err(Error::setting("--engine", "progressive passes (--passes, --time) need a photon-mapping engine"));
     }
     let run = |pass: &Job| Ok(render_job(scene, rays, pass, engine, &NoProgress));
-    crate::progressive::render_passes(scene, rays, &job, &run, budget, progress)
+    crate::progressive::render_passes(scene, rays, job, &run, budget, progress)
 }

@@ -353,8 +353,7 @@ pub fn per_pass(settings: &Settings, given: PerPass) -> Settings {
 
 /// The line the CLI prints before a progressive render: passes or budget, and each pass's work.
 #[must_use]
-pub fn describe(scene: &Scene, settings: &Settings, budget: Option<Duration>) -> String {
-    let plan = crate::effects::Effects::plan(scene, settings);
+pub fn describe(plan: &crate::effects::Effects, settings: &Settings, budget: Option<Duration>) -> String {
     let maps: Vec<String> =
         [(plan.global_map.on, settings.photons, "global"), (plan.caustic_map.on, settings.caustic_photons, "caustic")]
             .iter()

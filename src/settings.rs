@@ -173,6 +173,76 @@ impl Preset {
     }
 }
 
+/// Settings given on the command line, each over the scene file's value (`None`: not given).
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    /// `--width`.
+    pub width: Option<u32>,
+    /// `--height`.
+    pub height: Option<u32>,
+    /// `--spp`.
+    pub spp: Option<u32>,
+    /// `--photons`.
+    pub photons: Option<u32>,
+    /// `--caustic-photons`.
+    pub caustic_photons: Option<u32>,
+    /// `--k`: both maps' k.
+    pub k: Option<u32>,
+    /// `--kernel`.
+    pub kernel: Option<Kernel>,
+    /// `--kernels`.
+    pub kernels: Option<crate::kernels::KernelSet>,
+    /// `--gather-rays`.
+    pub gather_rays: Option<u32>,
+    /// `--no-final-gather`.
+    pub no_final_gather: bool,
+    /// `--visibility` (turns it on; the scene file may too).
+    pub visibility: bool,
+    /// `--force`, added to the scene file's.
+    pub force: Vec<String>,
+    /// `--passes`.
+    pub passes: Option<u32>,
+    /// `--alpha`.
+    pub alpha: Option<f32>,
+    /// `--max-depth`.
+    pub max_depth: Option<u32>,
+    /// `--seed`.
+    pub seed: Option<u64>,
+    /// `--threads`.
+    pub threads: Option<u32>,
+}
+
+impl Overrides {
+    /// The settings of a render, layered: the scene file's `file`, then `preset`'s amounts of
+    /// work, then these flags. Not validated: [`crate::job::Job::new`] does that once. Also
+    /// returns which amounts are per progressive pass (the preset's and those the flags give).
+    #[must_use]
+    pub fn layer(&self, file: Settings, preset: Option<Preset>) -> (Settings, PerPass) {
+        let mut s = file;
+        let from_preset = preset.map(|p| p.apply(&mut s)).unwrap_or_default();
+        macro_rules! set {
+            ($($f:ident),*) => { $( if let Some(v) = self.$f { s.$f = v; } )* };
+        }
+        set!(width, height, spp, photons, caustic_photons, gather_rays, max_depth, seed, threads, kernel, kernels);
+        set!(passes, alpha);
+        if let Some(k) = self.k {
+            s.k = k;
+            s.caustic_k = k;
+        }
+        s.force.extend(self.force.iter().cloned());
+        if self.no_final_gather {
+            s.final_gather = false;
+        }
+        s.visibility |= self.visibility;
+        let given = PerPass {
+            spp: self.spp.is_some(),
+            photons: self.photons.is_some(),
+            caustic_photons: self.caustic_photons.is_some(),
+        };
+        (s, from_preset | given)
+    }
+}
+
 impl Settings {
     /// Rejects values that make no sense, naming the field.
     pub fn validate(&self) -> Result<()> {

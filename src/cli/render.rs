@@ -1,0 +1,259 @@
+//! `photonwave render SCENE`: loads a scene, layers the settings (scene file, preset, flags),
+//! renders once or progressively, and writes the EXR, the PNG preview and the JSON stats.
+
+use super::bars::Bars;
+use super::{parse_duration, parse_vec3, significant, Say};
+use glam::Vec3;
+use photonwave::engine::{Budget, Engine};
+use photonwave::error::{Error, Result};
+use photonwave::files::{check_outputs, Output};
+use photonwave::job::Job;
+use photonwave::scene::file::{fitted_camera_to, load_scene_lit};
+use photonwave::scene::{Camera, Light, LightPreset};
+use photonwave::settings::{Kernel, Overrides, Preset};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Flags of `render`.
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// Scene file (.toml) or mesh (.obj with its .mtl).
+    pub scene: PathBuf,
+    /// Output EXR (beauty as the default layer, one layer per term).
+    #[arg(short, long, default_value = "out.exr")]
+    pub output: PathBuf,
+    /// Image width in pixels [scene file, else 320].
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels [scene file, else 320].
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Camera position X,Y,Z [scene file, else fitted to the scene bounds].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<Vec3>,
+    /// Point the camera looks at X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<Vec3>,
+    /// Camera up direction X,Y,Z [0,1,0].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<Vec3>,
+    /// Vertical field of view in degrees [scene file, else 40].
+    #[arg(long)]
+    pub fov: Option<f32>,
+    /// Jittered samples per pixel [16].
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Photons to store in the global map [200000].
+    #[arg(long)]
+    pub photons: Option<u32>,
+    /// Photons to store in the caustic map [100000].
+    #[arg(long)]
+    pub caustic_photons: Option<u32>,
+    /// Nearest photons per estimate, both maps [global 64, caustic 48].
+    #[arg(long)]
+    pub k: Option<u32>,
+    /// Density-estimation kernel: box, cone, epanechnikov [cone].
+    #[arg(long)]
+    pub kernel: Option<Kernel>,
+    /// BVH traversal and photon lookups: `simd` (8-wide packets) or `scalar` (their scalar twins,
+    /// for checking) [simd].
+    #[arg(long)]
+    pub kernels: Option<photonwave::kernels::KernelSet>,
+    /// Final-gather rays per camera sample [16].
+    #[arg(long)]
+    pub gather_rays: Option<u32>,
+    /// Read the global map directly at the first diffuse hit instead of final gathering.
+    #[arg(long)]
+    pub no_final_gather: bool,
+    /// Count only photons visible from each estimate's point (no light through thin walls; one
+    /// short occlusion ray per candidate photon) [off, or the scene file's `visibility`].
+    #[arg(long)]
+    pub visibility: bool,
+    /// Force a part of the effects plan on even where the scene does not need it (repeatable):
+    /// caustic_map, global_map, final_gather, refraction, shadow_rays.
+    #[arg(long)]
+    pub force: Vec<String>,
+    /// Progressive passes: each traces fresh photons and estimates with fixed radii that shrink
+    /// pass by pass (α); the image is their mean [1 = one k-nearest-neighbour render].
+    #[arg(long)]
+    pub passes: Option<u32>,
+    /// Time budget, e.g. `30s`, `500ms`, `2m`: progressive passes until it is spent, ending
+    /// within 5 % of it (counted from the start, scene loading included).
+    #[arg(long, value_parser = parse_duration)]
+    pub time: Option<std::time::Duration>,
+    /// Radius reduction of progressive passes, r²ᵢ₊₁ = r²ᵢ·(i+α)/(i+1) [0.6667].
+    #[arg(long)]
+    pub alpha: Option<f32>,
+    /// Longest photon path / specular chain [10].
+    #[arg(long)]
+    pub max_depth: Option<u32>,
+    /// Seed of all random streams [1].
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Worker threads, 0 = all cores [0].
+    #[arg(long)]
+    pub threads: Option<u32>,
+    /// Write the summary as JSON to this file.
+    #[arg(long)]
+    pub stats: Option<PathBuf>,
+    /// Write a tone-mapped PNG preview to this file.
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// Engine: `wavefront` (bevy_ecs stages over SoA queues), `reference` (scalar photon mapper)
+    /// or `path` (unbiased path tracer, for validation).
+    #[arg(long, default_value = "wavefront")]
+    pub engine: Engine,
+    /// Amounts of work (spp, photons, gather rays, passes) from a named preset, over the scene
+    /// file's settings and under these flags: `preview`, `default`, or `reference` (a long
+    /// progressive run to measure other renders against).
+    #[arg(long)]
+    pub preset: Option<Preset>,
+    /// Add a light to the scene, placed from the camera (repeatable): `headlight` (a point light
+    /// at the eye) or `sun` (a directional light from above and behind the camera). For meshes
+    /// that bring no light, such as a bare OBJ from a model library.
+    #[arg(long, value_enum)]
+    pub light: Vec<LightPreset>,
+    /// Print errors only: no plan, warnings, progress bars or summary.
+    #[arg(long, short, conflicts_with = "verbose")]
+    pub quiet: bool,
+    /// Also print per-system runs, lanes and times (wavefront engine).
+    #[arg(long, short)]
+    pub verbose: bool,
+}
+
+/// The camera a render uses: the scene file's, else one fitted to `bounds` for an image of
+/// `aspect`, with the CLI's `--eye`, `--target`, `--up` and `--fov` over either.
+fn view(args: &RenderArgs, file: Option<Camera>, bounds: (Vec3, Vec3), aspect: f32) -> Camera {
+    let fov = args.fov.or(file.map(|c| c.fov_deg)).unwrap_or(40.0);
+    let mut camera = file.unwrap_or_else(|| fitted_camera_to(bounds, fov, aspect));
+    camera.fov_deg = fov;
+    camera.eye = args.eye.unwrap_or(camera.eye);
+    camera.target = args.target.unwrap_or(camera.target);
+    camera.up = args.up.unwrap_or(camera.up);
+    camera
+}
+
+/// The flags that override the scene file's settings.
+fn overrides(args: &RenderArgs) -> Overrides {
+    Overrides {
+        width: args.width,
+        height: args.height,
+        spp: args.spp,
+        photons: args.photons,
+        caustic_photons: args.caustic_photons,
+        k: args.k,
+        kernel: args.kernel,
+        kernels: args.kernels,
+        gather_rays: args.gather_rays,
+        no_final_gather: args.no_final_gather,
+        visibility: args.visibility,
+        force: args.force.clone(),
+        passes: args.passes,
+        alpha: args.alpha,
+        max_depth: args.max_depth,
+        seed: args.seed,
+        threads: args.threads,
+    }
+}
+
+/// Runs `render`.
+pub fn run(args: RenderArgs) -> Result<()> {
+    let t0 = Instant::now();
+    let say = Say { quiet: args.quiet, verbose: args.verbose };
+    let mut outputs = vec![Output { flag: "--output", path: &args.output, ext: "exr" }];
+    outputs.extend(args.png.as_deref().map(|path| Output { flag: "--png", path, ext: "png" }));
+    outputs.extend(args.stats.as_deref().map(|path| Output { flag: "--stats", path, ext: "json" }));
+    // Every output is checked before any work, and again against every file the scene read.
+    check_outputs(&outputs, std::slice::from_ref(&args.scene))?;
+    // `--light` presets are placed from the camera, which may be fitted to the meshes' bounds
+    // for the image's aspect ratio (as the flags or the defaults give it: a scene file that sets
+    // a size has a camera too).
+    let default = photonwave::settings::Settings::default();
+    let cli_aspect = args.width.unwrap_or(default.width) as f32 / args.height.unwrap_or(default.height).max(1) as f32;
+    let added = |bounds: (Vec3, Vec3), file: Option<Camera>| -> Vec<Light> {
+        let c = view(&args, file, bounds, cli_aspect);
+        args.light.iter().map(|preset| preset.light(c.eye, c.target, c.up)).collect()
+    };
+    let loaded = load_scene_lit(&args.scene, &added)?;
+    check_outputs(&outputs, &loaded.inputs)?;
+    let scene = std::sync::Arc::new(loaded.scene);
+    let (settings, per_pass) = overrides(&args).layer(loaded.settings, args.preset);
+    // Validated and planned once, for the whole render.
+    let job = Job::new(&scene, &settings)?;
+    let settings = &job.settings;
+    let camera = view(&args, loaded.camera, scene.mesh_bounds(), settings.width as f32 / settings.height as f32);
+    let rays = camera.prepare(settings.width, settings.height)?;
+    let load_s = t0.elapsed().as_secs_f64();
+
+    for w in &scene.warnings {
+        say.warn(w);
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if job.threads > 2 * cores {
+        say.warn(format!(
+            "{} threads on {cores} cores: threads beyond the cores only add switching (measured 20× slower \
+             at 1024 on 2 cores); 0 uses every core",
+            job.threads
+        ));
+    }
+    say.info(format!(
+        "scene: {} triangles, {} materials, lights: {} ({} emissive triangles), total power {} W\n",
+        scene.triangle_count(),
+        scene.materials.len(),
+        scene.lights.len(),
+        scene.area_lights.len(),
+        significant(scene.total_power().element_sum() / 3.0)
+    ));
+    if args.engine == Engine::Path {
+        say.info(
+            "plan: path tracing with next-event estimation — every term sampled from the camera; no photon maps\n",
+        );
+    } else {
+        say.info(job.plan.describe());
+    }
+    let bars = Bars::new(args.quiet);
+    let budget = args.time.map(|limit| Budget { limit, start: t0 });
+    let job = if photonwave::engine::is_progressive(settings, budget) {
+        let pass = Job { settings: photonwave::progressive::per_pass(settings, per_pass), ..job.clone() };
+        if args.engine != Engine::Path {
+            say.info(photonwave::progressive::describe(&pass.plan, &pass.settings, args.time));
+        }
+        pass
+    } else {
+        job
+    };
+    let settings = &job.settings;
+    let (film, mut stats) = photonwave::engine::render_planned(&scene, &rays, &job, args.engine, budget, &bars)?;
+    if let Some(w) = stats.progressive.as_ref().and_then(photonwave::progressive::budget_warning) {
+        say.warn(w);
+    }
+    if stats.progressive.is_none() {
+        let short = [
+            stats.global_map.shortfall("global", settings.photons.into()),
+            stats.caustic_map.shortfall("caustic", settings.caustic_photons.into()),
+        ];
+        for w in short.into_iter().flatten() {
+            say.warn(w);
+        }
+    }
+    stats.scene = args.scene.display().to_string();
+    stats.times.load_s = load_s;
+    stats.times.total_s += load_s;
+
+    film.write_exr(&args.output)?;
+    say.info(format!("wrote {}\n", args.output.display()));
+    if let Some(p) = &args.png {
+        film.write_png(p)?;
+        say.info(format!("wrote {}\n", p.display()));
+    }
+    say.info(stats.summary());
+    if say.verbose {
+        say.info(stats.stage_summary());
+    }
+    if let Some(p) = &args.stats {
+        let json = serde_json::to_string_pretty(&stats).map_err(|e| Error::output(p, e))?;
+        photonwave::files::write_bytes(p, json.as_bytes())?;
+        say.info(format!("wrote {}\n", p.display()));
+    }
+    Ok(())
+}
