@@ -45,7 +45,7 @@ fn run_workers(threads: usize, copies: usize, worker: &(dyn Fn() + Sync)) {
     }
 }
 
-/// Runs `work(chunk_index, range)` over `0..n` in chunks of `chunk` on `threads` threads and
+/// Runs `work(range)` over `0..n` in chunks of `chunk` on `threads` threads and
 /// returns the results in chunk order. `done(k)` is called after each chunk with its size.
 pub fn map_chunks<T: Send>(
     n: usize,

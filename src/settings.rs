@@ -72,7 +72,7 @@ pub struct Settings {
     /// Final-gather rays that end on a Lambertian surface read irradiance precomputed at every
     /// 4th global photon (Christensen 1999) instead of a full density estimate: one
     /// nearest-neighbour search instead of k. Slightly blurrier, several times faster. Not used
-    /// by progressive passes, where it would be biased (see `reference::precompute_irradiance`).
+    /// by progressive passes, where it would be biased (see `transport::maps::precompute_irradiance`).
     pub precompute_irradiance: bool,
     /// Longest photon path and longest specular chain of a camera path (bounces).
     pub max_depth: u32,

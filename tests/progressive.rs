@@ -324,7 +324,7 @@ fn pixel_radii_follow_the_photon_density() {
 /// Progressive passes converge to the path tracer's indirect light (caustics included; the path
 /// tracer files them under `indirect`), and never read irradiance precomputed at photons: under
 /// small fixed radii that was biased low, 3.6 % after 64 passes and 5.2 % after 512 on this
-/// scene (src/reference/mod.rs, `precompute_irradiance`).
+/// scene (src/transport/maps.rs, `precompute_irradiance`).
 ///
 /// Tolerance: 3 standard errors of the mean per-pixel difference (structure cancels; measured
 /// 0.8 % of the mean) plus 2 % for the fixed radii's remaining blur at edges and corners

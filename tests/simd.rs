@@ -148,7 +148,7 @@ fn lookups_honour_the_radius_and_the_filters_exactly() {
 #[test]
 fn photon_packing_stays_within_its_stated_error_bounds() {
     // 20 bytes a photon: power per channel within 2⁻⁷ of the largest channel (dithered), incoming direction
-    // within 1°, normal within 4° (photon_map.rs module notes).
+    // within 1°, normal within 4° (photon_map/mod.rs module notes).
     assert_eq!(PhotonMap::bytes_per_photon(), 20);
     let photons: Vec<Photon> = (0..5000u64)
         .map(|i| {
