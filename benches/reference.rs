@@ -4,7 +4,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec3;
-use photonwave::kernels::KernelSet;
+use photonwave::code_path::CodePath;
 use photonwave::photon_map::{Filter, Lookup, Reflectance};
 use photonwave::reference::build_maps;
 use photonwave::rng::{Domain, Sampler};
@@ -73,7 +73,7 @@ fn density(c: &mut Criterion) {
                     filter: Filter { n: *n, flags_mask: 0 },
                 };
                 sum +=
-                    maps.global.estimate(KernelSet::Simd, &q, Reflectance::Constant(Vec3::ONE), &mut scratch).radiance;
+                    maps.global.estimate(CodePath::Simd, &q, Reflectance::Constant(Vec3::ONE), &mut scratch).radiance;
             }
             black_box(sum)
         })

@@ -8,8 +8,8 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec3;
 use photonwave::bench::RaySets;
+use photonwave::code_path::CodePath;
 use photonwave::geometry::packet::{closest_packets, occluded_packets};
-use photonwave::kernels::KernelSet;
 use photonwave::photon_map::{Filter, Lookup, Reflectance};
 use photonwave::reference::build_maps;
 use photonwave::scene::file::load_scene;
@@ -66,7 +66,7 @@ fn density(c: &mut Criterion) {
     let r = settings.global_radius * s.diagonal();
     let mut g = c.benchmark_group("simd_density");
     g.throughput(Throughput::Elements(queries.len() as u64));
-    for set in [KernelSet::Simd, KernelSet::Scalar] {
+    for set in [CodePath::Simd, CodePath::Scalar] {
         let name = format!("{set:?}").to_lowercase();
         let lookup =
             |p, n, k, r_max| Lookup { p, k, r_max, kernel: settings.kernel, filter: Filter { n, flags_mask: 0 } };

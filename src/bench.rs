@@ -127,7 +127,7 @@ impl RaySets {
             let d = Frame::new(ng).to_world(cosine_hemisphere([s.get(0, 3), s.get(0, 4)]));
             diffuse.push(RayQuery::new(offset_ray_origin(sp.p, sp.p_error, ng, d), d, f32::INFINITY));
         }
-        diffuse.sort_by_key(|r| crate::kernels::coherence_key(r.origin, r.direction, scene.bounds));
+        diffuse.sort_by_key(|r| crate::code_path::coherence_key(r.origin, r.direction, scene.bounds));
         RaySets { camera, shadow, diffuse, hits }
     }
 }
@@ -352,7 +352,7 @@ const QUERIES: usize = 65_536;
 /// Lambertian reflectance. `knn`: the k = 64 nearest under the default maximum radius;
 /// `radius`: every photon within a fixed radius, the median radius the k-NN lookups found.
 fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usize) -> Vec<DensityRow> {
-    use crate::kernels::KernelSet;
+    use crate::code_path::CodePath;
     use crate::photon_map::{Filter, Lookup, Reflectance};
     use crate::reference::build_maps;
     use crate::settings::Settings;
@@ -377,7 +377,7 @@ fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usiz
         filter: Filter { n, flags_mask: 0 },
     };
     let f = |n: Vec3| Reflectance::Hemisphere { value: Vec3::splat(0.5 / std::f32::consts::PI), ng: n };
-    let knn = |set: KernelSet| {
+    let knn = |set: CodePath| {
         map_chunks(
             queries.len(),
             CHUNK,
@@ -393,7 +393,7 @@ fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usiz
         )
         .concat()
     };
-    let radius_lookup = |set: KernelSet, r: f32| {
+    let radius_lookup = |set: CodePath, r: f32| {
         map_chunks(
             queries.len(),
             CHUNK,
@@ -409,16 +409,16 @@ fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usiz
         .into_iter()
         .sum::<f32>()
     };
-    let radii: Vec<f64> = knn(KernelSet::Scalar).iter().map(|e| f64::from(e.radius)).collect();
+    let radii: Vec<f64> = knn(CodePath::Scalar).iter().map(|e| f64::from(e.radius)).collect();
     let r_fixed = if radii.is_empty() { r_max } else { median(radii) as f32 };
-    let (ts, tk) = time_pair(reps, || drop(knn(KernelSet::Simd)), || drop(knn(KernelSet::Scalar)));
+    let (ts, tk) = time_pair(reps, || drop(knn(CodePath::Simd)), || drop(knn(CodePath::Scalar)));
     let (rs, rk) = time_pair(
         reps,
         || {
-            std::hint::black_box(radius_lookup(KernelSet::Simd, r_fixed));
+            std::hint::black_box(radius_lookup(CodePath::Simd, r_fixed));
         },
         || {
-            std::hint::black_box(radius_lookup(KernelSet::Scalar, r_fixed));
+            std::hint::black_box(radius_lookup(CodePath::Scalar, r_fixed));
         },
     );
     let n = queries.len() as f64;

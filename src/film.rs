@@ -76,11 +76,13 @@ impl Terms {
         self.emitted + self.direct + self.specular + self.caustic + self.indirect
     }
     /// The terms as an array, in [`Term::ALL`] order.
+    #[inline]
     #[must_use]
     pub fn as_array(&self) -> [Vec3; 5] {
-        Term::ALL.map(|t| self.get(t))
+        [self.emitted, self.direct, self.specular, self.caustic, self.indirect]
     }
     /// The value of term `t`.
+    #[inline]
     #[must_use]
     pub fn get(&self, t: Term) -> Vec3 {
         match t {
@@ -92,6 +94,7 @@ impl Terms {
         }
     }
     /// Adds `v` to term `t`.
+    #[inline]
     pub fn add(&mut self, t: Term, v: Vec3) {
         match t {
             Term::Emitted => self.emitted += v,
@@ -102,6 +105,7 @@ impl Terms {
         }
     }
     /// True if every component is finite.
+    #[inline]
     #[must_use]
     pub fn is_finite(&self) -> bool {
         self.as_array().iter().all(|v| v.is_finite())

@@ -16,7 +16,7 @@
 //! - [`progress`]: the progress-reporting trait;
 //! - [`files`]: checked reads, atomic writes and output checks;
 //! - [`memory`]: the memory a render needs against what the machine has;
-//! - [`kernels`]: the SIMD-or-scalar choice for traversal and photon lookups;
+//! - [`code_path`]: the SIMD kernels or their scalar twins, for traversal and photon lookups;
 //! - [`geometry`]: triangles, the BVH, single-ray and 8-wide packet traversal;
 //!
 //! **Data** — records and their own methods:
@@ -51,6 +51,7 @@
 #![warn(missing_docs)]
 
 pub mod bench;
+pub mod code_path;
 pub mod compare;
 pub mod effects;
 pub mod engine;
@@ -60,7 +61,6 @@ pub mod film;
 pub mod fuzzing;
 pub mod geometry;
 pub mod job;
-pub mod kernels;
 pub mod material;
 pub mod memory;
 pub mod parallel;

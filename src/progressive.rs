@@ -19,10 +19,10 @@
 //! The driver ([`render_passes`]) takes a closure that renders one pass of a [`Job`], so it
 //! knows nothing of the engines; it owns the time budget ([`Budget`]).
 
+use crate::code_path::CodePath;
 use crate::error::Result;
 use crate::film::{Film, Terms};
 use crate::job::{FixedRadii, Job, Pass, PixelRadii};
-use crate::kernels::KernelSet;
 use crate::parallel::map_chunks;
 use crate::photon_map::{flags, Filter, Kernel, Lookup, PhotonMap};
 use crate::progress::Progress;
@@ -71,7 +71,7 @@ pub fn radius2_scale(i: u32, alpha: f32) -> f64 {
 /// within `r_max`), over up to [`RADIUS_SAMPLES`] photons spread through the map. `None` for an
 /// empty map or when no sampled photon has k neighbours within `r_max`.
 #[must_use]
-pub fn median_knn_radius(map: &PhotonMap, k: u32, r_max: f32, kernels: KernelSet) -> Option<f32> {
+pub fn median_knn_radius(map: &PhotonMap, k: u32, r_max: f32, code_path: CodePath) -> Option<f32> {
     if map.is_empty() {
         return None;
     }
@@ -88,7 +88,7 @@ pub fn median_knn_radius(map: &PhotonMap, k: u32, r_max: f32, kernels: KernelSet
                 kernel: Kernel::Box,
                 filter: Filter { n: p.normal, flags_mask: 0 },
             };
-            map.nearest(kernels, &q, &mut scratch);
+            map.nearest(code_path, &q, &mut scratch);
             (scratch.len() == k as usize).then(|| scratch.iter().map(|c| c.0).fold(0.0, f32::max).sqrt())
         })
         .collect();
@@ -120,8 +120,8 @@ pub fn initial_radii(scene: &Scene, rays: &CameraRays, job: &Job) -> FixedRadii 
     };
     let (maps, _, _) = build_job_maps(scene, &pilot);
     let uniform = FixedRadii::uniform(
-        median_knn_radius(&maps.global, settings.k, r_global, settings.kernels).unwrap_or(r_global),
-        median_knn_radius(&maps.caustic, settings.caustic_k, r_caustic, settings.kernels).unwrap_or(r_caustic),
+        median_knn_radius(&maps.global, settings.k, r_global, settings.code_path).unwrap_or(r_global),
+        median_knn_radius(&maps.caustic, settings.caustic_k, r_caustic, settings.code_path).unwrap_or(r_caustic),
     );
     let first = Job { pass: Pass { seed: settings.seed, radii: None }, ..job.clone() };
     let pixels = settings.per_pixel_radii.then(|| Arc::new(pixel_radii(scene, rays, &first, &maps, &uniform)));
@@ -149,7 +149,7 @@ pub fn pixel_radii(
     let pixels = w * settings.height as usize;
     let want_global = ctx.effects.global_map.on && !ctx.effects.final_gather.on;
     let knn = |map: &PhotonMap, k: u32, r_max: f32, q: Lookup, scratch: &mut Vec<(f32, u32)>| {
-        map.nearest(settings.kernels, &Lookup { k: k as usize, r_max, ..q }, scratch);
+        map.nearest(settings.code_path, &Lookup { k: k as usize, r_max, ..q }, scratch);
         let r = scratch.iter().map(|c| c.0).fold(0.0, f32::max).sqrt();
         if scratch.len() == k as usize && r > 0.0 && r.is_finite() {
             r

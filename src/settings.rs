@@ -62,9 +62,11 @@ pub struct Settings {
     pub caustic_radius: f32,
     /// Density-estimation kernel for both maps.
     pub kernel: Kernel,
-    /// SIMD kernels (`simd`, the default) or their scalar twins (`scalar`) for BVH traversal
-    /// and photon lookups; the images agree (tests/simd.rs).
-    pub kernels: crate::kernels::KernelSet,
+    /// The code path of BVH traversal and photon lookups: the SIMD kernels (`simd`, the
+    /// default) or their scalar twins (`scalar`); the images agree (tests/simd.rs). Named
+    /// `kernels` before issue 14; that key is still read.
+    #[serde(alias = "kernels")]
+    pub code_path: crate::code_path::CodePath,
     /// Final-gather rays per camera sample.
     pub gather_rays: u32,
     /// Final gather (true) or read the global map directly at the first diffuse hit (false).
@@ -120,7 +122,7 @@ impl Default for Settings {
             global_radius: 0.05,
             caustic_radius: 0.015,
             kernel: Kernel::Cone,
-            kernels: crate::kernels::KernelSet::Simd,
+            code_path: crate::code_path::CodePath::Simd,
             gather_rays: 16,
             final_gather: true,
             precompute_irradiance: true,
@@ -190,8 +192,8 @@ pub struct Overrides {
     pub k: Option<u32>,
     /// `--kernel`.
     pub kernel: Option<Kernel>,
-    /// `--kernels`.
-    pub kernels: Option<crate::kernels::KernelSet>,
+    /// `--code-path`.
+    pub code_path: Option<crate::code_path::CodePath>,
     /// `--gather-rays`.
     pub gather_rays: Option<u32>,
     /// `--no-final-gather`.
@@ -223,7 +225,7 @@ impl Overrides {
         macro_rules! set {
             ($($f:ident),*) => { $( if let Some(v) = self.$f { s.$f = v; } )* };
         }
-        set!(width, height, spp, photons, caustic_photons, gather_rays, max_depth, seed, threads, kernel, kernels);
+        set!(width, height, spp, photons, caustic_photons, gather_rays, max_depth, seed, threads, kernel, code_path);
         set!(passes, alpha);
         if let Some(k) = self.k {
             s.k = k;
@@ -306,5 +308,34 @@ impl Settings {
         } else {
             self.threads as usize
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Layering: the scene file's values, then the preset's amounts, then the flags; the amounts
+    /// per progressive pass are the preset's (when it is progressive) and those the flags give.
+    #[test]
+    fn flags_override_the_preset_which_overrides_the_file() {
+        let file = Settings { spp: 3, photons: 7_000, seed: 9, k: 20, ..Settings::default() };
+        let flags = Overrides { spp: Some(5), k: Some(30), no_final_gather: true, ..Default::default() };
+        let (s, given) = flags.layer(file.clone(), Some(Preset::Preview));
+        assert_eq!((s.spp, s.photons, s.gather_rays, s.seed), (5, 50_000, 8, 9));
+        assert_eq!((s.k, s.caustic_k, s.final_gather), (30, 30, false));
+        assert_eq!(given, PerPass { spp: true, photons: false, caustic_photons: false });
+        let (s, given) = Overrides::default().layer(file.clone(), Some(Preset::Reference));
+        assert_eq!((s.passes, given), (512, PerPass { spp: true, photons: true, caustic_photons: true }));
+        assert_eq!(Overrides::default().layer(file.clone(), None).0, file);
+    }
+
+    /// The code path's old key still reads.
+    #[test]
+    fn the_old_kernels_key_still_sets_the_code_path() {
+        let s: Settings = toml::from_str("kernels = \"scalar\"").unwrap();
+        assert_eq!(s.code_path, crate::code_path::CodePath::Scalar);
+        let s: Settings = toml::from_str("code_path = \"scalar\"").unwrap();
+        assert_eq!(s.code_path, crate::code_path::CodePath::Scalar);
     }
 }

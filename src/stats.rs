@@ -148,8 +148,8 @@ pub struct RenderStats {
     pub spp: u32,
     /// Worker threads.
     pub threads: usize,
-    /// Traversal and lookup kernels: simd or scalar.
-    pub kernels: String,
+    /// Code path of traversal and photon lookups: simd or scalar.
+    pub code_path: String,
     /// Seed.
     pub seed: u64,
     /// The effects plan: each part with whether it ran and why (photon-mapping engines only;
@@ -196,7 +196,7 @@ impl RenderStats {
             height: settings.height,
             spp: settings.spp,
             threads,
-            kernels: format!("{:?}", settings.kernels).to_lowercase(),
+            code_path: format!("{:?}", settings.code_path).to_lowercase(),
             seed: settings.seed,
             numerics: Numerics { load_normals: scene.zero_normals, ..Default::default() },
             ..Default::default()
@@ -224,7 +224,7 @@ impl RenderStats {
             }
         };
         format!(
-            "summary ({} engine, {} kernels, {} threads)\n{}{}  rays: {} total ({} camera, {} shadow, {} gather, {} photon)\n  \
+            "summary ({} engine, {} code path, {} threads)\n{}{}  rays: {} total ({} camera, {} shadow, {} gather, {} photon)\n  \
              time: load {:.2} s, global photons {:.2} s, caustic photons {:.2} s, maps {:.2} s, camera {:.2} s, total {:.2} s\n  \
              non-finite values dropped: {} photon emissions, {} photon bounces ({} more with a zero pdf), \
              {} camera samples; \
@@ -232,7 +232,7 @@ impl RenderStats {
              closed scene; \
              {} photons turned away by the normal filter\n",
             self.engine,
-            self.kernels,
+            self.code_path,
             self.threads,
             map("global", &self.global_map),
             map("caustic", &self.caustic_map),

@@ -5,7 +5,7 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use photonwave::kernels::KernelSet;
+use photonwave::code_path::CodePath;
 use photonwave::material::{Bsdf, Material, SurfaceFrame};
 use photonwave::photon_map::{Filter, Lookup, Photon, PhotonMap, Reflectance};
 use photonwave::progress::NoProgress;
@@ -148,7 +148,7 @@ fn every_kernel_returns_a_uniform_density() {
     for kernel in [Kernel::Box, Kernel::Cone, Kernel::Epanechnikov] {
         let q =
             Lookup { p: Vec3::ZERO, k: 100_000, r_max: 50.0 * h, kernel, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
-        let e = map.estimate(KernelSet::Simd, &q, Reflectance::Constant(Vec3::ONE), &mut scratch);
+        let e = map.estimate(CodePath::Simd, &q, Reflectance::Constant(Vec3::ONE), &mut scratch);
         let rel = e.radiance.x * h * h;
         assert!((rel - 1.0).abs() < 0.005, "{kernel:?}: {rel}");
     }
@@ -179,7 +179,7 @@ fn knn_estimate_is_unbiased_on_a_uniform_plane() {
             let p = Vec3::new(0.1 + i as f32 * 0.01, 0.0, 0.1 + j as f32 * 0.01);
             let look =
                 Lookup { p, k: 16, r_max: 0.1, kernel: Kernel::Box, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
-            let e = map.estimate(KernelSet::Simd, &look, Reflectance::Constant(Vec3::ONE), &mut scratch);
+            let e = map.estimate(CodePath::Simd, &look, Reflectance::Constant(Vec3::ONE), &mut scratch);
             sum += e.radiance.x as f64 / n as f64;
             q += 1;
         }
@@ -342,7 +342,7 @@ fn directional_light_irradiance_is_cosine_weighted_by_both_methods() {
                 let q =
                     Lookup { p, k: 400, r_max: 1.0, kernel: Kernel::Box, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
                 let eval = |wi| mat.bsdf.eval(&sp.frame, Vec3::Y, wi);
-                let e = maps.global.estimate(KernelSet::Simd, &q, Reflectance::PerPhoton(&eval), &mut scratch);
+                let e = maps.global.estimate(CodePath::Simd, &q, Reflectance::PerPhoton(&eval), &mut scratch);
                 photon_sum += e.radiance.x;
             }
         }

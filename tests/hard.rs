@@ -79,7 +79,7 @@ fn thin_wall_lets_nothing_through() {
 ///   is ≈ 1/√20 000 = 0.7 %; the 2 % is 2.8 of them.
 #[test]
 fn grazing_light_follows_the_cosine_law() {
-    use photonwave::kernels::KernelSet;
+    use photonwave::code_path::CodePath;
     use photonwave::photon_map::{Filter, Lookup, Reflectance};
     use photonwave::settings::Kernel;
     for deg in [0u32, 60, 85, 89] {
@@ -108,7 +108,7 @@ fn grazing_light_follows_the_cosine_law() {
                 kernel: Kernel::Box,
                 filter: Filter { n: Vec3::Y, flags_mask: 0 },
             };
-            let e = map.estimate_radius(KernelSet::Simd, &q, Reflectance::Constant(Vec3::ONE));
+            let e = map.estimate_radius(CodePath::Simd, &q, Reflectance::Constant(Vec3::ONE));
             let ratio = e.radiance / cos;
             println!("{deg}°, {name}: photon irradiance / cos θ = {ratio} from {} photons", e.count);
             assert!((ratio - Vec3::ONE).abs().max_element() < 0.02, "{deg}°, {name}: {ratio} ({} photons)", e.count);
@@ -150,7 +150,7 @@ fn a_zero_area_emitter_triangle_changes_nothing() {
 /// 3 of them plus 1 % for the tessellated sphere's shading normals bending rays slightly.
 #[test]
 fn light_inside_glass_reaches_the_walls_only_as_caustics() {
-    use photonwave::kernels::KernelSet;
+    use photonwave::code_path::CodePath;
     use photonwave::photon_map::{Filter, Lookup, Reflectance};
     use photonwave::settings::Kernel;
     let loaded = hard("light-in-glass.toml");
@@ -177,7 +177,7 @@ fn light_inside_glass_reaches_the_walls_only_as_caustics() {
     for (name, map) in [("reference", &reference.caustic), ("wavefront", &wavefront.caustic)] {
         for (wall, p, n) in [("back", -Vec3::Z, Vec3::Z), ("floor", -Vec3::Y, Vec3::Y)] {
             let q = Lookup { p, k: 0, r_max: r, kernel: Kernel::Box, filter: Filter { n, flags_mask: 0 } };
-            let e = map.estimate_radius(KernelSet::Simd, &q, Reflectance::Constant(Vec3::ONE));
+            let e = map.estimate_radius(CodePath::Simd, &q, Reflectance::Constant(Vec3::ONE));
             let ratio = e.radiance / expected;
             let tol = 3.0 / (e.count as f32).sqrt() + 0.01;
             println!("{name}, {wall}: caustic irradiance / I·cos θ/D² = {ratio} from {} photons (± {tol})", e.count);
@@ -521,7 +521,7 @@ fn no_photon_leaves_a_watertight_mesh() {
 #[test]
 fn no_photon_crosses_a_corner() {
     photons_turned_away_are_counted_alike();
-    use photonwave::kernels::KernelSet;
+    use photonwave::code_path::CodePath;
     use photonwave::photon_map::{Filter, Lookup, PhotonMap, Reflectance};
     use photonwave::settings::Kernel;
     let loaded = hard("corner.toml");
@@ -536,7 +536,7 @@ fn no_photon_crosses_a_corner() {
             let own = PhotonMap::build(all.iter().copied().filter(|q| q.normal.dot(n) > 0.9).collect());
             let others = all.iter().filter(|q| q.normal.dot(n) <= 0.9 && (q.position - p).length() < 0.2).count();
             assert!(others > 100, "{name}, {side}: only {others} photons of the other surface nearby");
-            for set in [KernelSet::Simd, KernelSet::Scalar] {
+            for set in [CodePath::Simd, CodePath::Scalar] {
                 let q = Lookup { p, k: 64, r_max: 0.2, kernel: Kernel::Box, filter: Filter { n, flags_mask: 0 } };
                 let mut near = Vec::new();
                 map.nearest(set, &q, &mut near);
@@ -558,7 +558,7 @@ fn no_photon_crosses_a_corner() {
                 // The k-nearest search counts those it met while its radius shrank, alike in both
                 // kernel sets.
                 let knn = |set| map.estimate(set, &q, Reflectance::Constant(Vec3::ONE), &mut Vec::new()).rejected;
-                assert_eq!(knn(KernelSet::Simd), knn(KernelSet::Scalar), "{name}, {side}");
+                assert_eq!(knn(CodePath::Simd), knn(CodePath::Scalar), "{name}, {side}");
                 assert!(
                     (e.radiance - e_own.radiance).abs().max_element() <= 1e-5 * e_own.radiance.max_element(),
                     "{name}, {side}, {set:?}"

@@ -290,9 +290,9 @@ fn the_cli_prints_what_is_asked() {
     let (code, e) = run(&["--engine", "path"]);
     assert_eq!(code, 0, "{e}");
     assert!(e.contains("plan: path tracing") && !e.contains("global map    on"), "{e}");
-    assert!(e.contains("(path engine, simd kernels") && !e.contains("not built — \n"), "{e}");
+    assert!(e.contains("(path engine, simd code path") && !e.contains("not built — \n"), "{e}");
     let v = json(&stats);
-    assert_eq!(v["kernels"], "simd");
+    assert_eq!(v["code_path"], "simd");
     assert!(v.get("effects").is_none(), "{v}");
     assert!(v["global_map"]["reason"].as_str().unwrap().contains("path tracer"));
 }

@@ -5,7 +5,7 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use photonwave::kernels::KernelSet;
+use photonwave::code_path::CodePath;
 use photonwave::photon_map::{flags, Filter, Lookup, Photon, PhotonMap, Reflectance};
 use photonwave::rng::{Domain, Sampler};
 use photonwave::sampling::uniform_sphere;
@@ -83,18 +83,18 @@ fn simd_lookups_find_the_same_photons_as_the_scalar_twins() {
         for (k, r_max, flags_mask) in [(1, 0.05, 0), (16, 0.02, 0), (64, 0.1, flags::DIRECT), (200, 0.01, 0)] {
             for kernel in [Kernel::Box, Kernel::Cone, Kernel::Epanechnikov] {
                 let q = Lookup { p, k, r_max, kernel, filter: Filter { n, flags_mask } };
-                map.nearest(KernelSet::Simd, &q, &mut a);
-                map.nearest(KernelSet::Scalar, &q, &mut b);
+                map.nearest(CodePath::Simd, &q, &mut a);
+                map.nearest(CodePath::Scalar, &q, &mut b);
                 assert_eq!(sorted(a.clone()), sorted(b.clone()), "query {qi} {q:?}: different photons");
                 let lambert = Reflectance::Hemisphere { value: Vec3::splat(0.3), ng: n };
                 for f in [Reflectance::Constant(Vec3::ONE), lambert, Reflectance::PerPhoton(&glossy)] {
-                    let es = map.estimate(KernelSet::Simd, &q, f, &mut a);
-                    let ek = map.estimate(KernelSet::Scalar, &q, f, &mut b);
+                    let es = map.estimate(CodePath::Simd, &q, f, &mut a);
+                    let ek = map.estimate(CodePath::Scalar, &q, f, &mut b);
                     assert_eq!(es.count, ek.count, "query {qi}");
                     assert_eq!(es.radius, ek.radius, "query {qi}");
                     assert!(close(es.radiance, ek.radiance), "query {qi}: {:?} vs {:?}", es.radiance, ek.radiance);
-                    let rs = map.estimate_radius(KernelSet::Simd, &q, f);
-                    let rk = map.estimate_radius(KernelSet::Scalar, &q, f);
+                    let rs = map.estimate_radius(CodePath::Simd, &q, f);
+                    let rk = map.estimate_radius(CodePath::Scalar, &q, f);
                     assert_eq!(rs.count, rk.count, "query {qi}: radius lookup counts");
                     assert!(close(rs.radiance, rk.radiance), "query {qi}: {:?} vs {:?}", rs.radiance, rk.radiance);
                 }
@@ -118,7 +118,7 @@ fn lookups_honour_the_radius_and_the_filters_exactly() {
         photons.push(Photon { position: d * 0.02, power: Vec3::ONE, wi: Vec3::Y, normal: Vec3::Y, flags });
     }
     let map = PhotonMap::build(photons);
-    for set in [KernelSet::Simd, KernelSet::Scalar] {
+    for set in [CodePath::Simd, CodePath::Scalar] {
         let q = Lookup {
             p: Vec3::ZERO,
             k: 100,
@@ -192,8 +192,8 @@ fn renders_with_simd_kernels_match_renders_with_scalar_twins() {
             gather_rays: 4,
             ..Default::default()
         };
-        let simd = render(&loaded, &Settings { kernels: KernelSet::Simd, ..base.clone() });
-        let scalar = render(&loaded, &Settings { kernels: KernelSet::Scalar, ..base });
+        let simd = render(&loaded, &Settings { code_path: CodePath::Simd, ..base.clone() });
+        let scalar = render(&loaded, &Settings { code_path: CodePath::Scalar, ..base });
         for (a, b) in simd.beauty().iter().zip(scalar.beauty()) {
             assert!(close(*a, b), "{scene}: {a:?} vs {b:?}");
         }

@@ -56,9 +56,9 @@ pub struct RenderArgs {
     #[arg(long)]
     pub kernel: Option<Kernel>,
     /// BVH traversal and photon lookups: `simd` (8-wide packets) or `scalar` (their scalar twins,
-    /// for checking) [simd].
-    #[arg(long)]
-    pub kernels: Option<photonwave::kernels::KernelSet>,
+    /// for checking) [simd]. `--kernels` is the old name.
+    #[arg(long, alias = "kernels")]
+    pub code_path: Option<photonwave::code_path::CodePath>,
     /// Final-gather rays per camera sample [16].
     #[arg(long)]
     pub gather_rays: Option<u32>,
@@ -143,7 +143,7 @@ fn overrides(args: &RenderArgs) -> Overrides {
         caustic_photons: args.caustic_photons,
         k: args.k,
         kernel: args.kernel,
-        kernels: args.kernels,
+        code_path: args.code_path,
         gather_rays: args.gather_rays,
         no_final_gather: args.no_final_gather,
         visibility: args.visibility,

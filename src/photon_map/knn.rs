@@ -5,19 +5,20 @@
 
 use super::packing::key_normal;
 use super::{Estimate, Lookup, PhotonMap, Reflectance, Test};
-use crate::kernels::KernelSet;
+use crate::code_path::CodePath;
 use glam::Vec3;
 
 impl PhotonMap {
     /// The `k` nearest photons to `q.p` within `q.r_max` that pass `q.filter`, as
     /// (distance², index), unordered, into `out`.
-    pub fn nearest(&self, set: KernelSet, q: &Lookup, out: &mut Vec<(f32, u32)>) {
+    pub fn nearest(&self, set: CodePath, q: &Lookup, out: &mut Vec<(f32, u32)>) {
         self.nearest_counted(set, q, out);
     }
 
     /// [`Self::nearest`], returning how many photons the normal test turned away (see
     /// [`Estimate::rejected`]); both kernel sets count the same photons.
-    pub(super) fn nearest_counted(&self, set: KernelSet, q: &Lookup, out: &mut Vec<(f32, u32)>) -> u32 {
+    #[inline]
+    pub(super) fn nearest_counted(&self, set: CodePath, q: &Lookup, out: &mut Vec<(f32, u32)>) -> u32 {
         out.clear();
         if q.k == 0 || self.is_empty() {
             return 0;
@@ -46,7 +47,7 @@ impl PhotonMap {
         };
         let mut r2 = q.r_max * q.r_max;
         self.walk(q.p, &mut r2, |lo, hi, simd_ok, r2| {
-            if simd_ok && set == KernelSet::Simd {
+            if simd_ok && set == CodePath::Simd {
                 for base in (lo..hi).step_by(8) {
                     let (m, turned, d2) = self.accepts8(base, q.p, *r2, &q.filter);
                     let valid = (1u32 << (hi - base).min(8)) - 1;
@@ -89,7 +90,8 @@ impl PhotonMap {
 
     /// Reflected radiance at `q.p` from its k nearest photons: Σ f(wi_p)·Φ_p·K over the
     /// (k−1)-of-k rule above.
-    pub fn estimate(&self, set: KernelSet, q: &Lookup, f: Reflectance<'_>, scratch: &mut Vec<(f32, u32)>) -> Estimate {
+    #[inline]
+    pub fn estimate(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>, scratch: &mut Vec<(f32, u32)>) -> Estimate {
         if self.is_empty() {
             return Estimate { radius: q.r_max, ..Default::default() };
         }
@@ -103,6 +105,7 @@ impl PhotonMap {
     /// The squared radius of a k-nearest estimate over `found` (the k-th photon's distance, that
     /// photon removed: it lies on the boundary; or `q.r_max`² when fewer were found); `None`
     /// for a zero radius.
+    #[inline]
     pub(super) fn knn_radius2(q: &Lookup, found: &mut Vec<(f32, u32)>) -> Option<f32> {
         let (r2, skip) = if found.len() == q.k {
             // The k-th photon defines r and lies on the boundary: sum the other k − 1.
@@ -131,7 +134,7 @@ impl PhotonMap {
     /// estimate there is zero.
     pub fn estimate_visible(
         &self,
-        set: KernelSet,
+        set: CodePath,
         q: &Lookup,
         f: Reflectance<'_>,
         scratch: &mut Vec<(f32, u32)>,

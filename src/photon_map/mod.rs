@@ -231,7 +231,7 @@ impl PhotonMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernels::KernelSet;
+    use crate::code_path::CodePath;
 
     fn photon(x: f32, z: f32, power: f32) -> Photon {
         Photon { position: Vec3::new(x, 0.0, z), power: Vec3::splat(power), wi: Vec3::Y, normal: Vec3::Y, flags: 0 }
@@ -247,7 +247,7 @@ mod tests {
         let map = PhotonMap::build(photons);
         let f = Reflectance::Constant(Vec3::ONE);
         let mut scratch = Vec::new();
-        for set in [KernelSet::Scalar, KernelSet::Simd] {
+        for set in [CodePath::Scalar, CodePath::Simd] {
             for (k, r) in [(20usize, 0.3f32), (0, 0.2)] {
                 let q = Lookup {
                     p: Vec3::ZERO,
@@ -313,7 +313,7 @@ mod tests {
             let q = Vec3::new(rnd(), 0.0, rnd());
             let lookup =
                 Lookup { p: q, k: 10, r_max: 0.2, kernel: Kernel::Box, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
-            map.nearest(KernelSet::Simd, &lookup, &mut out);
+            map.nearest(CodePath::Simd, &lookup, &mut out);
             let mut got: Vec<f32> = out.iter().map(|c| c.0).collect();
             got.sort_by(f32::total_cmp);
             let mut want: Vec<f32> =

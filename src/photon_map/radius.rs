@@ -2,13 +2,13 @@
 //! as the walk finds them — 8 at a time by the SIMD kernel, one at a time by its scalar twin.
 
 use super::{Estimate, Lookup, PhotonMap, Reflectance, Test};
-use crate::kernels::KernelSet;
+use crate::code_path::CodePath;
 use glam::Vec3;
 use wide::f32x8;
 
 impl PhotonMap {
     /// Reflected radiance at `q.p` from every photon within the fixed radius `q.r_max`.
-    pub fn estimate_radius(&self, set: KernelSet, q: &Lookup, f: Reflectance<'_>) -> Estimate {
+    pub fn estimate_radius(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>) -> Estimate {
         let r2 = q.r_max * q.r_max;
         if self.is_empty() || !(r2 > 0.0) || !r2.is_finite() {
             return Estimate { radius: q.r_max, ..Default::default() };
@@ -18,7 +18,7 @@ impl PhotonMap {
         let mut sum8 = [f32x8::ZERO; 3];
         let mut r2_walk = r2;
         self.walk(q.p, &mut r2_walk, |lo, hi, simd_ok, _| {
-            if simd_ok && set == KernelSet::Simd {
+            if simd_ok && set == CodePath::Simd {
                 for base in (lo..hi).step_by(8) {
                     let (mut m, turned, d2) = self.accepts8(base, q.p, r2, &q.filter);
                     let valid = (1u32 << (hi - base).min(8)) - 1;

@@ -3,23 +3,24 @@
 
 use super::packing::{dequantise8, key_wi, oct_decode8, rgbe_decode, rgbe_decode8, DIR_STEPS};
 use super::{Estimate, Kernel, Lookup, PhotonMap, Reflectance};
-use crate::kernels::KernelSet;
+use crate::code_path::CodePath;
 use glam::Vec3;
 use wide::{f32x8, u32x8};
 
 impl PhotonMap {
     /// The kernel estimate over `found` within squared radius `r2`.
+    #[inline]
     pub(super) fn sum_estimate(
         &self,
-        set: KernelSet,
+        set: CodePath,
         q: &Lookup,
         r2: f32,
         f: Reflectance<'_>,
         found: &[(f32, u32)],
     ) -> Estimate {
         let sum = match set {
-            KernelSet::Scalar => self.sum_scalar(found, r2, q.kernel, f),
-            KernelSet::Simd => self.sum_simd(found, r2, q.kernel, f),
+            CodePath::Scalar => self.sum_scalar(found, r2, q.kernel, f),
+            CodePath::Simd => self.sum_simd(found, r2, q.kernel, f),
         };
         Estimate {
             radiance: sum * q.kernel.normalisation(r2),
@@ -98,10 +99,12 @@ impl PhotonMap {
         }
     }
 
+    #[inline]
     pub(super) fn sum_scalar(&self, found: &[(f32, u32)], r2: f32, kernel: Kernel, f: Reflectance<'_>) -> Vec3 {
         found.iter().map(|&(d2, i)| self.contribution(i as usize, d2, r2, kernel, f)).sum()
     }
 
+    #[inline]
     pub(super) fn sum_simd(&self, found: &[(f32, u32)], r2: f32, kernel: Kernel, f: Reflectance<'_>) -> Vec3 {
         let mut acc = [f32x8::ZERO; 3];
         for chunk in found.chunks(8) {

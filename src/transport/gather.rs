@@ -14,6 +14,7 @@ use glam::Vec3;
 /// shading normal on `wo`'s side, ray `g` drawn from bounce `g` (dims 0–1) of `s`. A direction
 /// below the geometric surface gives no ray but still counts in the estimator's N. Calls
 /// `emit(g, origin, direction)` for each ray, in order.
+#[inline]
 pub fn gather_rays(sp: &SurfacePoint, wo: Vec3, n: u32, s: &Sampler, mut emit: impl FnMut(u32, Vec3, Vec3)) {
     let (ng, ns) = sp.frame.oriented(wo);
     let frame = Frame::new(ns);
@@ -29,6 +30,7 @@ pub fn gather_rays(sp: &SurfacePoint, wo: Vec3, n: u32, s: &Sampler, mut emit: i
 /// The glossy lobe's ray at `sp` seen from `wo`, drawn from bounce 0 (dims 0–1) of `s`, with
 /// its weight; `None` for a material without a glossy lobe or a sample below the surface.
 #[must_use]
+#[inline]
 pub fn glossy_ray(sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler) -> Option<Bounce> {
     let bs = bsdf.sample_glossy(&sp.frame, wo, [s.get(0, 0), s.get(0, 1)])?;
     Some(Bounce {

@@ -90,9 +90,9 @@ fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings,
                     let f = Reflectance::Constant(Vec3::ONE);
                     let e = if settings.visibility {
                         let visible = photon_visibility(scene, src.position, src.normal, radius);
-                        global.estimate_visible(settings.kernels, &lookup, f, &mut scratch, &visible)
+                        global.estimate_visible(settings.code_path, &lookup, f, &mut scratch, &visible)
                     } else {
-                        global.estimate(settings.kernels, &lookup, f, &mut scratch)
+                        global.estimate(settings.code_path, &lookup, f, &mut scratch)
                     };
                     Photon { position: src.position, power: e.radiance, wi: src.normal, normal: src.normal, flags: 0 }
                 })

@@ -26,6 +26,7 @@ pub struct Bounce {
 /// Samples the BSDF at `sp` toward `wo` with the numbers of bounce `bounce` (dims 0–2), for
 /// radiance: the ray that continues the path, or `None` where the sample is absorbed.
 #[must_use]
+#[inline]
 pub fn continue_ray(sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler, bounce: u32) -> Option<Bounce> {
     let u = [s.get(bounce, 0), s.get(bounce, 1), s.get(bounce, 2)];
     let bs = bsdf.sample(&sp.frame, wo, u, Transport::Radiance)?;

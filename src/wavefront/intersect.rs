@@ -24,7 +24,7 @@ fn closest_hits(shared: &Shared, rays: &RayColumns, hits: &mut HitColumns) {
             let queries: Vec<RayQuery> =
                 r.map(|i| RayQuery::new(rays.origin(i), rays.direction(i), f32::INFINITY)).collect();
             let hits =
-                shared.job.settings.kernels.closest_coherent(scene.bvh(), scene.columns(), &queries, scene.bounds);
+                shared.job.settings.code_path.closest_coherent(scene.bvh(), scene.columns(), &queries, scene.bounds);
             part.extend(hits.into_iter())
         },
         |part| hits.append(part),
@@ -68,7 +68,7 @@ pub fn trace_shadow_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
         // Shadow rays are queued in camera-lane order, from neighbouring hits toward the same
         // lights: already coherent, and sorting them cost more than it saved (BENCHMARKS.md).
         let mut blocked = vec![false; queries.len()];
-        shared.job.settings.kernels.occluded(scene.bvh(), scene.columns(), &queries, &mut blocked);
+        shared.job.settings.code_path.occluded(scene.bvh(), scene.columns(), &queries, &mut blocked);
         blocked
     });
     for (i, b) in blocked.into_iter().enumerate() {

@@ -4,7 +4,7 @@
 //! ([`crate::geometry::packet`]) and single-ray traversal ([`crate::geometry::traverse`]); the
 //! 8-wide and one-at-a-time photon lookups ([`crate::photon_map`]). The twins make the same
 //! decisions (same hits, same photons found); sums over photons differ only in rounding order.
-//! The renderer runs [`KernelSet::Simd`] unless `kernels = "scalar"` is set.
+//! The renderer runs [`CodePath::Simd`] unless `code_path = "scalar"` is set.
 
 use crate::geometry::bvh::{Bvh, Hit, TriangleColumns};
 use crate::geometry::{packet, traverse, RayQuery};
@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 /// Which implementation of the SIMD kernels runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
-pub enum KernelSet {
+pub enum CodePath {
     /// 8-wide `wide::f32x8` kernels (the default: fastest, measured in BENCHMARKS.md).
     #[default]
     Simd,
@@ -22,20 +22,20 @@ pub enum KernelSet {
     Scalar,
 }
 
-impl KernelSet {
+impl CodePath {
     /// Closest hits of `rays` into `out`.
     pub fn closest(self, bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [Option<Hit>]) {
         match self {
-            KernelSet::Simd => packet::closest_packets(bvh, tris, rays, out),
-            KernelSet::Scalar => traverse::closest_rays(bvh, tris, rays, out),
+            CodePath::Simd => packet::closest_packets(bvh, tris, rays, out),
+            CodePath::Scalar => traverse::closest_rays(bvh, tris, rays, out),
         }
     }
 
     /// Any-hit tests of `rays` into `out`.
     pub fn occluded(self, bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [bool]) {
         match self {
-            KernelSet::Simd => packet::occluded_packets(bvh, tris, rays, out),
-            KernelSet::Scalar => traverse::occluded_rays(bvh, tris, rays, out),
+            CodePath::Simd => packet::occluded_packets(bvh, tris, rays, out),
+            CodePath::Scalar => traverse::occluded_rays(bvh, tris, rays, out),
         }
     }
 }
@@ -82,7 +82,7 @@ fn in_coherent_order<T: Copy + Default>(
     out
 }
 
-impl KernelSet {
+impl CodePath {
     /// Closest hits of `rays` (in input order); the SIMD set traces them sorted for coherence.
     #[must_use]
     pub fn closest_coherent(
@@ -93,8 +93,8 @@ impl KernelSet {
         bounds: (Vec3, Vec3),
     ) -> Vec<Option<Hit>> {
         match self {
-            KernelSet::Simd => in_coherent_order(rays, bounds, |r, o| packet::closest_packets(bvh, tris, r, o)),
-            KernelSet::Scalar => {
+            CodePath::Simd => in_coherent_order(rays, bounds, |r, o| packet::closest_packets(bvh, tris, r, o)),
+            CodePath::Scalar => {
                 let mut out = vec![None; rays.len()];
                 traverse::closest_rays(bvh, tris, rays, &mut out);
                 out
