@@ -7,6 +7,7 @@
 use super::queues::{PathKind, PathQueue, PhotonLane, PhotonQueue, Segment, ShadowLane, ShadowQueue};
 use super::{par_columns, par_lanes, CameraWork, Maps, PhotonWork, Shared, StageStats, CHUNK};
 use crate::film::{PixelMean, Term};
+use crate::material::Bsdf;
 use crate::rng::{Domain, Sampler};
 use crate::stats::Numerics;
 use crate::transport::direct::{direct_light_rays, ShadowRay};
@@ -192,6 +193,10 @@ pub fn spawn_glossy_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
         let Some(hit) = w.paths.hits.get(i) else { continue };
         let sp = scene.surface(&hit);
         let bsdf = &scene.materials[sp.material as usize].bsdf;
+        // Only glossy materials have the lobe (glossy_ray says so too, after the stream's fork).
+        if !matches!(bsdf, Bsdf::Glossy { .. }) {
+            continue;
+        }
         let gls = Sampler::from_key(w.paths.key[i]).fork(streams::glossy(w.paths.depth[i]));
         let Some(ray) = glossy_ray(&sp, bsdf, -w.paths.rays.direction(i), &gls) else { continue };
         segments.push(Segment {
@@ -240,10 +245,14 @@ fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32]) -> PathQ
                 Some(Segment {
                     origin: next.origin,
                     dir: next.dir,
+                    sample: w.paths.sample[i],
+                    kind: w.paths.kind[i],
+                    key: w.paths.key[i],
+                    base: w.paths.base[i],
                     depth: w.paths.depth[i] + 1,
                     beta: w.paths.beta[i] * next.weight,
+                    term: w.paths.term[i],
                     through_specular: w.paths.kind[i] == PathKind::Camera,
-                    ..w.paths.item(i)
                 })
             }) {
                 part.push(s);
