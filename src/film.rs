@@ -220,8 +220,11 @@ impl Film {
                 channels.push(AnyChannel::new(full.as_str(), FlatSamples::F32(data)));
             }
         }
-        let layer =
-            Layer::new(size, LayerAttributes::default(), Encoding::FAST_LOSSLESS, AnyChannels::sort(channels.into()));
+        // Blocks in increasing order: with the default (unspecified) order the encoder writes
+        // blocks as its threads finish them, and two renders of the same image gave files that
+        // differed byte for byte.
+        let encoding = Encoding { line_order: LineOrder::Increasing, ..Encoding::FAST_LOSSLESS };
+        let layer = Layer::new(size, LayerAttributes::default(), encoding, AnyChannels::sort(channels.into()));
         let image = Image::from_layer(layer);
         crate::files::replace(path, |tmp| image.write().to_file(tmp).map_err(|e| PwError::output(path, e)))
     }
@@ -364,4 +367,41 @@ pub fn read_exr_layer(path: &Path, layer: &str) -> Result<(u32, u32, Vec<Vec3>)>
         .map(|(_, p)| p)
         .ok_or_else(|| PwError::parse(path, 0, format!("EXR has no RGB channels for layer `{layer}`")))?;
     Ok((image.width, image.height, pixels))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The same film written twice gives the same bytes: blocks are written in increasing order,
+    /// not as the encoder's threads finish them (which made 320² renders differ file to file).
+    #[test]
+    fn the_same_film_writes_the_same_bytes() {
+        let (w, h) = (320u32, 320u32);
+        let pixels = (0..w * h)
+            .map(|i| {
+                let v = Vec3::new((i % 97) as f32, (i % 31) as f32, (i % 7) as f32) * 0.01;
+                Terms {
+                    emitted: v,
+                    direct: v * 0.5,
+                    specular: Vec3::ZERO,
+                    caustic: v * v,
+                    indirect: Vec3::new(v.y, v.z, v.x),
+                }
+            })
+            .collect();
+        let film = Film { width: w, height: h, pixels };
+        let dir = std::env::temp_dir().join(format!("photonwave-film-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let bytes = |name: &str| {
+            let path = dir.join(name);
+            film.write_exr(&path).unwrap();
+            std::fs::read(&path).unwrap()
+        };
+        let first = bytes("a.exr");
+        for k in 0..4 {
+            assert!(first == bytes(&format!("b{k}.exr")), "write {k} differs");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
