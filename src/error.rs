@@ -10,15 +10,17 @@ use std::path::{Path, PathBuf};
 // Each variant's doc names and explains its fields.
 #[allow(missing_docs)]
 pub enum Error {
-    /// A file could not be read at all.
+    /// The file at `path` could not be read at all; `message` says why.
     Io { path: PathBuf, message: String },
-    /// A file was read but its content is wrong at a known line (1-based; 0 when unknown).
+    /// The file at `path` was read but its content is wrong at `line` (1-based; 0 when
+    /// unknown), as `message` says.
     Parse { path: PathBuf, line: usize, message: String },
-    /// The scene as a whole cannot be rendered (no light, zero-area emitter, …).
+    /// The scene as a whole cannot be rendered (no light, zero-area emitter, …): `message`.
     Scene { message: String },
-    /// A setting has a value that makes no sense; `field` is its name as the user wrote it.
+    /// A setting has a value that makes no sense; `field` is its name as the user wrote it,
+    /// `message` what is wrong.
     Setting { field: String, message: String },
-    /// Writing an output file failed.
+    /// Writing the output file at `path` failed; `message` says why.
     Output { path: PathBuf, message: String },
 }
 

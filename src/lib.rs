@@ -16,17 +16,17 @@
 //! - [`progress`]: the progress-reporting trait;
 //! - [`files`]: checked reads, atomic writes and output checks;
 //! - [`memory`]: the memory a render needs against what the machine has;
-//! - [`code_path`]: the SIMD kernels or their scalar twins, for traversal and photon lookups;
 //! - [`geometry`]: triangles, the BVH, single-ray and 8-wide packet traversal;
+//! - [`code_path`]: the SIMD kernels or their scalar twins, for traversal and photon lookups;
 //!
 //! **Data** — records and their own methods:
 //! - [`material`]: BSDFs (Lambert, glossy Phong, mirror, glass) and Fresnel;
 //! - [`photon_map`]: the 20-byte photon, the kd-tree, k-NN and fixed-radius density estimates;
-//! - [`settings`]: the user's knobs and their validation;
-//! - [`plan`] and [`effects`]: the effects plan — which terms and machinery a scene needs, and why;
-//! - [`film`]: the five [`film::Term`]s per pixel, EXR and PNG output;
-//! - [`stats`]: plain records of what a render did (rays, times, maps, numerics);
+//! - [`settings`]: the user's knobs, their layering and validation;
 //! - [`scene`]: OBJ/MTL and TOML loading, lights, the camera;
+//! - [`plan`] and [`effects`]: the effects plan — which terms and machinery a scene needs, and why;
+//! - [`stats`]: plain records of what a render did (rays, times, maps, numerics);
+//! - [`film`]: the five [`film::Term`]s per pixel, EXR and PNG output;
 //! - [`job`]: one render's validated settings, plan and pass (seed, progressive radii);
 //!
 //! **Physics** — written once:

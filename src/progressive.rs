@@ -182,7 +182,7 @@ pub fn pixel_radii(
                     };
                     let caustic = knn(&maps.caustic, settings.caustic_k, ctx.caustic_radius, q, &mut scratch);
                     let global = if want_global {
-                        let q = Lookup { filter: Filter { n: ng, flags_mask: flags::DIRECT | flags::CAUSTIC }, ..q };
+                        let q = Lookup { filter: Filter { n: ng, flags_mask: flags::OWN_TERMS }, ..q };
                         knn(&maps.global, settings.k, ctx.global_radius, q, &mut scratch)
                     } else {
                         fallback.global

@@ -80,7 +80,8 @@ pub struct Settings {
     pub max_depth: u32,
     /// Area-light samples per shading point.
     pub light_samples: u32,
-    /// Seed of every random stream.
+    /// The user's seed: a single render and the first progressive pass draw every random
+    /// stream from it; later passes and the pilot pass mix their own from it.
     pub seed: u64,
     /// Worker threads (0 = all cores).
     pub threads: u32,

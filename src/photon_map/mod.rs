@@ -48,6 +48,9 @@ pub mod flags {
     pub const DIRECT: u8 = 1;
     /// Every bounce before this hit was specular (mirror/glass): an `LS+D` caustic photon.
     pub const CAUSTIC: u8 = 2;
+    /// Photons whose light the direct and caustic terms compute on their own: masked wherever
+    /// the global map stands for indirect light only.
+    pub const OWN_TERMS: u8 = DIRECT | CAUSTIC;
 }
 
 /// A stored photon.

@@ -11,7 +11,6 @@
 use crate::film::{Film, Term, Terms};
 use crate::job::Job;
 use crate::material::Bsdf;
-use crate::photon_map::flags;
 use crate::progress::Progress;
 use crate::rng::Sampler;
 use crate::scene::camera::CameraRays;
@@ -19,7 +18,7 @@ use crate::scene::{Scene, SurfacePoint};
 use crate::stats::{Numerics, RayCounts};
 use crate::transport::camera::render_pixels;
 use crate::transport::direct::direct_light;
-use crate::transport::estimate::{caustic_estimate, global_estimate, map_radiance};
+use crate::transport::estimate::{caustic_estimate, indirect_estimate, map_radiance};
 use crate::transport::gather::{gather_rays, glossy_ray};
 use crate::transport::specular::{continue_ray, emission_toward, first_non_specular};
 use crate::transport::{streams, Context, PhotonMaps};
@@ -81,7 +80,7 @@ pub fn trace_camera_path(
             * if ctx.effects.final_gather.on {
                 final_gather(ctx, &sp, &mat.bsdf, wo, &s.fork(streams::gather(depth)), rays, scratch)
             } else {
-                global_estimate(ctx, &sp, &mat.bsdf, wo, flags::DIRECT | flags::CAUSTIC, Some(pixel), scratch)
+                indirect_estimate(ctx, &sp, &mat.bsdf, wo, Some(pixel), scratch)
             };
         let glossy = beta * glossy_reflection(ctx, &sp, &mat.bsdf, wo, &s.fork(streams::glossy(depth)), rays, scratch);
         if through_specular {
@@ -143,6 +142,6 @@ pub fn glossy_reflection(
     let b = &ctx.scene.materials[y.material as usize].bsdf;
     let direct = direct_light(ctx, &y, b, -d, &s.fork(streams::GLOSSY_HIT_LIGHT), rays);
     let caustic = caustic_estimate(ctx, &y, b, -d, None, scratch);
-    let rest = global_estimate(ctx, &y, b, -d, flags::DIRECT | flags::CAUSTIC, None, scratch);
+    let rest = indirect_estimate(ctx, &y, b, -d, None, scratch);
     ray.weight * beta * (direct + caustic + rest)
 }

@@ -13,10 +13,10 @@ use std::f32::consts::PI;
 pub enum Light {
     /// Emissive triangle `tri` (scene BVH order) with radiance `radiance` from its front face.
     Area { tri: u32, radiance: Vec3 },
-    /// Isotropic point light with radiant intensity `intensity` (W/sr).
+    /// Isotropic point light at `position` with radiant intensity `intensity` (W/sr).
     Point { position: Vec3, intensity: Vec3 },
-    /// Spot light: intensity `intensity` inside `cos_inner`, falling linearly in cos θ to zero at
-    /// `cos_outer`.
+    /// Spot light at `position` aimed along unit `direction`: intensity `intensity` inside
+    /// `cos_inner`, falling linearly in cos θ to zero at `cos_outer`.
     Spot { position: Vec3, direction: Vec3, intensity: Vec3, cos_inner: f32, cos_outer: f32 },
     /// Distant light travelling along `direction` with irradiance `irradiance` on a perpendicular plane.
     Directional { direction: Vec3, irradiance: Vec3 },

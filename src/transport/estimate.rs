@@ -5,7 +5,7 @@
 
 use super::Context;
 use crate::material::Bsdf;
-use crate::photon_map::{Filter, Lookup, PhotonMap, Reflectance};
+use crate::photon_map::{flags, Filter, Lookup, PhotonMap, Reflectance};
 use crate::scene::{Scene, SurfacePoint};
 use glam::Vec3;
 use std::sync::atomic::Ordering;
@@ -95,6 +95,21 @@ pub fn global_estimate(
 ) -> Vec3 {
     let fixed = ctx.fixed.map(|r| r.global_at(pixel));
     map_estimate(ctx, &ctx.maps.global, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, fixed, scratch)
+}
+
+/// Indirect light at `sp` toward `wo` from the global map alone: its estimate without direct and
+/// caustic photons ([`flags::OWN_TERMS`]), whose light other terms compute; `pixel` as for
+/// [`caustic_estimate`].
+#[inline]
+pub fn indirect_estimate(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    pixel: Option<usize>,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Vec3 {
+    global_estimate(ctx, sp, bsdf, wo, flags::OWN_TERMS, pixel, scratch)
 }
 
 /// Radiance leaving a non-specular point toward `wo` as the photon maps see it: kd/π × the

@@ -11,7 +11,9 @@
 //! - [`estimate`]: photon-map density estimates at a surface point;
 //! - [`maps`]: the photon maps of a render and Christensen's precomputed irradiance.
 //!
-//! Each function handles one vertex; the loops over rays, paths and pixels belong to the
+//! Each function handles one vertex, except two loops every one-ray engine shares: the pixel
+//! loop ([`camera::render_pixels`]) and a ray's chain through mirrors and glass
+//! ([`specular::first_non_specular`]). The loops over paths, bounces and queues belong to the
 //! engines.
 
 pub mod camera;

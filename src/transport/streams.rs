@@ -1,7 +1,8 @@
 //! The random-stream layout, in one place. Every number a render draws is
 //! `Sampler::get(bounce, dimension)` of a stream keyed by (seed, domain, path index), or of a
-//! sub-stream forked from one with a tag below. Both photon-mapping engines and the path tracer
-//! draw the same numbers for the same decision, which is what makes their images agree.
+//! sub-stream forked from one with a tag below. Both photon-mapping engines draw the same numbers
+//! for the same decision, which is what makes their images agree; the path tracer shares the
+//! camera jitter and BSDF bounces and has its own light stream ([`path_light`]).
 //!
 //! Camera path of sample `i` (`Domain::Camera`, index `i`):
 //! - bounce 0, dims 0–1: the jitter inside the pixel;

@@ -8,9 +8,8 @@ use super::queues::PathKind;
 use super::{par_lanes, CameraWork, Maps, Shared, StageStats, GATHER_CHUNK};
 use crate::film::Term;
 use crate::material::Bsdf;
-use crate::photon_map::flags;
 use crate::scene::SurfacePoint;
-use crate::transport::estimate::{caustic_estimate, global_estimate, map_radiance};
+use crate::transport::estimate::{caustic_estimate, indirect_estimate, map_radiance};
 use crate::transport::Context;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -96,7 +95,7 @@ pub fn gather_global(
         Term::Indirect,
         |ctx, sp, bsdf, wo, kind, pixel, scratch| match kind {
             PathKind::Gather => map_radiance(ctx, sp, bsdf, wo, scratch),
-            _ => global_estimate(ctx, sp, bsdf, wo, flags::DIRECT | flags::CAUSTIC, pixel, scratch),
+            _ => indirect_estimate(ctx, sp, bsdf, wo, pixel, scratch),
         },
     );
     stats.record("gather_global", n, t);

@@ -8,9 +8,9 @@
 //! - rays: origin 12, direction 12 (f32 columns, as traversal reads them);
 //! - hits: triangle 4 (u32::MAX = escaped), t 4, barycentrics 12 (all three, exactly as the
 //!   triangle test returned them, so surface points match the reference engine's bit for bit);
-//! - photons: path index 8, bounce 4, power 12, specular-only flag 1 → 61 B a lane with ray and hit;
+//! - photons: path index 8, bounce 4, power 12, specular-only flag 1 → 69 B a lane with ray and hit;
 //! - camera-pass paths: sample 4, kind 1, sampler key 8, bounce base 1, depth 4, term 1,
-//!   throughput 12, through-specular flag 1 → 64 B a lane with ray and hit;
+//!   throughput 12, through-specular flag 1 → 76 B a lane with ray and hit;
 //! - shadow rays: sample 4, term 1, t_max 4, contribution 12, plus the ray.
 
 use crate::film::Term;
@@ -185,8 +185,7 @@ impl Classified {
 /// (`origin`, `dir`) and the given fields; the queue has the ray as [`RayColumns`], one `Vec`
 /// column per field, and — with `+ hits` — the closest hits of its rays as [`HitColumns`]
 /// (written by the intersect stage, so `push` and `append` leave them alone). Every queue gets
-/// `len`, `is_empty`, `push`, `append`, `reserve`, `clear` and `item`.
-#[macro_export]
+/// `len`, `is_empty`, `push`, `append`, `reserve` and `clear`.
 macro_rules! soa_queue {
     (
         $(#[$qmeta:meta])* queue $queue:ident $(+ $hits:ident)?;
@@ -208,10 +207,10 @@ macro_rules! soa_queue {
         #[derive(Clone, Debug, Default, PartialEq)]
         pub struct $queue {
             /// Rays, one per lane.
-            pub rays: $crate::wavefront::queues::RayColumns,
+            pub rays: RayColumns,
             $(
                 /// Closest hits of `rays`, one per lane, as the last intersect stage found them.
-                pub $hits: $crate::wavefront::queues::HitColumns,
+                pub $hits: HitColumns,
             )?
             $($(#[$fmeta])* pub $field: Vec<$ty>,)*
         }
@@ -248,11 +247,6 @@ macro_rules! soa_queue {
                 self.rays.clear();
                 $(self.$hits.clear();)?
                 $(self.$field.clear();)*
-            }
-            /// Lane `i` as a work item.
-            #[must_use]
-            pub fn item(&self, i: usize) -> $item {
-                $item { origin: self.rays.origin(i), dir: self.rays.direction(i), $($field: self.$field[i],)* }
             }
         }
     };

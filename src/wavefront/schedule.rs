@@ -1,4 +1,4 @@
-//! The recipe: the four schedules (photon pass and bounce, camera pass and bounce), the order
+//! The recipe: the four schedules (photon wave and bounce, camera wave and bounce), the order
 //! of their systems, their run conditions from the effects plan, and the loops that run a
 //! bounce schedule until its queues are empty.
 
@@ -7,7 +7,8 @@ use super::{classify, deposit, emit, gather, intersect, shade, Stage};
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{ExecutorKind, ScheduleLabel};
 
-/// The photon pass for one batch: emit, then the bounce loop.
+/// One wave of the photon pass (up to `MAX_BATCHES_PER_WAVE` batches of paths): emit, then the
+/// bounce loop.
 #[derive(ScheduleLabel, Clone, Debug, PartialEq, Eq, Hash)]
 pub struct PhotonPass;
 /// One photon bounce.
