@@ -108,6 +108,13 @@ pub struct Settings {
     /// thinner than the search radius (scenes/hard/thin-wall.toml), at a cost measured in
     /// BENCHMARKS.md. Off by default.
     pub visibility: bool,
+    /// Progressive passes' fixed-radius estimates are divided by the part of the kernel's disk
+    /// that lies on the query's surface, found from the other surfaces' photons the normal
+    /// filter turns away (`photon_map::boundary`): edges and corners are not darkened. An open
+    /// edge (a mesh boundary with no surface beyond it) is not seen and stays darkened. On by
+    /// default; `false` gives the plain estimate, for comparison. One-pass (k-nearest)
+    /// estimates are not corrected (measured: no better, BENCHMARKS.md).
+    pub boundary_correction: bool,
 }
 
 impl Default for Settings {
@@ -136,6 +143,7 @@ impl Default for Settings {
             alpha: 2.0 / 3.0,
             per_pixel_radii: true,
             visibility: false,
+            boundary_correction: true,
         }
     }
 }
@@ -201,6 +209,8 @@ pub struct Overrides {
     pub no_final_gather: bool,
     /// `--visibility` (turns it on; the scene file may too).
     pub visibility: bool,
+    /// `--no-boundary-correction`.
+    pub no_boundary_correction: bool,
     /// `--force`, added to the scene file's.
     pub force: Vec<String>,
     /// `--passes`.
@@ -237,6 +247,9 @@ impl Overrides {
             s.final_gather = false;
         }
         s.visibility |= self.visibility;
+        if self.no_boundary_correction {
+            s.boundary_correction = false;
+        }
         let given = PerPass {
             spp: self.spp.is_some(),
             photons: self.photons.is_some(),

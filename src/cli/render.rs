@@ -69,6 +69,10 @@ pub struct RenderArgs {
     /// short occlusion ray per candidate photon) [off, or the scene file's `visibility`].
     #[arg(long)]
     pub visibility: bool,
+    /// Plain density estimates, without dividing by the part of the kernel's disk on the
+    /// surface (edges and corners then come out darker; for comparison) [on].
+    #[arg(long)]
+    pub no_boundary_correction: bool,
     /// Force a part of the effects plan on even where the scene does not need it (repeatable):
     /// caustic_map, global_map, final_gather, refraction, shadow_rays.
     #[arg(long)]
@@ -147,6 +151,7 @@ fn overrides(args: &RenderArgs) -> Overrides {
         gather_rays: args.gather_rays,
         no_final_gather: args.no_final_gather,
         visibility: args.visibility,
+        no_boundary_correction: args.no_boundary_correction,
         force: args.force.clone(),
         passes: args.passes,
         alpha: args.alpha,

@@ -28,6 +28,7 @@
 //! [`radius`] (fixed-radius estimates), `sum` (the kernel sums); each SIMD kernel beside its
 //! scalar twin.
 
+pub mod boundary;
 mod filter;
 pub mod kernel;
 pub mod knn;

@@ -1,19 +1,33 @@
 //! Fixed-radius density estimates (progressive passes): every photon within the radius, summed
 //! as the walk finds them — 8 at a time by the SIMD kernel, one at a time by its scalar twin.
 
+use super::boundary::Neighbours;
 use super::{Estimate, Lookup, PhotonMap, Reflectance, Test};
 use crate::code_path::CodePath;
 use glam::Vec3;
 use wide::f32x8;
 
 impl PhotonMap {
-    /// Reflected radiance at `q.p` from every photon within the fixed radius `q.r_max`.
+    /// Reflected radiance at `q.p` from every photon within the fixed radius `q.r_max`, as if
+    /// the whole disk lay on the query's surface.
     pub fn estimate_radius(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>) -> Estimate {
+        self.estimate_fixed(set, q, f, false)
+    }
+
+    /// [`Self::estimate_radius`] divided by the part of the kernel's disk that lies on the
+    /// query's surface ([`Neighbours::coverage`]): no darkening at edges and in corners.
+    pub fn estimate_radius_on_surface(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>) -> Estimate {
+        self.estimate_fixed(set, q, f, true)
+    }
+
+    /// The fixed-radius estimate, boundary-corrected when `on_surface`.
+    fn estimate_fixed(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>, on_surface: bool) -> Estimate {
         let r2 = q.r_max * q.r_max;
         if self.is_empty() || !(r2 > 0.0) || !r2.is_finite() {
             return Estimate { radius: q.r_max, ..Default::default() };
         }
         let (mut count, mut rejected) = (0u32, 0u32);
+        let mut neighbours = Neighbours::default();
         let mut sum = Vec3::ZERO;
         let mut sum8 = [f32x8::ZERO; 3];
         let mut r2_walk = r2;
@@ -23,7 +37,17 @@ impl PhotonMap {
                     let (mut m, turned, d2) = self.accepts8(base, q.p, r2, &q.filter);
                     let valid = (1u32 << (hi - base).min(8)) - 1;
                     m &= valid;
-                    rejected += (turned & valid).count_ones();
+                    let turned = turned & valid;
+                    rejected += turned.count_ones();
+                    if on_surface {
+                        // Lane order, as the scalar twin meets them.
+                        let mut left = turned;
+                        while left != 0 {
+                            let l = left.trailing_zeros() as usize;
+                            left &= left - 1;
+                            neighbours.note(self, base + l, q.p, q.filter.n);
+                        }
+                    }
                     if m == 0 {
                         continue;
                     }
@@ -49,7 +73,12 @@ impl PhotonMap {
                                 sum += self.contribution(i, d2, r2, q.kernel, f);
                                 count += 1;
                             }
-                            Test::Normal => rejected += 1,
+                            Test::Normal => {
+                                rejected += 1;
+                                if on_surface {
+                                    neighbours.note(self, i, q.p, q.filter.n);
+                                }
+                            }
                             Test::Flags => {}
                         }
                     }
@@ -57,6 +86,8 @@ impl PhotonMap {
             }
         });
         let simd = Vec3::new(sum8[0].reduce_add(), sum8[1].reduce_add(), sum8[2].reduce_add());
-        Estimate { radiance: (sum + simd) * q.kernel.normalisation(r2), radius: q.r_max, count, rejected }
+        let coverage = neighbours.coverage(self, q.p, q.filter.n, r2, q.kernel);
+        let radiance = (sum + simd) * q.kernel.normalisation(r2) / coverage;
+        Estimate { radiance, radius: q.r_max, count, rejected }
     }
 }

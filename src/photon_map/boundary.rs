@@ -1,0 +1,152 @@
+//! Boundary correction of density estimates. A density estimate divides the photons' power by
+//! the area of the kernel's disk, as if the whole disk lay on the query's surface. Near an edge
+//! or in a corner — where a floor meets a wall, a box stands on the floor, a wall meets the
+//! ceiling — part of the disk lies beyond the surface, the normal filter rightly turns the other
+//! surface's photons away, and the estimate falls toward ½ at an edge and ¼ in a corner. The
+//! radius shrinks only slowly in progressive passes (r ∝ N^(−1/6)), so this bias outlives the
+//! noise: measured on CornellBox-Original, 256 progressive passes came out 0.8 % dark overall and
+//! 3–8 % dark on the ceiling and around the boxes' feet, and the error scaled with the radius.
+//!
+//! The photons the normal filter turned away say where the other surfaces are. Each distinct
+//! normal among them (up to [`MAX_PLANES`]) gives a plane through one of its photons; where that
+//! plane meets the query's tangent plane, it cuts the disk. Above the query's plane the other
+//! surface rises (a wall: the query's surface lies on the side the wall faces); below it the
+//! surface falls away (a box's top edge: the query's surface lies on the side the face turns
+//! from). The estimate is then divided by the kernel-weighted fraction of the disk on the valid
+//! side of every cut ([`Neighbours::coverage`]), found by a fixed polar quadrature. For a uniform
+//! density on a flat region this returns the interior value at an edge and in a corner (tested
+//! in `tests/hard.rs`). Planes nearly parallel to the query's (a thin wall's far side) cut
+//! nothing and are ignored.
+
+use super::packing::key_normal;
+use super::{Kernel, PhotonMap};
+use glam::Vec3;
+use std::sync::OnceLock;
+
+/// At most this many other surfaces per estimate (a corner has two, a box's foot corner three).
+pub const MAX_PLANES: usize = 4;
+/// The correction never scales an estimate by more than 1 / this (a point with less of its disk
+/// on its surface than this is left less corrected rather than amplified without bound).
+pub const MIN_COVERAGE: f32 = 0.125;
+/// Rings and angles of the polar quadrature over the unit disk.
+const RINGS: usize = 8;
+const ANGLES: usize = 32;
+
+/// One other surface met by an estimate's normal filter.
+#[derive(Clone, Copy, Debug, Default)]
+struct Plane {
+    /// The photons' stored normal (12 key bits): one per flat surface.
+    key: u32,
+    /// The photon nearest the query's tangent plane, and its height above it: the other surface
+    /// meets the query's plane near this photon's foot. (Placing the cut with the stored normal
+    /// instead would move it by height × the normal's 4° quantisation error.)
+    low: (u32, f32),
+    /// The signed height of the photon farthest from the query's plane: above (a wall rising) or
+    /// below (a face falling away).
+    high: f32,
+}
+
+/// The other surfaces an estimate's normal filter met, up to [`MAX_PLANES`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Neighbours {
+    planes: [Plane; MAX_PLANES],
+    len: usize,
+}
+
+impl Neighbours {
+    /// Notes photon `i`, turned away by the normal filter of a query at `p` with normal `n`.
+    #[inline]
+    pub(super) fn note(&mut self, map: &PhotonMap, i: usize, p: Vec3, n: Vec3) {
+        let key = map.key[i] & 0xfff;
+        let height = n.dot(map.position(i) - p);
+        if let Some(plane) = self.planes[..self.len].iter_mut().find(|pl| pl.key == key) {
+            if height.abs() < plane.low.1.abs() {
+                plane.low = (i as u32, height);
+            }
+            if height.abs() > plane.high.abs() {
+                plane.high = height;
+            }
+        } else if self.len < MAX_PLANES {
+            self.planes[self.len] = Plane { key, low: (i as u32, height), high: height };
+            self.len += 1;
+        }
+    }
+
+    /// True if no other surface was met.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The kernel-weighted fraction of the disk of radius² `r2` around `p` (normal `n`) that lies
+    /// on the query's side of every noted surface, at least [`MIN_COVERAGE`]; 1 where no surface
+    /// cuts the disk.
+    #[must_use]
+    pub fn coverage(&self, map: &PhotonMap, p: Vec3, n: Vec3, r2: f32, kernel: Kernel) -> f32 {
+        let r = r2.sqrt();
+        if self.len == 0 || !(r > 0.0) || !r.is_finite() {
+            return 1.0;
+        }
+        let (t, b) = n.any_orthonormal_pair();
+        // Each cut as a half-plane in disk units: valid where a·cosθ·ρ + b·sinθ·ρ + c > 0.
+        let mut cuts = [(0.0f32, 0.0f32, 0.0f32); MAX_PLANES];
+        let mut count = 0;
+        for plane in &self.planes[..self.len] {
+            let (i, low) = (plane.low.0 as usize, plane.low.1);
+            let m = key_normal(map.key[i]).normalize_or_zero();
+            let (mt, mb) = (m.dot(t), m.dot(b));
+            let tangential = (mt * mt + mb * mb).sqrt();
+            // Nearly parallel planes (a thin wall's far side) meet the disk nowhere; witnesses
+            // all in the query's own plane cannot tell the side.
+            if tangential < 0.2 || plane.high.abs() < 1e-4 * r {
+                continue;
+            }
+            // The cut passes through the foot of the lowest witness, across m's tangential part.
+            // Rising surface: valid where m·(q − foot) > 0; falling: < 0.
+            let foot = map.position(i) - n * low;
+            let side = if plane.high > 0.0 { 1.0 } else { -1.0 };
+            let c = side * m.dot(p - foot) / r;
+            // A line at distance ≥ r cuts nothing. A query on the line is half covered (rounding
+            // may put it a hair beyond); one clearly beyond it sees an inconsistent plane (not a
+            // flat surface meeting its own), which cuts nothing.
+            if c >= tangential || c < -0.05 * tangential {
+                continue;
+            }
+            let c = c.max(0.0);
+            cuts[count] = (side * mt, side * mb, c);
+            count += 1;
+        }
+        if count == 0 {
+            return 1.0;
+        }
+        let table = quadrature(kernel);
+        let (mut inside, mut total) = (0.0f32, 0.0f32);
+        for &(x, y, w) in table.iter() {
+            total += w;
+            if cuts[..count].iter().all(|&(ca, cb, cc)| ca * x + cb * y + cc > 0.0) {
+                inside += w;
+            }
+        }
+        (inside / total).max(MIN_COVERAGE)
+    }
+}
+
+/// The polar quadrature of `kernel` over the unit disk: points (x, y) at ring midpoints and
+/// evenly spaced angles, each weighted by kernel weight × ρ (the polar area element).
+fn quadrature(kernel: Kernel) -> &'static [(f32, f32, f32); RINGS * ANGLES] {
+    static TABLES: [OnceLock<[(f32, f32, f32); RINGS * ANGLES]>; 3] =
+        [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+    let slot = match kernel {
+        Kernel::Box => 0,
+        Kernel::Cone => 1,
+        Kernel::Epanechnikov => 2,
+    };
+    TABLES[slot].get_or_init(|| {
+        std::array::from_fn(|k| {
+            let (ring, angle) = (k / ANGLES, k % ANGLES);
+            let rho = (ring as f32 + 0.5) / RINGS as f32;
+            let theta = (angle as f32 + 0.5) * std::f32::consts::TAU / ANGLES as f32;
+            (rho * theta.cos(), rho * theta.sin(), kernel.weight(rho * rho, 1.0) * rho)
+        })
+    })
+}
