@@ -110,9 +110,8 @@ pub struct Settings {
     pub visibility: bool,
     /// Progressive passes' fixed-radius estimates are divided by the part of the kernel's disk
     /// that lies on the query's surface, found from the other surfaces' photons the normal
-    /// filter turns away (`photon_map::boundary`): edges and corners are not darkened. An open
-    /// edge (a mesh boundary with no surface beyond it) is not seen and stays darkened. On by
-    /// default; `false` gives the plain estimate, for comparison. One-pass (k-nearest)
+    /// filter turns away (`photon_map::boundary`) and from the open edges of its flat region
+    /// (`scene::open_edges`): edges and corners are not darkened. On by default; `false` gives the plain estimate, for comparison. One-pass (k-nearest)
     /// estimates are not corrected (measured: no better, BENCHMARKS.md).
     pub boundary_correction: bool,
 }

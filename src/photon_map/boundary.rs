@@ -25,12 +25,24 @@ use std::sync::OnceLock;
 
 /// At most this many other surfaces per estimate (a corner has two, a box's foot corner three).
 pub const MAX_PLANES: usize = 4;
+/// At most this many cuts from the geometry per estimate.
+pub const MAX_EXTRA_CUTS: usize = 4;
 /// The correction never scales an estimate by more than 1 / this (a point with less of its disk
 /// on its surface than this is left less corrected rather than amplified without bound).
 pub const MIN_COVERAGE: f32 = 0.125;
 /// Rings and angles of the polar quadrature over the unit disk.
 const RINGS: usize = 8;
 const ANGLES: usize = 32;
+
+/// A cut known from the geometry rather than from photons (an open edge of the query's surface,
+/// `scene::open_edges`): the disk is valid where `inward · (q − point) > 0`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Cut {
+    /// A point on the cut line.
+    pub point: Vec3,
+    /// Unit direction in the query's plane, across the line, toward the valid side.
+    pub inward: Vec3,
+}
 
 /// One other surface met by an estimate's normal filter.
 #[derive(Clone, Copy, Debug, Default)]
@@ -79,18 +91,28 @@ impl Neighbours {
     }
 
     /// The kernel-weighted fraction of the disk of radius² `r2` around `p` (normal `n`) that lies
-    /// on the query's side of every noted surface, at least [`MIN_COVERAGE`]; 1 where no surface
-    /// cuts the disk.
+    /// on the query's side of every noted surface and of every cut in `extra`, at least
+    /// [`MIN_COVERAGE`]; 1 where nothing cuts the disk.
     #[must_use]
-    pub fn coverage(&self, map: &PhotonMap, p: Vec3, n: Vec3, r2: f32, kernel: Kernel) -> f32 {
+    pub fn coverage(&self, map: &PhotonMap, p: Vec3, n: Vec3, r2: f32, kernel: Kernel, extra: &[Cut]) -> f32 {
         let r = r2.sqrt();
-        if self.len == 0 || !(r > 0.0) || !r.is_finite() {
+        if (self.len == 0 && extra.is_empty()) || !(r > 0.0) || !r.is_finite() {
             return 1.0;
         }
         let (t, b) = n.any_orthonormal_pair();
         // Each cut as a half-plane in disk units: valid where a·cosθ·ρ + b·sinθ·ρ + c > 0.
-        let mut cuts = [(0.0f32, 0.0f32, 0.0f32); MAX_PLANES];
+        let mut cuts = [(0.0f32, 0.0f32, 0.0f32); MAX_PLANES + MAX_EXTRA_CUTS];
         let mut count = 0;
+        for cut in extra.iter().take(MAX_EXTRA_CUTS) {
+            let (wt, wb) = (cut.inward.dot(t), cut.inward.dot(b));
+            let tangential = (wt * wt + wb * wb).sqrt();
+            let c = cut.inward.dot(p - cut.point) / r;
+            if tangential < 0.2 || c >= tangential || c < -0.05 * tangential {
+                continue;
+            }
+            cuts[count] = (wt, wb, c.max(0.0));
+            count += 1;
+        }
         for plane in &self.planes[..self.len] {
             let (i, low) = (plane.low.0 as usize, plane.low.1);
             let m = key_normal(map.key[i]).normalize_or_zero();

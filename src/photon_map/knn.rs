@@ -143,7 +143,7 @@ impl PhotonMap {
             return Estimate { radius: 0.0, rejected, ..Default::default() };
         };
         let e = self.sum_estimate(set, q, r2, f, scratch);
-        let coverage = neighbours.coverage(self, q.p, q.filter.n, r2, q.kernel);
+        let coverage = neighbours.coverage(self, q.p, q.filter.n, r2, q.kernel, &[]);
         Estimate { rejected, radiance: e.radiance / coverage, ..e }
     }
 

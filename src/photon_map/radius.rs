@@ -1,7 +1,7 @@
 //! Fixed-radius density estimates (progressive passes): every photon within the radius, summed
 //! as the walk finds them — 8 at a time by the SIMD kernel, one at a time by its scalar twin.
 
-use super::boundary::Neighbours;
+use super::boundary::{Cut, Neighbours};
 use super::{Estimate, Lookup, PhotonMap, Reflectance, Test};
 use crate::code_path::CodePath;
 use glam::Vec3;
@@ -11,17 +11,18 @@ impl PhotonMap {
     /// Reflected radiance at `q.p` from every photon within the fixed radius `q.r_max`, as if
     /// the whole disk lay on the query's surface.
     pub fn estimate_radius(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>) -> Estimate {
-        self.estimate_fixed(set, q, f, false)
+        self.estimate_fixed(set, q, f, None)
     }
 
     /// [`Self::estimate_radius`] divided by the part of the kernel's disk that lies on the
-    /// query's surface ([`Neighbours::coverage`]): no darkening at edges and in corners.
-    pub fn estimate_radius_on_surface(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>) -> Estimate {
-        self.estimate_fixed(set, q, f, true)
+    /// query's surface ([`Neighbours::coverage`]): no darkening at edges and in corners. `edges`
+    /// are cuts the photons cannot show (open edges of the query's surface).
+    pub fn estimate_radius_on_surface(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>, edges: &[Cut]) -> Estimate {
+        self.estimate_fixed(set, q, f, Some(edges))
     }
 
-    /// The fixed-radius estimate, boundary-corrected when `on_surface`.
-    fn estimate_fixed(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>, on_surface: bool) -> Estimate {
+    /// The fixed-radius estimate, boundary-corrected when `on_surface` is given.
+    fn estimate_fixed(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>, on_surface: Option<&[Cut]>) -> Estimate {
         let r2 = q.r_max * q.r_max;
         if self.is_empty() || !(r2 > 0.0) || !r2.is_finite() {
             return Estimate { radius: q.r_max, ..Default::default() };
@@ -39,7 +40,7 @@ impl PhotonMap {
                     m &= valid;
                     let turned = turned & valid;
                     rejected += turned.count_ones();
-                    if on_surface {
+                    if on_surface.is_some() {
                         // Lane order, as the scalar twin meets them.
                         let mut left = turned;
                         while left != 0 {
@@ -75,7 +76,7 @@ impl PhotonMap {
                             }
                             Test::Normal => {
                                 rejected += 1;
-                                if on_surface {
+                                if on_surface.is_some() {
                                     neighbours.note(self, i, q.p, q.filter.n);
                                 }
                             }
@@ -86,7 +87,10 @@ impl PhotonMap {
             }
         });
         let simd = Vec3::new(sum8[0].reduce_add(), sum8[1].reduce_add(), sum8[2].reduce_add());
-        let coverage = neighbours.coverage(self, q.p, q.filter.n, r2, q.kernel);
+        let coverage = match on_surface {
+            Some(edges) => neighbours.coverage(self, q.p, q.filter.n, r2, q.kernel, edges),
+            None => 1.0,
+        };
         let radiance = (sum + simd) * q.kernel.normalisation(r2) / coverage;
         Estimate { radiance, radius: q.r_max, count, rejected }
     }

@@ -8,6 +8,7 @@ pub mod generated;
 pub mod light;
 pub mod mtl;
 pub mod obj;
+pub mod open_edges;
 pub mod validate;
 
 use crate::error::{Error, Result};
@@ -94,6 +95,8 @@ pub struct Scene {
     pub encloses_lights: bool,
     /// Non-fatal observations made while loading.
     pub warnings: Vec<String>,
+    /// Edges bordering one triangle, listed per triangle of their flat region.
+    pub open_edges: open_edges::OpenEdges,
     bvh: Bvh,
     /// (any delta, any glass, any non-delta) material on a triangle, computed once.
     kinds: (bool, bool, bool),
@@ -241,6 +244,7 @@ impl Scene {
             warnings,
             bvh,
             kinds: (false, false, false),
+            open_edges: open_edges::OpenEdges::default(),
         };
         let mut used = vec![false; scene.materials.len()];
         for &m in &scene.material {
@@ -284,6 +288,7 @@ impl Scene {
         let area_w: Vec<f64> = scene.area_lights.iter().map(|&i| powers[i as usize]).collect();
         scene.area_power = Distribution1D::try_new(&area_w);
         scene.encloses_lights = scene.find_enclosure();
+        scene.open_edges = scene.find_open_edges(scene.diagonal().max(f32::MIN_POSITIVE));
         Ok(scene)
     }
 
