@@ -111,8 +111,9 @@ pub struct Settings {
     /// Progressive passes' fixed-radius estimates are divided by the part of the kernel's disk
     /// that lies on the query's surface, found from the other surfaces' photons the normal
     /// filter turns away (`photon_map::boundary`) and from the open edges of its flat region
-    /// (`scene::open_edges`): edges and corners are not darkened. On by default; `false` gives the plain estimate, for comparison. One-pass (k-nearest)
-    /// estimates are not corrected (measured: no better, BENCHMARKS.md).
+    /// (`scene::open_edges`): edges and corners are not darkened (not with `visibility`, whose
+    /// estimates stay plain). On by default; `false` gives the plain estimate, for comparison.
+    /// One-pass (k-nearest) estimates are not corrected (measured: no better, BENCHMARKS.md).
     pub boundary_correction: bool,
 }
 
