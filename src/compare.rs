@@ -59,6 +59,8 @@ pub fn layer_error(layer: &str, a: &[Vec3], b: &[Vec3]) -> LayerError {
 pub fn layer_errors(image: &[(String, Vec<Vec3>)], reference: &[(String, Vec<Vec3>)]) -> Vec<LayerError> {
     image
         .iter()
+        // The image layers only: not diagnostics such as a progressive render's `error`.
+        .filter(|(name, _)| name.is_empty() || crate::film::TERM_NAMES.contains(&name.as_str()))
         .filter_map(|(name, pa)| {
             let (_, pb) = reference.iter().find(|(n, _)| n == name)?;
             Some(layer_error(if name.is_empty() { "beauty" } else { name }, pa, pb))

@@ -181,6 +181,11 @@ pub struct Film {
     pub height: u32,
     /// Per-pixel terms.
     pub pixels: Vec<Terms>,
+    /// Progressive renders: per pixel, the half-width of a 95 % confidence interval of the beauty
+    /// image's grey value ((R+G+B)/3) from the spread between the passes — the noise only; the
+    /// estimates' bias is not in it. Written as the EXR layer `error` (R = G = B). `None` for a
+    /// single render.
+    pub error: Option<Vec<f32>>,
 }
 
 impl Film {
@@ -204,6 +209,9 @@ impl Film {
         let mut layers = vec![(String::new(), self.beauty())];
         for term in Term::ALL {
             layers.push((term.name().to_string(), self.pixels.iter().map(|t| t.get(term)).collect()));
+        }
+        if let Some(e) = &self.error {
+            layers.push(("error".to_string(), e.iter().map(|&v| Vec3::splat(v)).collect()));
         }
         layers
     }
@@ -390,7 +398,7 @@ mod tests {
                 }
             })
             .collect();
-        let film = Film { width: w, height: h, pixels };
+        let film = Film { width: w, height: h, pixels, error: None };
         let dir = std::env::temp_dir().join(format!("photonwave-film-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let bytes = |name: &str| {

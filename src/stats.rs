@@ -276,7 +276,7 @@ impl RenderStats {
             })
         };
         format!(
-            "  progressive: {} passes (α = {:.3}), pilot {:.2} s, radii global {:.4} → {:.4}, caustic {:.4} → {:.4}{budget}{}{}\n",
+            "  progressive: {} passes (α = {:.3}), pilot {:.2} s, radii global {:.4} → {:.4}, caustic {:.4} → {:.4}{budget}{}{}\n{}",
             p.passes,
             p.alpha,
             p.pilot_seconds,
@@ -285,7 +285,12 @@ impl RenderStats {
             p.initial_radii[1],
             p.final_radii[1],
             per_pixel("caustic", p.pixel_caustic_radii),
-            per_pixel("global", p.pixel_global_radii)
+            per_pixel("global", p.pixel_global_radii),
+            p.noise_95.map_or(String::new(), |e| format!(
+                "  noise: ±{:.2} % of the image mean (95 % intervals from the spread between passes, per pixel in the \
+                 EXR's `error` layer; bias not included)\n",
+                100.0 * e
+            ))
         )
     }
 
@@ -363,4 +368,8 @@ pub struct ProgressiveStats {
     pub pass_seconds: Vec<f64>,
     /// Wall time of the pilot photon pass and the per-pixel radii.
     pub pilot_seconds: f64,
+    /// The image's noise: the mean over pixels of the `error` layer (the half-width of each
+    /// pixel's 95 % interval from the spread between passes), over the mean beauty grey value.
+    /// Noise only, not bias. `None` before two passes.
+    pub noise_95: Option<f64>,
 }

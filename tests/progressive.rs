@@ -351,3 +351,44 @@ fn progressive_indirect_light_matches_the_path_tracer() {
     println!("caustic + indirect: progressive {m_pm:.6}, path traced {m_pt:.6} (ratio {:.4}, se {se:.6})", m_pm / m_pt);
     assert!((m_pm - m_pt).abs() < 3.0 * se + 0.02 * m_pt, "progressive {m_pm} vs path traced {m_pt} (se {se})");
 }
+
+/// The `error` layer is the half-width of a 95 % Student-t interval of each pixel's mean over
+/// the passes: with passes whose beauty grey value alternates a ± d in every pixel (exactly
+/// representable values), the layer must equal t(N−1)·s/√N, s the passes' sample standard
+/// deviation, to 1e-6 relative. One pass has no layer. The t quantile itself is checked against
+/// tables (0.5 %).
+#[test]
+fn the_error_layer_is_the_interval_of_the_passes_spread() {
+    use photonwave::progressive::student_t975;
+    for (dof, table) in [(1u32, 12.706f64), (4, 2.776), (10, 2.228), (30, 2.042), (100, 1.984)] {
+        assert!((student_t975(dof) / table - 1.0).abs() < 0.005, "t({dof}) = {}", student_t975(dof));
+    }
+    let (scene, cam) = spheres();
+    let settings = small(3);
+    let mut p = Progressive::new(&scene, &cam, &common::job(&scene, &settings));
+    let (a, d) = (0.5f32, 0.125f32);
+    let n = (settings.width * settings.height) as usize;
+    // Pass k gives a + d for even k and a − d for odd k.
+    let calls = std::cell::Cell::new(0u32);
+    let fake = |_: &Job| -> photonwave::Result<(Film, photonwave::stats::RenderStats)> {
+        let v = if calls.get().is_multiple_of(2) { a + d } else { a - d };
+        calls.set(calls.get() + 1);
+        let t = photonwave::film::Terms { direct: glam::Vec3::splat(v), ..Default::default() };
+        let film = Film { width: settings.width, height: settings.height, pixels: vec![t; n], error: None };
+        Ok((film, photonwave::stats::RenderStats::default()))
+    };
+    p.step(&fake).unwrap();
+    assert!(p.image().error.is_none());
+    for _ in 0..7 {
+        p.step(&fake).unwrap();
+    }
+    let image = p.image();
+    let values: Vec<f64> = (0..8u32).map(|k| f64::from(if k.is_multiple_of(2) { a + d } else { a - d })).collect();
+    let nf = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / nf;
+    let s = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (nf - 1.0)).sqrt();
+    let want = student_t975(7) * s / nf.sqrt();
+    let error = image.error.as_ref().expect("eight passes have an error layer");
+    assert!(want > 0.0, "the passes must differ for this test to mean anything");
+    assert!(error.iter().all(|&e| (f64::from(e) / want - 1.0).abs() < 1e-6), "{} vs {want}", error[0]);
+}
