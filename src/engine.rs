@@ -30,7 +30,7 @@ pub use crate::progressive::Budget;
 /// Whether `settings` (and an optional budget) make a progressive render.
 #[must_use]
 pub fn is_progressive(settings: &Settings, budget: Option<Budget>) -> bool {
-    settings.passes > 1 || budget.is_some()
+    settings.passes > 1 || budget.is_some() || settings.target_error > 0.0
 }
 
 /// One pass of `job` rendered by `engine`: a whole render with the job's seed and, in a

@@ -347,6 +347,17 @@ impl Progressive {
         }
     }
 
+    /// The image's noise: the mean over pixels of [`Progressive::noise`] over the image's mean
+    /// grey value (`target_error`'s metric). `None` before two passes.
+    #[must_use]
+    pub fn noise_95(&self) -> Option<f64> {
+        let noise = self.noise()?;
+        let n = f64::from(self.progress.passes);
+        let mean_grey = self.grey.iter().map(|g| g.0).sum::<f64>() / n / self.grey.len().max(1) as f64;
+        let mean_error = noise.iter().map(|&v| f64::from(v)).sum::<f64>() / noise.len().max(1) as f64;
+        Some(mean_error / mean_grey.max(f64::MIN_POSITIVE))
+    }
+
     /// Per pixel, the half-width of a 95 % confidence interval of the mean beauty grey value,
     /// from the spread between the passes: t · s/√N, with s the passes' sample standard deviation
     /// and t Student's 97.5 % quantile for N − 1 degrees of freedom. The noise only, not the bias;
@@ -417,9 +428,15 @@ pub fn describe(plan: &crate::effects::Effects, settings: &Settings, budget: Opt
             .collect();
     format!(
         "progressive: {} each {} spp{}{}, α = {:.3}\n",
-        match budget {
-            Some(b) => format!("passes for {:.2} s,", b.as_secs_f64()),
-            None => format!("{} passes,", settings.passes),
+        match (budget, settings.target_error > 0.0) {
+            (Some(b), false) => format!("passes for {:.2} s,", b.as_secs_f64()),
+            (Some(b), true) =>
+                format!("passes until noise ±{:.2} % or {:.2} s,", 100.0 * settings.target_error, b.as_secs_f64()),
+            (None, true) if settings.passes > 1 => {
+                format!("passes until noise ±{:.2} %, at most {},", 100.0 * settings.target_error, settings.passes)
+            }
+            (None, true) => format!("passes until noise ±{:.2} %,", 100.0 * settings.target_error),
+            (None, false) => format!("{} passes,", settings.passes),
         },
         settings.spp,
         if maps.is_empty() { "" } else { ", " },
@@ -456,27 +473,44 @@ pub fn render_passes(
     let t = Instant::now();
     let start = budget.map_or(t, |b| b.start);
     let mut p = Progressive::new(scene, rays, job);
-    let total = budget.map_or(u64::from(settings.passes), |b| b.limit.as_millis() as u64);
-    progress.start(if budget.is_some() { "ms of budget" } else { "passes" }, total);
+    let target = f64::from(settings.target_error);
+    // A target with no pass count runs until it is met (or the budget is spent).
+    let pass_cap = if target > 0.0 && settings.passes == 1 { u32::MAX } else { settings.passes };
+    let (unit, total) = match budget {
+        Some(b) => ("ms of budget", b.limit.as_millis() as u64),
+        // Noise falls as 1/√N, so (target / noise)² of the passes needed are done.
+        None if pass_cap == u32::MAX => ("% to target", 100),
+        None => ("passes", u64::from(settings.passes)),
+    };
+    progress.start(unit, total);
     let mut shown = 0u64;
     loop {
-        let go_on = match budget {
-            Some(b) => p.another_fits(start.elapsed(), b.limit),
-            None => p.passes() < settings.passes,
-        };
+        let reached = target > 0.0
+            && p.passes() >= crate::settings::MIN_PASSES_FOR_TARGET
+            && p.noise_95().is_some_and(|e| e <= target);
+        let go_on = !reached
+            && match budget {
+                Some(b) => p.another_fits(start.elapsed(), b.limit),
+                None => p.passes() < pass_cap,
+            };
         if !go_on {
             break;
         }
         p.step(run)?;
         let elapsed = start.elapsed();
+        let noise = p.noise_95().map_or(String::new(), |e| format!(", noise ±{:.2} %", 100.0 * e));
         let done = match budget {
             Some(b) => {
                 let left = (b.limit.as_secs_f64() - elapsed.as_secs_f64()).max(0.0);
-                progress.message(&format!("pass {}, {left:.1} s left", p.passes()));
+                progress.message(&format!("pass {}{noise}, {left:.1} s left", p.passes()));
                 (elapsed.as_millis() as u64).min(total)
             }
+            None if pass_cap == u32::MAX => {
+                progress.message(&format!("pass {}{noise}, target ±{:.2} %", p.passes(), 100.0 * target));
+                p.noise_95().map_or(0, |e| (100.0 * (target / e).powi(2)).min(100.0) as u64)
+            }
             None => {
-                progress.message(&format!("pass {} of {}", p.passes(), settings.passes));
+                progress.message(&format!("pass {} of {}{noise}", p.passes(), settings.passes));
                 u64::from(p.passes())
             }
         };
@@ -485,15 +519,13 @@ pub fn render_passes(
     }
     progress.finish();
     let film = p.image();
+    let noise_95 = p.noise_95();
     let mut stats = p.stats;
     let mut prog = p.progress;
     prog.budget_s = budget.map(|b| b.limit.as_secs_f64());
     prog.elapsed_s = start.elapsed().as_secs_f64();
-    prog.noise_95 = film.error.as_ref().map(|e| {
-        let mean_error = e.iter().map(|&v| f64::from(v)).sum::<f64>() / e.len().max(1) as f64;
-        let mean = film.mean();
-        mean_error / (f64::from(mean.element_sum()) / 3.0).max(f64::MIN_POSITIVE)
-    });
+    prog.noise_95 = noise_95;
+    prog.target_error = (target > 0.0).then_some(settings.target_error);
     stats.phases.push(format!("{} progressive passes", prog.passes));
     stats.spp = settings.spp * prog.passes;
     stats.progressive = Some(prog);

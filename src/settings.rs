@@ -13,6 +13,9 @@ pub const PART_NAMES: [&str; 5] = ["caustic_map", "global_map", "final_gather", 
 /// reach a surface the map stores on).
 pub const MAX_PATHS_PER_PHOTON: u64 = 256;
 
+/// Passes a `target_error` render runs before it trusts the spread between passes.
+pub const MIN_PASSES_FOR_TARGET: u32 = 4;
+
 /// Which per-pass amounts were given explicitly (by a flag, a sweep knob or a preset); those are
 /// used as they are in every pass instead of being spread over the passes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -92,6 +95,11 @@ pub struct Settings {
     /// traces fresh photons and estimates with fixed radii that shrink pass by pass (Knaus &
     /// Zwicker 2011), and the image is the mean of the passes.
     pub passes: u32,
+    /// Progressive passes until the image's noise — the mean half-width of the pixels' 95 %
+    /// intervals over the image mean (the `error` layer; bias not included) — is at most this
+    /// (a fraction: 0.01 = 1 %), after at least [`MIN_PASSES_FOR_TARGET`] passes. 0 = off. With
+    /// `passes` > 1 the passes cap it; with a time budget, the budget does.
+    pub target_error: f32,
     /// Radius reduction of progressive passes: r²ᵢ₊₁ = r²ᵢ·(i + α)/(i + 1). Smaller α shrinks
     /// faster (less bias, more noise).
     pub alpha: f32,
@@ -140,6 +148,7 @@ impl Default for Settings {
             threads: 0,
             force: Vec::new(),
             passes: 1,
+            target_error: 0.0,
             alpha: 2.0 / 3.0,
             per_pixel_radii: true,
             visibility: false,
@@ -215,6 +224,8 @@ pub struct Overrides {
     pub force: Vec<String>,
     /// `--passes`.
     pub passes: Option<u32>,
+    /// `--target-error`.
+    pub target_error: Option<f32>,
     /// `--alpha`.
     pub alpha: Option<f32>,
     /// `--max-depth`.
@@ -237,7 +248,7 @@ impl Overrides {
             ($($f:ident),*) => { $( if let Some(v) = self.$f { s.$f = v; } )* };
         }
         set!(width, height, spp, photons, caustic_photons, gather_rays, max_depth, seed, threads, kernel, code_path);
-        set!(passes, alpha);
+        set!(passes, alpha, target_error);
         if let Some(k) = self.k {
             s.k = k;
             s.caustic_k = k;
@@ -301,6 +312,9 @@ impl Settings {
         }
         if !(1..=10_000_000).contains(&self.passes) {
             return err("passes", "must be between 1 and 10000000");
+        }
+        if !(self.target_error == 0.0 || (1e-4..1.0).contains(&self.target_error)) {
+            return err("target_error", "must be 0 (off) or in [0.0001, 1) (a fraction of the image mean: 0.01 = 1 %)");
         }
         if !(self.alpha > 0.0 && self.alpha < 1.0) {
             return err("alpha", "must be in (0, 1) (2/3 is the usual choice)");

@@ -360,6 +360,8 @@ pub struct ProgressiveStats {
     /// First global radii per pixel (10th, 50th, 90th percentile), with per-pixel radii and
     /// final gathering off.
     pub pixel_global_radii: Option<[f32; 3]>,
+    /// The noise the passes ran until (`target_error`), if one was given.
+    pub target_error: Option<f32>,
     /// Time budget in seconds, if one was given.
     pub budget_s: Option<f64>,
     /// Seconds from the caller's start to the last pass's end.

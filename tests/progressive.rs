@@ -392,3 +392,30 @@ fn the_error_layer_is_the_interval_of_the_passes_spread() {
     assert!(want > 0.0, "the passes must differ for this test to mean anything");
     assert!(error.iter().all(|&e| (f64::from(e) / want - 1.0).abs() < 1e-6), "{} vs {want}", error[0]);
 }
+
+/// `target_error` stops at the first pass whose image noise (mean `error` half-width over the
+/// image mean) is at most the target, after at least 4 passes: the same render with one pass
+/// fewer is still above it. The noise it reports is the noise of the image it wrote: recomputed
+/// from the film's error layer and pixels, to 1e-4 relative (f32 layer against f64 sums).
+#[test]
+fn target_error_stops_at_the_error_it_reports() {
+    use photonwave::engine::{render, Engine};
+    let (scene, cam) = spheres();
+    let target = 0.25f32;
+    let s = Settings { target_error: target, ..small(4) };
+    let (film, stats) = render(&scene, &cam, &s, Engine::Wavefront, None, &NoProgress).unwrap();
+    let p = stats.progressive.expect("a target makes a progressive render");
+    let noise = p.noise_95.expect("at least two passes");
+    assert!(p.passes >= 4 && noise <= f64::from(target), "{} passes, noise {noise}", p.passes);
+    assert_eq!(p.target_error, Some(target));
+    let error = film.error.as_ref().unwrap();
+    let mean_error = error.iter().map(|&v| f64::from(v)).sum::<f64>() / error.len() as f64;
+    let mean = film.pixels.iter().map(|t| f64::from(t.beauty().element_sum()) / 3.0).sum::<f64>() / error.len() as f64;
+    assert!((mean_error / mean / noise - 1.0).abs() < 1e-4, "{} vs {noise}", mean_error / mean);
+    // The target is far enough that the minimum of 4 passes is not what stopped it.
+    assert!(p.passes > 4, "{} passes", p.passes);
+    let fewer = Settings { target_error: 0.0, passes: p.passes - 1, ..s };
+    let (_, before) = render(&scene, &cam, &fewer, Engine::Wavefront, None, &NoProgress).unwrap();
+    let before = before.progressive.unwrap().noise_95.unwrap();
+    assert!(before > f64::from(target), "one pass fewer already had noise {before}");
+}

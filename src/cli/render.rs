@@ -81,6 +81,11 @@ pub struct RenderArgs {
     /// pass by pass (α); the image is their mean [1 = one k-nearest-neighbour render].
     #[arg(long)]
     pub passes: Option<u32>,
+    /// Progressive passes until the image's noise (mean 95 % interval half-width over the image
+    /// mean, the `error` layer; bias not included) is at most E, a fraction (0.01 = 1 %); with
+    /// `--time` or `--passes` as a cap [off].
+    #[arg(long, value_name = "E")]
+    pub target_error: Option<f32>,
     /// Time budget, e.g. `30s`, `500ms`, `2m`: progressive passes until it is spent, ending
     /// within 5 % of it (counted from the start, scene loading included).
     #[arg(long, value_parser = parse_duration)]
@@ -154,6 +159,7 @@ fn overrides(args: &RenderArgs) -> Overrides {
         no_boundary_correction: args.no_boundary_correction,
         force: args.force.clone(),
         passes: args.passes,
+        target_error: args.target_error,
         alpha: args.alpha,
         max_depth: args.max_depth,
         seed: args.seed,
