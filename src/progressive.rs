@@ -478,16 +478,19 @@ pub fn render_passes(
     let pass_cap = if target > 0.0 && settings.passes == 1 { u32::MAX } else { settings.passes };
     let (unit, total) = match budget {
         Some(b) => ("ms of budget", b.limit.as_millis() as u64),
-        // Noise falls as 1/√N, so (target / noise)² of the passes needed are done.
+        // With shrinking radii the noise falls about as N^(−1/3) (BENCHMARKS.md fits −0.31), so
+        // about (target / noise)³ of the passes needed are done.
         None if pass_cap == u32::MAX => ("% to target", 100),
         None => ("passes", u64::from(settings.passes)),
     };
     progress.start(unit, total);
     let mut shown = 0u64;
+    // The image noise after the last pass (computed once a pass: it reads every pixel).
+    let mut noise_now = None;
     loop {
         let reached = target > 0.0
             && p.passes() >= crate::settings::MIN_PASSES_FOR_TARGET
-            && p.noise_95().is_some_and(|e| e <= target);
+            && noise_now.is_some_and(|e| e <= target);
         let go_on = !reached
             && match budget {
                 Some(b) => p.another_fits(start.elapsed(), b.limit),
@@ -498,7 +501,8 @@ pub fn render_passes(
         }
         p.step(run)?;
         let elapsed = start.elapsed();
-        let noise = p.noise_95().map_or(String::new(), |e| format!(", noise ±{:.2} %", 100.0 * e));
+        noise_now = p.noise_95();
+        let noise = noise_now.map_or(String::new(), |e| format!(", noise ±{:.2} %", 100.0 * e));
         let done = match budget {
             Some(b) => {
                 let left = (b.limit.as_secs_f64() - elapsed.as_secs_f64()).max(0.0);
@@ -507,7 +511,9 @@ pub fn render_passes(
             }
             None if pass_cap == u32::MAX => {
                 progress.message(&format!("pass {}{noise}, target ±{:.2} %", p.passes(), 100.0 * target));
-                p.noise_95().map_or(0, |e| (100.0 * (target / e).powi(2)).min(100.0) as u64)
+                // Not 100 % before the minimum of passes has run.
+                let cap = if p.passes() < crate::settings::MIN_PASSES_FOR_TARGET { 99.0 } else { 100.0 };
+                noise_now.map_or(0, |e| (100.0 * (target / e).powi(3)).min(cap) as u64)
             }
             None => {
                 progress.message(&format!("pass {} of {}{noise}", p.passes(), settings.passes));
@@ -519,7 +525,7 @@ pub fn render_passes(
     }
     progress.finish();
     let film = p.image();
-    let noise_95 = p.noise_95();
+    let noise_95 = noise_now.or_else(|| p.noise_95());
     let mut stats = p.stats;
     let mut prog = p.progress;
     prog.budget_s = budget.map(|b| b.limit.as_secs_f64());

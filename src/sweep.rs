@@ -137,7 +137,7 @@ pub fn grid(base: &Settings, given: PerPass, knobs: &[Knob], budgets: &[Duration
         configs = next;
     }
     for c in &mut configs {
-        if c.settings.passes > 1 || !budgets.is_empty() {
+        if c.settings.passes > 1 || c.settings.target_error > 0.0 || !budgets.is_empty() {
             c.settings = per_pass(&c.settings, given);
         }
     }
@@ -217,8 +217,13 @@ impl Sweep {
         engine: Engine,
     ) -> Result<Self> {
         let configs = grid(base, given, &knobs, &budgets)?;
-        if engine == Engine::Path && (!budgets.is_empty() || configs.iter().any(|c| c.settings.passes > 1)) {
-            return Err(Error::setting("--engine", "progressive passes (--time, passes) need a photon-mapping engine"));
+        if engine == Engine::Path
+            && (!budgets.is_empty() || configs.iter().any(|c| c.settings.passes > 1 || c.settings.target_error > 0.0))
+        {
+            return Err(Error::setting(
+                "--engine",
+                "progressive passes (--time, passes, target_error) need a photon-mapping engine",
+            ));
         }
         Ok(Sweep { knobs, configs, budgets, engine })
     }

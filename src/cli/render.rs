@@ -83,7 +83,7 @@ pub struct RenderArgs {
     pub passes: Option<u32>,
     /// Progressive passes until the image's noise (mean 95 % interval half-width over the image
     /// mean, the `error` layer; bias not included) is at most E, a fraction (0.01 = 1 %); with
-    /// `--time` or `--passes` as a cap [off].
+    /// `--time` or `--passes` as a cap (without either it runs until the target is met) [off].
     #[arg(long, value_name = "E")]
     pub target_error: Option<f32>,
     /// Time budget, e.g. `30s`, `500ms`, `2m`: progressive passes until it is spent, ending

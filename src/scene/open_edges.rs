@@ -67,6 +67,16 @@ impl Scene {
         };
         let mut edges = Vec::new();
         let mut by_plane: HashMap<[i64; 4], Vec<u32>> = HashMap::new();
+        let mut plane_triangles: HashMap<[i64; 4], Vec<u32>> = HashMap::new();
+        for i in 0..n {
+            plane_triangles.entry(plane(i)).or_default().push(i as u32);
+        }
+        // Whether a point of triangle `i`'s plane lies inside triangle `j` (same plane).
+        let inside = |j: usize, q: Vec3| {
+            let c = corners(j);
+            let edge = |a: Vec3, b: Vec3| (b - a).cross(q - a).dot(self.ng[j]) >= 0.0;
+            edge(c[0], c[1]) && edge(c[1], c[2]) && edge(c[2], c[0])
+        };
         let mut open: Vec<(u32, usize)> = count.values().filter(|e| e.2 == 1).map(|e| (e.0, e.1 as usize)).collect();
         // Deterministic order (the map's is not).
         open.sort_unstable();
@@ -76,6 +86,13 @@ impl Scene {
             let across = self.ng[tri as usize].cross(b - a).normalize_or_zero();
             let inward = if across.dot(other - a) >= 0.0 { across } else { -across };
             if inward == Vec3::ZERO {
+                continue;
+            }
+            // An edge that only looks open — a seam between coplanar pieces whose vertices are
+            // not shared, or a T-junction — has a triangle of the same plane just past it.
+            let past = (a + b) * 0.5 - inward * (1e-4 * (b - a).length().max(1e-6 * size));
+            let key = plane(tri as usize);
+            if plane_triangles[&key].iter().any(|&j| j != tri && inside(j as usize, past)) {
                 continue;
             }
             by_plane.entry(plane(tri as usize)).or_default().push(edges.len() as u32);
@@ -110,7 +127,8 @@ mod tests {
     }
 
     /// A lone quad has four open edges, each pointing into the quad and listed for both of its
-    /// triangles; its diagonal is not open. A closed tetrahedron has none.
+    /// triangles; its diagonal is not open. A closed tetrahedron has none. A T-junction (one quad
+    /// meeting two along a seam whose vertices they do not all share) leaves the seam closed.
     #[test]
     fn a_quad_has_four_open_edges_and_a_closed_mesh_none() {
         let quad = scene(
@@ -133,5 +151,21 @@ mod tests {
         let tetra =
             scene(vec![Vec3::ZERO, Vec3::X, Vec3::Z, Vec3::Y], vec![[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]]);
         assert!(tetra.open_edges.edges.is_empty());
+        // A T-junction: one quad on the left, two on the right meeting it along x = 0.
+        let seam = scene(
+            vec![
+                Vec3::new(-1.0, 0.0, -1.0),
+                Vec3::new(0.0, 0.0, -1.0),
+                Vec3::new(0.0, 0.0, 1.0),
+                Vec3::new(-1.0, 0.0, 1.0),
+                Vec3::new(1.0, 0.0, -1.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(1.0, 0.0, 1.0),
+            ],
+            vec![[0, 2, 1], [0, 3, 2], [1, 6, 5], [1, 5, 4], [6, 2, 7], [6, 7, 5]],
+        );
+        // Outer edges only: 3 of the left quad, 2 of each right one (none along the seam).
+        assert_eq!(seam.open_edges.edges.len(), 7, "{:?}", seam.open_edges.edges);
     }
 }
