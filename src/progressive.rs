@@ -108,6 +108,7 @@ pub fn pilot_seed(seed: u64) -> u64 {
 /// The first pass's radii from a pilot photon pass (traced with [`pilot_seed`]): per map, the
 /// median k-th-neighbour distance over the pilot's photons (the maximum radius where a map is
 /// empty or too sparse); with `per_pixel_radii`, each pixel's own as well ([`pixel_radii`]).
+/// `job` is the render's, whose pass (the user's seed, no radii) is the first.
 #[must_use]
 pub fn initial_radii(scene: &Scene, rays: &CameraRays, job: &Job) -> FixedRadii {
     let settings = &job.settings;
@@ -123,8 +124,8 @@ pub fn initial_radii(scene: &Scene, rays: &CameraRays, job: &Job) -> FixedRadii 
         median_knn_radius(&maps.global, settings.k, r_global, settings.code_path).unwrap_or(r_global),
         median_knn_radius(&maps.caustic, settings.caustic_k, r_caustic, settings.code_path).unwrap_or(r_caustic),
     );
-    let first = Job { pass: Pass { seed: settings.seed, radii: None }, ..job.clone() };
-    let pixels = settings.per_pixel_radii.then(|| Arc::new(pixel_radii(scene, rays, &first, &maps, &uniform)));
+    // The pixels' first radii follow the first pass's camera samples: `job`'s own seed.
+    let pixels = settings.per_pixel_radii.then(|| Arc::new(pixel_radii(scene, rays, job, &maps, &uniform)));
     FixedRadii { pixels, ..uniform }
 }
 
@@ -351,10 +352,9 @@ impl Progressive {
     /// grey value (`target_error`'s metric). `None` before two passes.
     #[must_use]
     pub fn noise_95(&self) -> Option<f64> {
-        let noise = self.noise()?;
-        let n = f64::from(self.progress.passes);
-        let mean_grey = self.grey.iter().map(|g| g.0).sum::<f64>() / n / self.grey.len().max(1) as f64;
-        let mean_error = noise.iter().map(|&v| f64::from(v)).sum::<f64>() / noise.len().max(1) as f64;
+        let pixels = self.grey.len().max(1) as f64;
+        let mean_error = self.half_widths()?.sum::<f64>() / pixels;
+        let mean_grey = self.grey.iter().map(|g| g.0).sum::<f64>() / f64::from(self.progress.passes) / pixels;
         Some(mean_error / mean_grey.max(f64::MIN_POSITIVE))
     }
 
@@ -366,21 +366,21 @@ impl Progressive {
     /// before two passes.
     #[must_use]
     pub fn noise(&self) -> Option<Vec<f32>> {
+        Some(self.half_widths()?.map(|h| h as f32).collect())
+    }
+
+    /// [`Progressive::noise`]'s half-widths, pixel by pixel, in f64.
+    fn half_widths(&self) -> Option<impl Iterator<Item = f64> + '_> {
         let n = self.progress.passes;
         if n < 2 {
             return None;
         }
         let (nf, t) = (f64::from(n), student_t975(n - 1));
-        Some(
-            self.grey
-                .iter()
-                .map(|&(s1, s2)| {
-                    let mean = s1 / nf;
-                    let var = ((s2 - nf * mean * mean) / (nf - 1.0)).max(0.0);
-                    (t * (var / nf).sqrt()) as f32
-                })
-                .collect(),
-        )
+        Some(self.grey.iter().map(move |&(s1, s2)| {
+            let mean = s1 / nf;
+            let var = ((s2 - nf * mean * mean) / (nf - 1.0)).max(0.0);
+            t * (var / nf).sqrt()
+        }))
     }
 
     /// Whether another pass should start, `elapsed` after the caller's start, to end closest to

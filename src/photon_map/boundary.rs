@@ -92,12 +92,6 @@ impl Neighbours {
         }
     }
 
-    /// True if no other surface was met.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
     /// The kernel-weighted fraction of the disk of radius² `r2` around `p` (normal `n`) that lies
     /// on the query's side of every noted surface and of every cut in `extra`, at least
     /// [`MIN_COVERAGE`]; 1 where nothing cuts the disk.

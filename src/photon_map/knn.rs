@@ -3,7 +3,6 @@
 //! kernel and its scalar twin share the walk and the k-selection and visit photons in the same
 //! order, so both find the same photons.
 
-use super::boundary::Neighbours;
 use super::packing::key_normal;
 use super::{Estimate, Lookup, PhotonMap, Reflectance, Test};
 use crate::code_path::CodePath;
@@ -13,20 +12,13 @@ impl PhotonMap {
     /// The `k` nearest photons to `q.p` within `q.r_max` that pass `q.filter`, as
     /// (distance², index), unordered, into `out`.
     pub fn nearest(&self, set: CodePath, q: &Lookup, out: &mut Vec<(f32, u32)>) {
-        self.nearest_counted(set, q, out, None);
+        self.nearest_counted(set, q, out);
     }
 
     /// [`Self::nearest`], returning how many photons the normal test turned away (see
-    /// [`Estimate::rejected`]) and noting them in `neighbours` when given; both code paths
-    /// count and note the same photons in the same order.
+    /// [`Estimate::rejected`]); both code paths count the same photons.
     #[inline]
-    pub(super) fn nearest_counted(
-        &self,
-        set: CodePath,
-        q: &Lookup,
-        out: &mut Vec<(f32, u32)>,
-        mut neighbours: Option<&mut Neighbours>,
-    ) -> u32 {
+    pub(super) fn nearest_counted(&self, set: CodePath, q: &Lookup, out: &mut Vec<(f32, u32)>) -> u32 {
         out.clear();
         if q.k == 0 || self.is_empty() {
             return 0;
@@ -72,9 +64,6 @@ impl PhotonMap {
                                 offer(out, r2, d2[l], base + l);
                             } else {
                                 rejected += 1;
-                                if let Some(nb) = neighbours.as_deref_mut() {
-                                    nb.note(self, base + l, q.p, q.filter.n);
-                                }
                             }
                         }
                     }
@@ -85,12 +74,7 @@ impl PhotonMap {
                     if d2 < *r2 {
                         match Self::test(self.key[i], &q.filter) {
                             Test::Accepted => offer(out, r2, d2, i),
-                            Test::Normal => {
-                                rejected += 1;
-                                if let Some(nb) = neighbours.as_deref_mut() {
-                                    nb.note(self, i, q.p, q.filter.n);
-                                }
-                            }
+                            Test::Normal => rejected += 1,
                             Test::Flags => {}
                         }
                     }
@@ -105,46 +89,18 @@ impl PhotonMap {
     }
 
     /// Reflected radiance at `q.p` from its k nearest photons: Σ f(wi_p)·Φ_p·K over the
-    /// (k−1)-of-k rule above, as if the whole disk lay on the query's surface.
+    /// (k−1)-of-k rule above, as if the whole disk lay on the query's surface (k-nearest
+    /// estimates are not boundary-corrected: measured no better, BENCHMARKS.md).
     #[inline]
     pub fn estimate(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>, scratch: &mut Vec<(f32, u32)>) -> Estimate {
-        self.estimate_knn(set, q, f, scratch, false)
-    }
-
-    /// [`Self::estimate`] divided by the part of the kernel's disk that lies on the query's
-    /// surface ([`Neighbours::coverage`]): no darkening at edges and in corners.
-    #[inline]
-    pub fn estimate_on_surface(
-        &self,
-        set: CodePath,
-        q: &Lookup,
-        f: Reflectance<'_>,
-        scratch: &mut Vec<(f32, u32)>,
-    ) -> Estimate {
-        self.estimate_knn(set, q, f, scratch, true)
-    }
-
-    /// The k-nearest estimate, boundary-corrected when `on_surface`.
-    #[inline]
-    fn estimate_knn(
-        &self,
-        set: CodePath,
-        q: &Lookup,
-        f: Reflectance<'_>,
-        scratch: &mut Vec<(f32, u32)>,
-        on_surface: bool,
-    ) -> Estimate {
         if self.is_empty() {
             return Estimate { radius: q.r_max, ..Default::default() };
         }
-        let mut neighbours = Neighbours::default();
-        let rejected = self.nearest_counted(set, q, scratch, on_surface.then_some(&mut neighbours));
+        let rejected = self.nearest_counted(set, q, scratch);
         let Some(r2) = Self::knn_radius2(q, scratch) else {
             return Estimate { radius: 0.0, rejected, ..Default::default() };
         };
-        let e = self.sum_estimate(set, q, r2, f, scratch);
-        let coverage = neighbours.coverage(self, q.p, q.filter.n, r2, q.kernel, &[]);
-        Estimate { rejected, radiance: e.radiance / coverage, ..e }
+        Estimate { rejected, ..self.sum_estimate(set, q, r2, f, scratch) }
     }
 
     /// The squared radius of a k-nearest estimate over `found` (the k-th photon's distance, that
@@ -190,14 +146,14 @@ impl PhotonMap {
         }
         let (r2, rejected) = if q.k == 0 {
             // Every photon within the fixed radius (a bound no search reaches).
-            let rejected = self.nearest_counted(set, &Lookup { k: u32::MAX as usize, ..*q }, scratch, None);
+            let rejected = self.nearest_counted(set, &Lookup { k: u32::MAX as usize, ..*q }, scratch);
             let r2 = q.r_max * q.r_max;
             if !(r2 > 0.0) || !r2.is_finite() {
                 return Estimate { radius: q.r_max, ..Default::default() };
             }
             (r2, rejected)
         } else {
-            let rejected = self.nearest_counted(set, q, scratch, None);
+            let rejected = self.nearest_counted(set, q, scratch);
             let Some(r2) = Self::knn_radius2(q, scratch) else {
                 return Estimate { radius: 0.0, rejected, ..Default::default() };
             };

@@ -85,7 +85,7 @@ impl Scene {
     /// [`Scene::encloses_lights`]: closed (no edge borders one triangle alone), then each light tested for being inside
     /// one of the closed pieces (connected by shared edges) by the parity of a ray's crossings of
     /// that piece — per piece, so that a light inside a glass ball inside a room counts.
-    pub(super) fn find_enclosure(&self) -> bool {
+    pub(super) fn find_enclosure(&self, uses: &super::open_edges::EdgeUses) -> bool {
         if self.p0.is_empty() || self.lights.iter().any(|l| matches!(l, Light::Directional { .. })) {
             return false;
         }
@@ -98,20 +98,18 @@ impl Scene {
             }
             i
         }
-        let mut edges: std::collections::HashMap<([u32; 3], [u32; 3]), (u32, u32)> = std::collections::HashMap::new();
-        for i in 0..n {
-            let v = [self.p0[i], self.p1[i], self.p2[i]].map(|p| p.to_array().map(f32::to_bits));
-            for (a, b) in [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])] {
-                let e = edges.entry(if a < b { (a, b) } else { (b, a) }).or_insert((i as u32, 0));
-                e.1 += 1;
-                let (x, y) = (root(&mut parent, e.0), root(&mut parent, i as u32));
-                parent[x as usize] = y;
-            }
-        }
         // Closed: no edge borders a single triangle (three faces may meet at an edge, as at the
         // rim of a boundary between two dielectrics).
-        if edges.values().any(|&(_, count)| count < 2) {
+        if uses.values().any(|&(_, _, count)| count < 2) {
             return false;
+        }
+        // Triangles sharing an edge belong to one piece.
+        for i in 0..n {
+            for key in self.edge_keys(i) {
+                let first = uses.get(&key).map_or(i as u32, |e| e.0);
+                let (x, y) = (root(&mut parent, first), root(&mut parent, i as u32));
+                parent[x as usize] = y;
+            }
         }
         let piece: Vec<u32> = (0..n as u32).map(|i| root(&mut parent, i)).collect();
         let diagonal = self.diagonal();

@@ -287,8 +287,9 @@ impl Scene {
         scene.delta_lights = (0..scene.lights.len() as u32).filter(|&i| scene.lights[i as usize].is_delta()).collect();
         let area_w: Vec<f64> = scene.area_lights.iter().map(|&i| powers[i as usize]).collect();
         scene.area_power = Distribution1D::try_new(&area_w);
-        scene.encloses_lights = scene.find_enclosure();
-        scene.open_edges = scene.find_open_edges(scene.diagonal().max(f32::MIN_POSITIVE));
+        let edges = scene.edge_uses();
+        scene.encloses_lights = scene.find_enclosure(&edges);
+        scene.open_edges = scene.find_open_edges(scene.diagonal().max(f32::MIN_POSITIVE), &edges);
         Ok(scene)
     }
 

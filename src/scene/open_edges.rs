@@ -43,23 +43,37 @@ impl OpenEdges {
 }
 
 /// An edge by the bit patterns of its two ends, in order.
-type EdgeKey = ([u32; 3], [u32; 3]);
+pub(super) type EdgeKey = ([u32; 3], [u32; 3]);
+
+/// Per edge: the first triangle using it, which of that triangle's edges it is, and how many
+/// triangles use it.
+pub(super) type EdgeUses = HashMap<EdgeKey, (u32, u8, u32)>;
 
 impl Scene {
-    /// Finds the open edges and lists them per triangle of their flat region (triangles whose
-    /// normal and plane offset agree to 10⁻⁵, the offset relative to the scene's size `size`).
-    pub(super) fn find_open_edges(&self, size: f32) -> OpenEdges {
-        let n = self.p0.len();
-        let corners = |i: usize| [self.p0[i], self.p1[i], self.p2[i]];
-        // Edge (its ends' bits, ordered) → (first triangle, its edge index, triangles using it).
-        let mut count: HashMap<EdgeKey, (u32, u8, u32)> = HashMap::new();
-        for i in 0..n {
-            let v = corners(i).map(|p| p.to_array().map(f32::to_bits));
-            for (k, (a, b)) in [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])].into_iter().enumerate() {
-                let e = count.entry(if a < b { (a, b) } else { (b, a) }).or_insert((i as u32, k as u8, 0));
-                e.2 += 1;
+    /// The keys of triangle `i`'s three edges (edge k runs from corner k to corner k + 1).
+    pub(super) fn edge_keys(&self, i: usize) -> [EdgeKey; 3] {
+        let v = [self.p0[i], self.p1[i], self.p2[i]].map(|p| p.to_array().map(f32::to_bits));
+        [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])].map(|(a, b)| if a < b { (a, b) } else { (b, a) })
+    }
+
+    /// Every edge of the mesh with its uses, matched by the exact bits of its ends (once per
+    /// scene: the closed-scene test and the open edges both read it).
+    pub(super) fn edge_uses(&self) -> EdgeUses {
+        let mut uses = EdgeUses::new();
+        for i in 0..self.p0.len() {
+            for (k, key) in self.edge_keys(i).into_iter().enumerate() {
+                uses.entry(key).or_insert((i as u32, k as u8, 0)).2 += 1;
             }
         }
+        uses
+    }
+
+    /// Finds the open edges among `uses` and lists them per triangle of their flat region
+    /// (triangles whose normal and plane offset agree to 10⁻⁵, the offset relative to the
+    /// scene's size `size`).
+    pub(super) fn find_open_edges(&self, size: f32, uses: &EdgeUses) -> OpenEdges {
+        let n = self.p0.len();
+        let corners = |i: usize| [self.p0[i], self.p1[i], self.p2[i]];
         let q = |x: f32| (f64::from(x) * 1e5).round() as i64;
         let plane = |i: usize| {
             let nn = self.ng[i];
@@ -77,7 +91,7 @@ impl Scene {
             let edge = |a: Vec3, b: Vec3| (b - a).cross(q - a).dot(self.ng[j]) >= 0.0;
             edge(c[0], c[1]) && edge(c[1], c[2]) && edge(c[2], c[0])
         };
-        let mut open: Vec<(u32, usize)> = count.values().filter(|e| e.2 == 1).map(|e| (e.0, e.1 as usize)).collect();
+        let mut open: Vec<(u32, usize)> = uses.values().filter(|e| e.2 == 1).map(|e| (e.0, e.1 as usize)).collect();
         // Deterministic order (the map's is not).
         open.sort_unstable();
         for (tri, k) in open {

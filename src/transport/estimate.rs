@@ -47,8 +47,8 @@ fn map_estimate(
     // to 0.2 % bright and its 16×16-block error from 1.2 % to 1.6 % (BENCHMARKS.md).
     let e = match (fixed, ctx.settings.visibility) {
         (Some(r), false) if ctx.settings.boundary_correction => {
-            let edges = open_edge_cuts(ctx.scene, sp, r);
-            map.estimate_radius_on_surface(set, &Lookup { r_max: r, ..lookup }, f, &edges)
+            let (edges, len) = open_edge_cuts(ctx.scene, sp, r);
+            map.estimate_radius_on_surface(set, &Lookup { r_max: r, ..lookup }, f, &edges[..len])
         }
         (Some(r), false) => map.estimate_radius(set, &Lookup { r_max: r, ..lookup }, f),
         (None, false) => map.estimate(set, &lookup, f, scratch),
@@ -65,34 +65,21 @@ fn map_estimate(
 }
 
 /// The open edges of `sp`'s flat region within `r` of it, as cuts of its estimate's disk (at most
-/// [`MAX_EXTRA_CUTS`]; a region has few).
+/// [`MAX_EXTRA_CUTS`]; a region has few), and how many there are.
 #[inline]
-fn open_edge_cuts(scene: &Scene, sp: &SurfacePoint, r: f32) -> ArrayVec {
-    let mut cuts = ArrayVec::default();
+fn open_edge_cuts(scene: &Scene, sp: &SurfacePoint, r: f32) -> ([Cut; MAX_EXTRA_CUTS], usize) {
+    let mut cuts = [Cut::default(); MAX_EXTRA_CUTS];
+    let mut len = 0;
     for e in scene.open_edges.of(sp.tri) {
         // Distance from the point to the segment.
         let ab = e.b - e.a;
         let t = ((sp.p - e.a).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
-        if (e.a + ab * t).distance_squared(sp.p) < r * r && cuts.len < MAX_EXTRA_CUTS {
-            cuts.items[cuts.len] = Cut { point: e.a, inward: e.inward };
-            cuts.len += 1;
+        if (e.a + ab * t).distance_squared(sp.p) < r * r && len < MAX_EXTRA_CUTS {
+            cuts[len] = Cut { point: e.a, inward: e.inward };
+            len += 1;
         }
     }
-    cuts
-}
-
-/// A few cuts on the stack.
-#[derive(Default)]
-struct ArrayVec {
-    items: [Cut; MAX_EXTRA_CUTS],
-    len: usize,
-}
-
-impl std::ops::Deref for ArrayVec {
-    type Target = [Cut];
-    fn deref(&self) -> &[Cut] {
-        &self.items[..self.len]
-    }
+    (cuts, len)
 }
 
 /// Whether a photon (position, normal) is visible from the point `q` (normal `n`, on the side
