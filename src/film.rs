@@ -18,6 +18,10 @@ pub struct Terms {
     pub caustic: Vec3,
     /// Indirect diffuse light (final gather or the global map) at the first non-specular hit.
     pub indirect: Vec3,
+    /// Not a term and not in the beauty image: the estimated bias of the photon-map estimates
+    /// within the terms above, weighted as they are (fixed radii only: progressive passes; zero
+    /// otherwise). The part of [`Film::error`] that the spread between passes cannot show.
+    pub bias: Vec3,
 }
 
 /// One of the five terms a film keeps apart, in EXR layer order. Every engine routes what it
@@ -108,7 +112,7 @@ impl Terms {
     #[inline]
     #[must_use]
     pub fn is_finite(&self) -> bool {
-        self.as_array().iter().all(|v| v.is_finite())
+        self.as_array().iter().all(|v| v.is_finite()) && self.bias.is_finite()
     }
 }
 
@@ -119,6 +123,7 @@ impl std::ops::AddAssign for Terms {
         self.specular += o.specular;
         self.caustic += o.caustic;
         self.indirect += o.indirect;
+        self.bias += o.bias;
     }
 }
 
@@ -131,6 +136,7 @@ impl std::ops::Mul<f32> for Terms {
             specular: self.specular * s,
             caustic: self.caustic * s,
             indirect: self.indirect * s,
+            bias: self.bias * s,
         }
     }
 }
@@ -182,10 +188,10 @@ pub struct Film {
     /// Per-pixel terms.
     pub pixels: Vec<Terms>,
     /// Progressive renders: per pixel, the half-width of a 95 % confidence interval of the beauty
-    /// image's grey value ((R+G+B)/3) from the spread between the passes — the noise only; the
-    /// estimates' bias is not in it. Written as the EXR layer `error` (R = G = B). `None` for a
-    /// single render.
-    pub error: Option<Vec<f32>>,
+    /// image's grey value ((R+G+B)/3) from the spread between the passes — the noise. With the
+    /// pixels' estimated bias ([`Terms::bias`]) it makes the error bound of [`Film::error`].
+    /// `None` for a single render.
+    pub noise: Option<Vec<f32>>,
 }
 
 impl Film {
@@ -210,10 +216,24 @@ impl Film {
         for term in Term::ALL {
             layers.push((term.name().to_string(), self.pixels.iter().map(|t| t.get(term)).collect()));
         }
-        if let Some(e) = &self.error {
-            layers.push(("error".to_string(), e.iter().map(|&v| Vec3::splat(v)).collect()));
+        if let Some(error) = self.error() {
+            layers.push(("error".to_string(), error.into_iter().map(Vec3::splat).collect()));
+            let noise = self.noise.iter().flatten();
+            layers.push(("error.noise".to_string(), noise.map(|&v| Vec3::splat(v)).collect()));
+            layers.push(("error.bias".to_string(), self.pixels.iter().map(|t| t.bias).collect()));
         }
         layers
+    }
+
+    /// Progressive renders: per pixel, a bound on the error of the beauty grey value
+    /// ((R+G+B)/3) — the noise's 95 % half-width ([`Film::noise`]) plus the size of the estimated
+    /// bias (the grey value of [`Terms::bias`]), after Hachisuka, Jarosz and Jensen (2010). The
+    /// EXR layer `error`, beside `error.noise` and the signed RGB `error.bias`. `None` for a
+    /// single render.
+    #[must_use]
+    pub fn error(&self) -> Option<Vec<f32>> {
+        let noise = self.noise.as_ref()?;
+        Some(noise.iter().zip(&self.pixels).map(|(&n, t)| n + (t.bias.element_sum() / 3.0).abs()).collect())
     }
 
     /// Writes the EXR: default layer R, G, B = beauty; one layer per term (`direct.R`, …).
@@ -395,10 +415,11 @@ mod tests {
                     specular: Vec3::ZERO,
                     caustic: v * v,
                     indirect: Vec3::new(v.y, v.z, v.x),
+                    bias: Vec3::ZERO,
                 }
             })
             .collect();
-        let film = Film { width: w, height: h, pixels, error: None };
+        let film = Film { width: w, height: h, pixels, noise: None };
         let dir = std::env::temp_dir().join(format!("photonwave-film-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let bytes = |name: &str| {

@@ -50,7 +50,7 @@ pub struct Budget {
 pub const RADIUS_SAMPLES: usize = 1024;
 
 pub use crate::settings::PerPass;
-pub use crate::stats::ProgressiveStats;
+pub use crate::stats::{ImageError, ProgressiveStats};
 
 /// The seed of pass `i`: pass 0 keeps the user's seed; later ones are mixed from it.
 #[must_use]
@@ -336,7 +336,8 @@ impl Progressive {
         Ok(())
     }
 
-    /// The mean of the passes so far, with its noise ([`Progressive::noise`]).
+    /// The mean of the passes so far, with its noise ([`Progressive::noise`]) and, in its
+    /// pixels, its estimated bias.
     #[must_use]
     pub fn image(&self) -> Film {
         let n = self.progress.passes.max(1) as f32;
@@ -344,26 +345,28 @@ impl Progressive {
             width: self.job.settings.width,
             height: self.job.settings.height,
             pixels: self.sum.iter().map(|t| *t * (1.0 / n)).collect(),
-            error: self.noise(),
+            noise: self.noise(),
         }
     }
 
-    /// The image's noise: the mean over pixels of [`Progressive::noise`] over the image's mean
-    /// grey value (`target_error`'s metric). `None` before two passes.
+    /// The image's error estimate ([`ImageError`], `target_error`'s metric): the means over
+    /// pixels of [`Film::error`]'s bound and of its two parts, each over the image's mean grey
+    /// value. `None` before two passes.
     #[must_use]
-    pub fn noise_95(&self) -> Option<f64> {
+    pub fn error_95(&self) -> Option<ImageError> {
         let pixels = self.grey.len().max(1) as f64;
-        let mean_error = self.half_widths()?.sum::<f64>() / pixels;
-        let mean_grey = self.grey.iter().map(|g| g.0).sum::<f64>() / f64::from(self.progress.passes) / pixels;
-        Some(mean_error / mean_grey.max(f64::MIN_POSITIVE))
+        let n = f64::from(self.progress.passes);
+        let noise = self.half_widths()?.sum::<f64>() / pixels;
+        let bias = self.sum.iter().map(|t| (f64::from(t.bias.element_sum()) / 3.0 / n).abs()).sum::<f64>() / pixels;
+        let mean_grey = (self.grey.iter().map(|g| g.0).sum::<f64>() / n / pixels).max(f64::MIN_POSITIVE);
+        Some(ImageError { error: (noise + bias) / mean_grey, noise: noise / mean_grey, bias: bias / mean_grey })
     }
 
     /// Per pixel, the half-width of a 95 % confidence interval of the mean beauty grey value,
     /// from the spread between the passes: t · s/√N, with s the passes' sample standard deviation
-    /// and t Student's 97.5 % quantile for N − 1 degrees of freedom. The noise only, not the bias;
-    /// and approximate, as later passes' smaller radii make them a little noisier than earlier
-    /// ones (Hachisuka, Jarosz and Jensen 2010 model that and the bias; not done here). `None`
-    /// before two passes.
+    /// and t Student's 97.5 % quantile for N − 1 degrees of freedom. The noise only, not the bias
+    /// (which the pixels carry: [`Terms::bias`]); and approximate, as later passes' smaller radii
+    /// make them a little noisier than earlier ones. `None` before two passes.
     #[must_use]
     pub fn noise(&self) -> Option<Vec<f32>> {
         Some(self.half_widths()?.map(|h| h as f32).collect())
@@ -478,19 +481,19 @@ pub fn render_passes(
     let pass_cap = if target > 0.0 && settings.passes == 1 { u32::MAX } else { settings.passes };
     let (unit, total) = match budget {
         Some(b) => ("ms of budget", b.limit.as_millis() as u64),
-        // With shrinking radii the noise falls about as N^(−1/3) (BENCHMARKS.md fits −0.31), so
-        // about (target / noise)³ of the passes needed are done.
+        // With shrinking radii the error falls about as N^(−1/3) (BENCHMARKS.md fits −0.31 to the
+        // noise), so about (target / error)³ of the passes needed are done.
         None if pass_cap == u32::MAX => ("% to target", 100),
         None => ("passes", u64::from(settings.passes)),
     };
     progress.start(unit, total);
     let mut shown = 0u64;
-    // The image noise after the last pass (computed once a pass: it reads every pixel).
-    let mut noise_now = None;
+    // The image's error after the last pass (computed once a pass: it reads every pixel).
+    let mut error_now: Option<ImageError> = None;
     loop {
         let reached = target > 0.0
             && p.passes() >= crate::settings::MIN_PASSES_FOR_TARGET
-            && noise_now.is_some_and(|e| e <= target);
+            && error_now.is_some_and(|e| e.error <= target);
         let go_on = !reached
             && match budget {
                 Some(b) => p.another_fits(start.elapsed(), b.limit),
@@ -501,22 +504,22 @@ pub fn render_passes(
         }
         p.step(run)?;
         let elapsed = start.elapsed();
-        noise_now = p.noise_95();
-        let noise = noise_now.map_or(String::new(), |e| format!(", noise ±{:.2} %", 100.0 * e));
+        error_now = p.error_95();
+        let error = error_now.map_or(String::new(), |e| format!(", error ±{:.2} %", 100.0 * e.error));
         let done = match budget {
             Some(b) => {
                 let left = (b.limit.as_secs_f64() - elapsed.as_secs_f64()).max(0.0);
-                progress.message(&format!("pass {}{noise}, {left:.1} s left", p.passes()));
+                progress.message(&format!("pass {}{error}, {left:.1} s left", p.passes()));
                 (elapsed.as_millis() as u64).min(total)
             }
             None if pass_cap == u32::MAX => {
-                progress.message(&format!("pass {}{noise}, target ±{:.2} %", p.passes(), 100.0 * target));
+                progress.message(&format!("pass {}{error}, target ±{:.2} %", p.passes(), 100.0 * target));
                 // Not 100 % before the minimum of passes has run.
                 let cap = if p.passes() < crate::settings::MIN_PASSES_FOR_TARGET { 99.0 } else { 100.0 };
-                noise_now.map_or(0, |e| (100.0 * (target / e).powi(3)).min(cap) as u64)
+                error_now.map_or(0, |e| (100.0 * (target / e.error).powi(3)).min(cap) as u64)
             }
             None => {
-                progress.message(&format!("pass {} of {}{noise}", p.passes(), settings.passes));
+                progress.message(&format!("pass {} of {}{error}", p.passes(), settings.passes));
                 u64::from(p.passes())
             }
         };
@@ -525,12 +528,12 @@ pub fn render_passes(
     }
     progress.finish();
     let film = p.image();
-    let noise_95 = noise_now.or_else(|| p.noise_95());
+    let error_95 = error_now.or_else(|| p.error_95());
     let mut stats = p.stats;
     let mut prog = p.progress;
     prog.budget_s = budget.map(|b| b.limit.as_secs_f64());
     prog.elapsed_s = start.elapsed().as_secs_f64();
-    prog.noise_95 = noise_95;
+    prog.error_95 = error_95;
     prog.target_error = (target > 0.0).then_some(settings.target_error);
     stats.phases.push(format!("{} progressive passes", prog.passes));
     stats.spp = settings.spp * prog.passes;

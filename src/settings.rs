@@ -95,8 +95,9 @@ pub struct Settings {
     /// traces fresh photons and estimates with fixed radii that shrink pass by pass (Knaus &
     /// Zwicker 2011), and the image is the mean of the passes.
     pub passes: u32,
-    /// Progressive passes until the image's noise — the mean half-width of the pixels' 95 %
-    /// intervals over the image mean (the `error` layer; bias not included) — is at most this
+    /// Progressive passes until the image's estimated error — the mean of the pixels' error
+    /// bounds (95 % noise half-width plus estimated bias: the `error` layer) over the image mean —
+    /// is at most this
     /// (a fraction: 0.01 = 1 %), after at least [`MIN_PASSES_FOR_TARGET`] passes. 0 = off. With
     /// `passes` > 1 the passes cap it; with a time budget, the budget does.
     pub target_error: f32,

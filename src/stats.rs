@@ -286,10 +286,12 @@ impl RenderStats {
             p.final_radii[1],
             per_pixel("caustic", p.pixel_caustic_radii),
             per_pixel("global", p.pixel_global_radii),
-            p.noise_95.map_or(String::new(), |e| format!(
-                "  noise: ±{:.2} % of the image mean (95 % intervals from the spread between passes, per pixel in the \
-                 EXR's `error` layer; bias not included)\n",
-                100.0 * e
+            p.error_95.map_or(String::new(), |e| format!(
+                "  error: ±{:.2} % of the image mean = noise ±{:.2} % (95 % intervals from the spread between passes) \
+                 + bias {:.2} % (estimated from the photons); per pixel in the EXR's `error` layer\n",
+                100.0 * e.error,
+                100.0 * e.noise,
+                100.0 * e.bias
             ))
         )
     }
@@ -360,7 +362,7 @@ pub struct ProgressiveStats {
     /// First global radii per pixel (10th, 50th, 90th percentile), with per-pixel radii and
     /// final gathering off.
     pub pixel_global_radii: Option<[f32; 3]>,
-    /// The noise the passes ran until (`target_error`), if one was given.
+    /// The error the passes ran until (`target_error`), if one was given.
     pub target_error: Option<f32>,
     /// Time budget in seconds, if one was given.
     pub budget_s: Option<f64>,
@@ -370,8 +372,18 @@ pub struct ProgressiveStats {
     pub pass_seconds: Vec<f64>,
     /// Wall time of the pilot photon pass and the per-pixel radii.
     pub pilot_seconds: f64,
-    /// The image's noise: the mean over pixels of the `error` layer (the half-width of each
-    /// pixel's 95 % interval from the spread between passes), over the mean beauty grey value.
-    /// Noise only, not bias. `None` before two passes.
-    pub noise_95: Option<f64>,
+    /// The image's error estimate after the last pass. `None` before two passes.
+    pub error_95: Option<ImageError>,
+}
+
+/// A progressive image's error estimate, each part a mean over pixels over the image's mean
+/// beauty grey value: `error` = `noise` + `bias`, the mean of the EXR's `error` layer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ImageError {
+    /// The error bound: noise plus the bias's size.
+    pub error: f64,
+    /// The half-width of each pixel's 95 % interval from the spread between passes.
+    pub noise: f64,
+    /// The size of each pixel's estimated bias (Hachisuka, Jarosz and Jensen 2010).
+    pub bias: f64,
 }

@@ -352,13 +352,13 @@ fn progressive_indirect_light_matches_the_path_tracer() {
     assert!((m_pm - m_pt).abs() < 3.0 * se + 0.02 * m_pt, "progressive {m_pm} vs path traced {m_pt} (se {se})");
 }
 
-/// The `error` layer is the half-width of a 95 % Student-t interval of each pixel's mean over
-/// the passes: with passes whose beauty grey value alternates a ± d in every pixel (exactly
-/// representable values), the layer must equal t(N−1)·s/√N, s the passes' sample standard
-/// deviation, to 1e-6 relative. One pass has no layer. The t quantile itself is checked against
-/// tables (0.5 %).
+/// The noise is the half-width of a 95 % Student-t interval of each pixel's mean over the
+/// passes: with passes whose beauty grey value alternates a ± d in every pixel (exactly
+/// representable values), it must equal t(N−1)·s/√N, s the passes' sample standard deviation,
+/// to 1e-6 relative; and the `error` bound adds the size of the passes' mean bias's grey value.
+/// One pass has neither. The t quantile itself is checked against tables (0.5 %).
 #[test]
-fn the_error_layer_is_the_interval_of_the_passes_spread() {
+fn the_error_layer_is_the_passes_spread_plus_the_bias() {
     use photonwave::progressive::student_t975;
     for (dof, table) in [(1u32, 12.706f64), (4, 2.776), (10, 2.228), (30, 2.042), (100, 1.984)] {
         assert!((student_t975(dof) / table - 1.0).abs() < 0.005, "t({dof}) = {}", student_t975(dof));
@@ -366,19 +366,23 @@ fn the_error_layer_is_the_interval_of_the_passes_spread() {
     let (scene, cam) = spheres();
     let settings = small(3);
     let mut p = Progressive::new(&scene, &cam, &common::job(&scene, &settings));
-    let (a, d) = (0.5f32, 0.125f32);
+    let (a, d, bias) = (0.5f32, 0.125f32, 0.01f32);
     let n = (settings.width * settings.height) as usize;
     // Pass k gives a + d for even k and a − d for odd k.
     let calls = std::cell::Cell::new(0u32);
     let fake = |_: &Job| -> photonwave::Result<(Film, photonwave::stats::RenderStats)> {
         let v = if calls.get().is_multiple_of(2) { a + d } else { a - d };
         calls.set(calls.get() + 1);
-        let t = photonwave::film::Terms { direct: glam::Vec3::splat(v), ..Default::default() };
-        let film = Film { width: settings.width, height: settings.height, pixels: vec![t; n], error: None };
+        let t = photonwave::film::Terms {
+            direct: glam::Vec3::splat(v),
+            bias: glam::Vec3::new(-3.0, 1.0, 0.5) * bias,
+            ..Default::default()
+        };
+        let film = Film { width: settings.width, height: settings.height, pixels: vec![t; n], noise: None };
         Ok((film, photonwave::stats::RenderStats::default()))
     };
     p.step(&fake).unwrap();
-    assert!(p.image().error.is_none());
+    assert!(p.image().noise.is_none() && p.image().error().is_none());
     for _ in 0..7 {
         p.step(&fake).unwrap();
     }
@@ -388,8 +392,12 @@ fn the_error_layer_is_the_interval_of_the_passes_spread() {
     let mean = values.iter().sum::<f64>() / nf;
     let s = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (nf - 1.0)).sqrt();
     let want = student_t975(7) * s / nf.sqrt();
-    let error = image.error.as_ref().expect("eight passes have an error layer");
+    let noise = image.noise.as_ref().expect("eight passes have a noise estimate");
     assert!(want > 0.0, "the passes must differ for this test to mean anything");
+    assert!(noise.iter().all(|&e| (f64::from(e) / want - 1.0).abs() < 1e-6), "{} vs {want}", noise[0]);
+    // The bound adds the size of the bias's grey value: |(−3 + 1 + 0.5)/3 · bias| = bias / 2.
+    let error = image.error().expect("and an error bound");
+    let want = want + f64::from(bias) / 2.0;
     assert!(error.iter().all(|&e| (f64::from(e) / want - 1.0).abs() < 1e-6), "{} vs {want}", error[0]);
 }
 
@@ -405,17 +413,17 @@ fn target_error_stops_at_the_error_it_reports() {
     let s = Settings { target_error: target, ..small(4) };
     let (film, stats) = render(&scene, &cam, &s, Engine::Wavefront, None, &NoProgress).unwrap();
     let p = stats.progressive.expect("a target makes a progressive render");
-    let noise = p.noise_95.expect("at least two passes");
-    assert!(p.passes >= 4 && noise <= f64::from(target), "{} passes, noise {noise}", p.passes);
+    let error = p.error_95.expect("at least two passes").error;
+    assert!(p.passes >= 4 && error <= f64::from(target), "{} passes, error {error}", p.passes);
     assert_eq!(p.target_error, Some(target));
-    let error = film.error.as_ref().unwrap();
-    let mean_error = error.iter().map(|&v| f64::from(v)).sum::<f64>() / error.len() as f64;
-    let mean = film.pixels.iter().map(|t| f64::from(t.beauty().element_sum()) / 3.0).sum::<f64>() / error.len() as f64;
-    assert!((mean_error / mean / noise - 1.0).abs() < 1e-4, "{} vs {noise}", mean_error / mean);
+    let layer = film.error().unwrap();
+    let mean_error = layer.iter().map(|&v| f64::from(v)).sum::<f64>() / layer.len() as f64;
+    let mean = film.pixels.iter().map(|t| f64::from(t.beauty().element_sum()) / 3.0).sum::<f64>() / layer.len() as f64;
+    assert!((mean_error / mean / error - 1.0).abs() < 1e-4, "{} vs {error}", mean_error / mean);
     // The target is far enough that the minimum of 4 passes is not what stopped it.
     assert!(p.passes > 4, "{} passes", p.passes);
     let fewer = Settings { target_error: 0.0, passes: p.passes - 1, ..s };
     let (_, before) = render(&scene, &cam, &fewer, Engine::Wavefront, None, &NoProgress).unwrap();
-    let before = before.progressive.unwrap().noise_95.unwrap();
-    assert!(before > f64::from(target), "one pass fewer already had noise {before}");
+    let before = before.progressive.unwrap().error_95.unwrap().error;
+    assert!(before > f64::from(target), "one pass fewer already had error {before}");
 }

@@ -30,12 +30,13 @@ fn small() -> Settings {
     }
 }
 
-/// Largest per-pixel, per-channel difference relative to max(1, |reference|).
+/// Largest per-pixel, per-channel difference relative to max(1, |reference|), over the terms and
+/// the estimated bias.
 fn max_rel_diff(a: &Film, b: &Film) -> f32 {
     a.pixels
         .iter()
         .zip(&b.pixels)
-        .flat_map(|(x, y)| x.as_array().into_iter().zip(y.as_array()))
+        .flat_map(|(x, y)| x.as_array().into_iter().chain([x.bias]).zip(y.as_array().into_iter().chain([y.bias])))
         .map(|(x, y)| ((x - y).abs() / x.abs().max(glam::Vec3::ONE)).max_element())
         .fold(0.0, f32::max)
 }
@@ -158,7 +159,7 @@ fn both_engines_emit_and_store_the_same_photons() {
 }
 
 /// Progressive passes with per-pixel radii: the engines still agree per pixel (same tolerance
-/// as one-pass renders), with final gathering on and off.
+/// as one-pass renders), terms and estimated bias, with final gathering on and off.
 #[test]
 fn wavefront_matches_reference_with_per_pixel_radii() {
     use photonwave::engine::{render as render_with, Engine};
@@ -170,6 +171,7 @@ fn wavefront_matches_reference_with_per_pixel_radii() {
         let image = |e| render_with(&scene, &rays, &s, e, None, &NoProgress).unwrap();
         let ((reference, rs), (wave, _)) = (image(Engine::Reference), image(Engine::Wavefront));
         assert!(rs.progressive.unwrap().pixel_caustic_radii.is_some());
+        assert!(reference.pixels.iter().any(|t| t.bias != glam::Vec3::ZERO), "no bias estimated");
         let d = max_rel_diff(&reference, &wave);
         assert!(d < 1e-6, "final gather {final_gather}: max relative difference {d}");
     }

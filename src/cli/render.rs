@@ -81,8 +81,9 @@ pub struct RenderArgs {
     /// pass by pass (α); the image is their mean [1 = one k-nearest-neighbour render].
     #[arg(long)]
     pub passes: Option<u32>,
-    /// Progressive passes until the image's noise (mean 95 % interval half-width over the image
-    /// mean, the `error` layer; bias not included) is at most E, a fraction (0.01 = 1 %); with
+    /// Progressive passes until the image's estimated error (the `error` layer's mean — 95 %
+    /// noise half-width plus estimated bias — over the image mean) is at most E, a fraction
+    /// (0.01 = 1 %); with
     /// `--time` or `--passes` as a cap (without either it runs until the target is met) [off].
     #[arg(long, value_name = "E")]
     pub target_error: Option<f32>,

@@ -97,6 +97,9 @@ pub struct Estimate {
     pub radiance: Vec3,
     /// Radius the estimate used.
     pub radius: f32,
+    /// Fixed-radius estimates: the estimated bias of `radiance`, E[L̂] − L ≈ ½·μ₂·r²·ΔL, from
+    /// the same photons ([`Kernel::bias_normalisation`]); zero for k-nearest estimates.
+    pub bias: Vec3,
     /// Photons summed.
     pub count: u32,
     /// Photons within the search radius (as it stood when each was examined) that the normal

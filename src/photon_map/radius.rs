@@ -1,8 +1,9 @@
 //! Fixed-radius density estimates (progressive passes): every photon within the radius, summed
-//! as the walk finds them — 8 at a time by the SIMD kernel, one at a time by its scalar twin.
+//! as the walk finds them — 8 at a time by the SIMD kernel, one at a time by its scalar twin —
+//! with the estimate's bias from the same photons ([`Kernel::bias_normalisation`]).
 
-use super::boundary::{Cut, Neighbours};
-use super::{Estimate, Lookup, PhotonMap, Reflectance, Test};
+use super::boundary::{Coverage, Cut, Neighbours};
+use super::{Estimate, Kernel, Lookup, PhotonMap, Reflectance, Test};
 use crate::code_path::CodePath;
 use glam::Vec3;
 use wide::f32x8;
@@ -29,8 +30,8 @@ impl PhotonMap {
         }
         let (mut count, mut rejected) = (0u32, 0u32);
         let mut neighbours = Neighbours::default();
-        let mut sum = Vec3::ZERO;
-        let mut sum8 = [f32x8::ZERO; 3];
+        let (mut sum, mut bias) = (Vec3::ZERO, Vec3::ZERO);
+        let (mut sum8, mut bias8) = ([f32x8::ZERO; 3], [f32x8::ZERO; 3]);
         let mut r2_walk = r2;
         self.walk(q.p, &mut r2_walk, |lo, hi, simd_ok, _| {
             if simd_ok && set == CodePath::Simd {
@@ -60,8 +61,13 @@ impl PhotonMap {
                             0.0
                         }
                     }));
-                    let c = Self::contribution8(self.key8(base), self.power8(base), lanes, d2, r2, q.kernel, f);
+                    let r2_8 = f32x8::splat(r2);
+                    let weights = [q.kernel.weight8(d2, r2_8), Kernel::bias_weight8(d2, r2_8)];
+                    let [c, b] = Self::contributions8(self.key8(base), self.power8(base), lanes, weights, f);
                     for (s, v) in sum8.iter_mut().zip(c) {
+                        *s += v;
+                    }
+                    for (s, v) in bias8.iter_mut().zip(b) {
                         *s += v;
                     }
                 }
@@ -71,7 +77,9 @@ impl PhotonMap {
                     if d2 < r2 {
                         match Self::test(self.key[i], &q.filter) {
                             Test::Accepted => {
-                                sum += self.contribution(i, d2, r2, q.kernel, f);
+                                let (c, b) = self.contribution_and_bias(i, d2, r2, q.kernel, f);
+                                sum += c;
+                                bias += b;
                                 count += 1;
                             }
                             Test::Normal => {
@@ -86,12 +94,16 @@ impl PhotonMap {
                 }
             }
         });
-        let simd = Vec3::new(sum8[0].reduce_add(), sum8[1].reduce_add(), sum8[2].reduce_add());
+        let reduce = |v: [f32x8; 3]| Vec3::new(v[0].reduce_add(), v[1].reduce_add(), v[2].reduce_add());
         let coverage = match on_surface {
             Some(edges) => neighbours.coverage(self, q.p, q.filter.n, r2, q.kernel, edges),
-            None => 1.0,
+            None => Coverage::WHOLE,
         };
-        let radiance = (sum + simd) * q.kernel.normalisation(r2) / coverage;
-        Estimate { radiance, radius: q.r_max, count, rejected }
+        let (sum, bias) = (sum + reduce(sum8), bias + reduce(bias8));
+        let radiance = sum * q.kernel.normalisation(r2) / coverage.fraction;
+        // A cut disk's bias sum is not zero even for a uniform density: subtract that part.
+        let bias = (bias - sum * (coverage.bias_weight / coverage.fraction)) * q.kernel.bias_normalisation(r2)
+            / coverage.fraction;
+        Estimate { radiance, bias, radius: q.r_max, count, rejected }
     }
 }

@@ -25,6 +25,7 @@ impl PhotonMap {
         Estimate {
             radiance: sum * q.kernel.normalisation(r2),
             radius: r2.sqrt(),
+            bias: Vec3::ZERO,
             count: found.len() as u32,
             rejected: 0,
         }
@@ -33,8 +34,28 @@ impl PhotonMap {
     /// f(wi)·Φ·weight of photon `i` at squared distance `d2` (scalar twin of [`Self::contribution8`]).
     #[inline]
     pub(super) fn contribution(&self, i: usize, d2: f32, r2: f32, kernel: Kernel, f: Reflectance<'_>) -> Vec3 {
+        self.reflected(i, f) * kernel.weight(d2, r2)
+    }
+
+    /// f(wi)·Φ of photon `i` times its kernel weight and times its [`Kernel::bias_weight`]
+    /// (scalar twin of [`Self::contributions8`] with those two weights).
+    #[inline]
+    pub(super) fn contribution_and_bias(
+        &self,
+        i: usize,
+        d2: f32,
+        r2: f32,
+        kernel: Kernel,
+        f: Reflectance<'_>,
+    ) -> (Vec3, Vec3) {
+        let fp = self.reflected(i, f);
+        (fp * kernel.weight(d2, r2), fp * Kernel::bias_weight(d2, r2))
+    }
+
+    /// f(wi)·Φ of photon `i`, unweighted.
+    #[inline]
+    fn reflected(&self, i: usize, f: Reflectance<'_>) -> Vec3 {
         let key = self.key[i];
-        let w = kernel.weight(d2, r2);
         let fp = match f {
             Reflectance::Constant(v) => v,
             Reflectance::Hemisphere { value, ng } => {
@@ -47,7 +68,7 @@ impl PhotonMap {
             }
             Reflectance::PerPhoton(g) => g(key_wi(key).normalize_or_zero()),
         };
-        fp * rgbe_decode(self.power[i]) * w
+        fp * rgbe_decode(self.power[i])
     }
 
     /// f(wi)·Φ·weight of 8 photons (`key`, `power` columns, squared distances `d2`) in the lanes
@@ -63,11 +84,29 @@ impl PhotonMap {
         kernel: Kernel,
         f: Reflectance<'_>,
     ) -> [f32x8; 3] {
-        let w = lanes.select(kernel.weight8(d2, f32x8::splat(r2)), f32x8::ZERO);
+        let [c] = Self::contributions8(key, power, lanes, [kernel.weight8(d2, f32x8::splat(r2))], f);
+        c
+    }
+
+    /// f(wi)·Φ·w of 8 photons for each of `W` per-photon weights `weights`, in the lanes of
+    /// `lanes` (others 0), per channel: the photons' powers and directions are decoded once.
+    #[inline]
+    pub(super) fn contributions8<const W: usize>(
+        key: u32x8,
+        power: u32x8,
+        lanes: f32x8,
+        weights: [f32x8; W],
+        f: Reflectance<'_>,
+    ) -> [[f32x8; 3]; W] {
         let [pr, pg, pb] = rgbe_decode8(power);
-        let (pr, pg, pb) = (pr * w, pg * w, pb * w);
+        let weighted = weights.map(|w| {
+            let w = lanes.select(w, f32x8::ZERO);
+            (pr * w, pg * w, pb * w)
+        });
         match f {
-            Reflectance::Constant(v) => [pr * f32x8::splat(v.x), pg * f32x8::splat(v.y), pb * f32x8::splat(v.z)],
+            Reflectance::Constant(v) => {
+                weighted.map(|(pr, pg, pb)| [pr * f32x8::splat(v.x), pg * f32x8::splat(v.y), pb * f32x8::splat(v.z)])
+            }
             Reflectance::Hemisphere { value, ng } => {
                 let [wx, wy, wz] = oct_decode8(
                     dequantise8((key >> 16_u32) & u32x8::splat(255), DIR_STEPS),
@@ -76,25 +115,35 @@ impl PhotonMap {
                 let up =
                     (wx * f32x8::splat(ng.x) + wy * f32x8::splat(ng.y) + wz * f32x8::splat(ng.z)).simd_gt(f32x8::ZERO);
                 let zero = f32x8::ZERO;
-                [
-                    up.select(pr * f32x8::splat(value.x), zero),
-                    up.select(pg * f32x8::splat(value.y), zero),
-                    up.select(pb * f32x8::splat(value.z), zero),
-                ]
+                weighted.map(|(pr, pg, pb)| {
+                    [
+                        up.select(pr * f32x8::splat(value.x), zero),
+                        up.select(pg * f32x8::splat(value.y), zero),
+                        up.select(pb * f32x8::splat(value.z), zero),
+                    ]
+                })
             }
             Reflectance::PerPhoton(g) => {
-                let (pr, pg, pb) = (pr.to_array(), pg.to_array(), pb.to_array());
                 let (keys, on) = (key.to_array(), lanes.to_bitmask());
-                let mut out = [[0f32; 8]; 3];
-                for l in 0..8 {
+                let fps: [Vec3; 8] = std::array::from_fn(|l| {
                     if on >> l & 1 == 1 {
-                        let fp = g(key_wi(keys[l]).normalize_or_zero());
-                        out[0][l] = fp.x * pr[l];
-                        out[1][l] = fp.y * pg[l];
-                        out[2][l] = fp.z * pb[l];
+                        g(key_wi(keys[l]).normalize_or_zero())
+                    } else {
+                        Vec3::ZERO
                     }
-                }
-                out.map(f32x8::from)
+                });
+                weighted.map(|(pr, pg, pb)| {
+                    let (pr, pg, pb) = (pr.to_array(), pg.to_array(), pb.to_array());
+                    let mut out = [[0f32; 8]; 3];
+                    for l in 0..8 {
+                        if on >> l & 1 == 1 {
+                            out[0][l] = fps[l].x * pr[l];
+                            out[1][l] = fps[l].y * pg[l];
+                            out[2][l] = fps[l].z * pb[l];
+                        }
+                    }
+                    out.map(f32x8::from)
+                })
             }
         }
     }

@@ -75,25 +75,42 @@ pub fn trace_camera_path(
             continue;
         }
         let direct = beta * direct_light(ctx, &sp, &mat.bsdf, wo, &s.fork(streams::light(depth)), rays);
-        let caustic = beta * caustic_estimate(ctx, &sp, &mat.bsdf, wo, Some(pixel), scratch);
-        let indirect = beta
-            * if ctx.effects.final_gather.on {
-                final_gather(ctx, &sp, &mat.bsdf, wo, &s.fork(streams::gather(depth)), rays, scratch)
-            } else {
-                indirect_estimate(ctx, &sp, &mat.bsdf, wo, Some(pixel), scratch)
-            };
-        let glossy = beta * glossy_reflection(ctx, &sp, &mat.bsdf, wo, &s.fork(streams::glossy(depth)), rays, scratch);
+        let caustic = caustic_estimate(ctx, &sp, &mat.bsdf, wo, Some(pixel), scratch);
+        let indirect = if ctx.effects.final_gather.on {
+            final_gather(ctx, &sp, &mat.bsdf, wo, &s.fork(streams::gather(depth)), rays, scratch)
+        } else {
+            indirect_estimate(ctx, &sp, &mat.bsdf, wo, Some(pixel), scratch).into()
+        };
+        let glossy = glossy_reflection(ctx, &sp, &mat.bsdf, wo, &s.fork(streams::glossy(depth)), rays, scratch);
+        let (caustic_l, indirect_l, glossy_l) =
+            (beta * caustic.radiance, beta * indirect.radiance, beta * glossy.radiance);
         if through_specular {
-            terms.specular += direct + caustic + indirect + glossy;
+            terms.specular += direct + caustic_l + indirect_l + glossy_l;
         } else {
             terms.direct += direct;
-            terms.caustic += caustic;
-            terms.indirect += indirect;
-            terms.specular += glossy;
+            terms.caustic += caustic_l;
+            terms.indirect += indirect_l;
+            terms.specular += glossy_l;
         }
+        terms.bias += beta * (caustic.bias + indirect.bias + glossy.bias);
         break;
     }
     terms
+}
+
+/// Radiance found by photon-map estimates, with their estimated bias weighted the same way.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Estimated {
+    /// Radiance.
+    pub radiance: Vec3,
+    /// Its bias ([`crate::photon_map::Estimate::bias`]).
+    pub bias: Vec3,
+}
+
+impl From<crate::photon_map::Estimate> for Estimated {
+    fn from(e: crate::photon_map::Estimate) -> Self {
+        Estimated { radiance: e.radiance, bias: e.bias }
+    }
 }
 
 /// Final gather: `kd/N · Σ L(x, ωi)` over the N gather rays, L read from the photon maps at
@@ -106,26 +123,29 @@ pub fn final_gather(
     s: &Sampler,
     rays: &mut RayCounts,
     scratch: &mut Vec<(f32, u32)>,
-) -> Vec3 {
+) -> Estimated {
     let kd = bsdf.diffuse();
     if kd == Vec3::ZERO {
-        return Vec3::ZERO;
+        return Estimated::default();
     }
     let n = ctx.settings.gather_rays;
-    let mut sum = Vec3::ZERO;
+    let (mut sum, mut bias) = (Vec3::ZERO, Vec3::ZERO);
     gather_rays(sp, wo, n, s, |g, o, wi| {
         let chain = s.fork(streams::gather_ray(g));
         if let Some((y, d, beta)) = first_non_specular(ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, rays) {
             let bsdf = &ctx.scene.materials[y.material as usize].bsdf;
-            sum += beta * map_radiance(ctx, &y, bsdf, -d, scratch);
+            let e = map_radiance(ctx, &y, bsdf, -d, scratch);
+            sum += beta * e.radiance;
+            bias += beta * e.bias;
         }
     });
-    kd * sum / n as f32
+    Estimated { radiance: kd * sum / n as f32, bias: kd * bias / n as f32 }
 }
 
 /// The glossy lobe's reflection: one ray sampled from the lobe; at its first non-specular hit,
 /// direct light, caustics and the global map without direct and caustic photons (so each path
-/// is counted once: emission reached by this ray is already in the direct term).
+/// is counted once: emission reached by this ray is already in the direct term). The bias is
+/// that of the two estimates.
 pub fn glossy_reflection(
     ctx: &Context,
     sp: &SurfacePoint,
@@ -134,14 +154,15 @@ pub fn glossy_reflection(
     s: &Sampler,
     rays: &mut RayCounts,
     scratch: &mut Vec<(f32, u32)>,
-) -> Vec3 {
-    let Some(ray) = glossy_ray(sp, bsdf, wo, s) else { return Vec3::ZERO };
+) -> Estimated {
+    let Some(ray) = glossy_ray(sp, bsdf, wo, s) else { return Estimated::default() };
     let Some((y, d, beta)) = first_non_specular(ctx, ray.origin, ray.dir, s, streams::GLOSSY_CHAIN_BOUNCE, rays) else {
-        return Vec3::ZERO;
+        return Estimated::default();
     };
     let b = &ctx.scene.materials[y.material as usize].bsdf;
     let direct = direct_light(ctx, &y, b, -d, &s.fork(streams::GLOSSY_HIT_LIGHT), rays);
     let caustic = caustic_estimate(ctx, &y, b, -d, None, scratch);
     let rest = indirect_estimate(ctx, &y, b, -d, None, scratch);
-    ray.weight * beta * (direct + caustic + rest)
+    let w = ray.weight * beta;
+    Estimated { radiance: w * (direct + caustic.radiance + rest.radiance), bias: w * (caustic.bias + rest.bias) }
 }

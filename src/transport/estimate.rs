@@ -1,12 +1,14 @@
 //! Photon-map density estimates at a surface point: the caustic and global maps' reflected
 //! radiance (k nearest photons, or every photon within a progressive pass's fixed radii,
 //! optionally only the visible ones), and the radiance a final-gather ray reads where it lands
-//! (precomputed irradiance where that applies).
+//! (precomputed irradiance where that applies). Each returns the map's [`Estimate`]: with fixed
+//! radii it carries the estimate's bias too (not with `visibility`, whose estimates are not
+//! boundary-corrected either).
 
 use super::Context;
 use crate::material::Bsdf;
 use crate::photon_map::boundary::{Cut, MAX_EXTRA_CUTS};
-use crate::photon_map::{flags, Filter, Lookup, PhotonMap, Reflectance};
+use crate::photon_map::{flags, Estimate, Filter, Lookup, PhotonMap, Reflectance};
 use crate::scene::{Scene, SurfacePoint};
 use glam::Vec3;
 use std::sync::atomic::Ordering;
@@ -26,7 +28,7 @@ fn map_estimate(
     mask: u8,
     fixed: Option<f32>,
     scratch: &mut Vec<(f32, u32)>,
-) -> Vec3 {
+) -> Estimate {
     let (ng, _) = sp.frame.oriented(wo);
     let lookup = Lookup {
         p: sp.p,
@@ -61,7 +63,7 @@ fn map_estimate(
     if e.rejected > 0 {
         ctx.filtered.fetch_add(u64::from(e.rejected), Ordering::Relaxed);
     }
-    e.radiance
+    e
 }
 
 /// The open edges of `sp`'s flat region within `r` of it, as cuts of its estimate's disk (at most
@@ -102,7 +104,7 @@ pub fn caustic_estimate(
     wo: Vec3,
     pixel: Option<usize>,
     scratch: &mut Vec<(f32, u32)>,
-) -> Vec3 {
+) -> Estimate {
     let fixed = ctx.fixed.map(|r| r.caustic_at(pixel));
     map_estimate(ctx, &ctx.maps.caustic, ctx.settings.caustic_k, ctx.caustic_radius, sp, bsdf, wo, 0, fixed, scratch)
 }
@@ -118,7 +120,7 @@ pub fn global_estimate(
     mask: u8,
     pixel: Option<usize>,
     scratch: &mut Vec<(f32, u32)>,
-) -> Vec3 {
+) -> Estimate {
     let fixed = ctx.fixed.map(|r| r.global_at(pixel));
     map_estimate(ctx, &ctx.maps.global, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, fixed, scratch)
 }
@@ -134,7 +136,7 @@ pub fn indirect_estimate(
     wo: Vec3,
     pixel: Option<usize>,
     scratch: &mut Vec<(f32, u32)>,
-) -> Vec3 {
+) -> Estimate {
     global_estimate(ctx, sp, bsdf, wo, flags::OWN_TERMS, pixel, scratch)
 }
 
@@ -142,7 +144,13 @@ pub fn indirect_estimate(
 /// nearest precomputed irradiance for Lambertian surfaces when that is available (and a point
 /// with a similar normal lies within the global radius), the full global-map estimate otherwise.
 #[inline]
-pub fn map_radiance(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, scratch: &mut Vec<(f32, u32)>) -> Vec3 {
+pub fn map_radiance(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Estimate {
     let irr = &ctx.maps.irradiance;
     if let (Bsdf::Lambert { kd }, false) = (bsdf, irr.is_empty()) {
         let (ng, _) = sp.frame.oriented(wo);
@@ -163,7 +171,8 @@ pub fn map_radiance(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, scr
                 photon_visibility(ctx.scene, sp.p, ng, lookup.r_max)(p.position, p.normal)
             };
             if !ctx.settings.visibility || visible() {
-                return *kd * std::f32::consts::FRAC_1_PI * irr.power(i as usize);
+                let radiance = *kd * std::f32::consts::FRAC_1_PI * irr.power(i as usize);
+                return Estimate { radiance, radius: lookup.r_max, ..Default::default() };
             }
         }
     }

@@ -8,6 +8,7 @@ use super::queues::PathKind;
 use super::{par_lanes, CameraWork, Maps, Shared, StageStats, GATHER_CHUNK};
 use crate::film::Term;
 use crate::material::Bsdf;
+use crate::photon_map::Estimate;
 use crate::scene::SurfacePoint;
 use crate::transport::estimate::{caustic_estimate, indirect_estimate, map_radiance};
 use crate::transport::Context;
@@ -17,7 +18,8 @@ use std::time::Instant;
 
 /// Runs `estimate(ctx, point, bsdf, wo, kind, pixel, scratch)` at the diffuse hit of every lane
 /// whose kind passes `wanted` (`pixel` is the lane's pixel for camera lanes, `None` for
-/// others), in parallel, and adds `beta × value` to the lane's sample in lane order. `own` is
+/// others), in parallel, and adds `beta × radiance` to the lane's sample in lane order (and
+/// `beta × bias` to its bias). `own` is
 /// the term of camera lanes (routed to specular behind a mirror or glass); gather and glossy
 /// lanes use the term they carry. Returns the number of estimates.
 fn estimate_at_diffuse_hits(
@@ -26,13 +28,14 @@ fn estimate_at_diffuse_hits(
     work: &mut CameraWork,
     wanted: impl Fn(PathKind) -> bool,
     own: Term,
-    estimate: impl Fn(&Context, &SurfacePoint, &Bsdf, Vec3, PathKind, Option<usize>, &mut Vec<(f32, u32)>) -> Vec3 + Sync,
+    estimate: impl Fn(&Context, &SurfacePoint, &Bsdf, Vec3, PathKind, Option<usize>, &mut Vec<(f32, u32)>) -> Estimate
+        + Sync,
 ) -> usize {
     let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
     let spp = u64::from(shared.job.settings.spp);
     let w = &*work;
     let lanes: Vec<u32> = w.classified.diffuse.iter().copied().filter(|&l| wanted(w.paths.kind[l as usize])).collect();
-    let out: Vec<(u32, Term, Vec3)> = par_lanes(lanes.len(), GATHER_CHUNK, shared.job.threads, |r| {
+    let out: Vec<(u32, Term, Vec3, Vec3)> = par_lanes(lanes.len(), GATHER_CHUNK, shared.job.threads, |r| {
         let mut scratch = Vec::new();
         r.filter_map(|j| {
             let i = lanes[j] as usize;
@@ -41,17 +44,20 @@ fn estimate_at_diffuse_hits(
             let kind = w.paths.kind[i];
             let pixel =
                 (kind == PathKind::Camera).then(|| ((w.first_sample + u64::from(w.paths.sample[i])) / spp) as usize);
-            let value = estimate(&ctx, &sp, bsdf, -w.paths.rays.direction(i), kind, pixel, &mut scratch);
+            let e = estimate(&ctx, &sp, bsdf, -w.paths.rays.direction(i), kind, pixel, &mut scratch);
             let term = match kind {
                 PathKind::Camera => own.seen(w.paths.through_specular[i]),
                 _ => w.paths.term[i],
             };
-            Some((w.paths.sample[i], term, w.paths.beta[i] * value))
+            let beta = w.paths.beta[i];
+            Some((w.paths.sample[i], term, beta * e.radiance, beta * e.bias))
         })
         .collect()
     });
-    for &(sample, term, v) in &out {
-        work.terms[sample as usize].add(term, v);
+    for &(sample, term, v, bias) in &out {
+        let t = &mut work.terms[sample as usize];
+        t.add(term, v);
+        t.bias += bias;
     }
     work.numerics.photons_filtered += ctx.filtered();
     lanes.len()

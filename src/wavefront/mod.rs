@@ -190,7 +190,7 @@ pub fn render_job(scene: Arc<Scene>, camera: &CameraRays, job: &Job, progress: &
     progress.finish();
     let mut w = world.resource_mut::<CameraWork>();
     let film =
-        Film { width: settings.width, height: settings.height, pixels: std::mem::take(&mut w.film), error: None };
+        Film { width: settings.width, height: settings.height, pixels: std::mem::take(&mut w.film), noise: None };
     stats.rays += w.rays;
     stats.numerics += w.numerics;
     stats.times.camera_s = t.elapsed().as_secs_f64();
