@@ -192,6 +192,25 @@ pub struct Film {
     /// pixels' estimated bias ([`Terms::bias`]) it makes the error bound of [`Film::error`].
     /// `None` for a single render.
     pub noise: Option<Vec<f32>>,
+    /// With `--diagnostics`: per pixel, the density estimates' radii and photon counts.
+    pub diagnostics: Option<EstimateLayers>,
+}
+
+/// Per pixel, what the density estimates of one camera sample used (`crate::diagnostics`):
+/// radius (scene units) and photons summed, of the caustic estimate at the first non-specular
+/// point and of the global estimates where the render reads the global map (the mean over the
+/// final-gather hits). Written as the EXR layers `radius.caustic`, `photons.caustic`,
+/// `radius.global`, `photons.global` (R = G = B).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EstimateLayers {
+    /// Caustic estimate's radius.
+    pub caustic_radius: Vec<f32>,
+    /// Photons in the caustic estimate.
+    pub caustic_photons: Vec<f32>,
+    /// Global estimates' mean radius.
+    pub global_radius: Vec<f32>,
+    /// Photons in the global estimates, on average.
+    pub global_photons: Vec<f32>,
 }
 
 impl Film {
@@ -221,6 +240,16 @@ impl Film {
             let noise = self.noise.iter().flatten();
             layers.push(("error.noise".to_string(), noise.map(|&v| Vec3::splat(v)).collect()));
             layers.push(("error.bias".to_string(), self.pixels.iter().map(|t| t.bias).collect()));
+        }
+        if let Some(d) = &self.diagnostics {
+            for (name, values) in [
+                ("radius.caustic", &d.caustic_radius),
+                ("photons.caustic", &d.caustic_photons),
+                ("radius.global", &d.global_radius),
+                ("photons.global", &d.global_photons),
+            ] {
+                layers.push((name.to_string(), values.iter().map(|&v| Vec3::splat(v)).collect()));
+            }
         }
         layers
     }
@@ -419,7 +448,7 @@ mod tests {
                 }
             })
             .collect();
-        let film = Film { width: w, height: h, pixels, noise: None };
+        let film = Film { width: w, height: h, pixels, noise: None, diagnostics: None };
         let dir = std::env::temp_dir().join(format!("photonwave-film-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let bytes = |name: &str| {

@@ -42,6 +42,7 @@
 //! **Drivers and tools**:
 //! - [`progressive`]: progressive passes with shrinking radii and a time budget;
 //! - [`engine`]: the one render entry point — a single render or progressive passes;
+//! - [`diagnostics`]: the diagnostic layers — estimate radii and photon counts per pixel;
 //! - [`compare`], [`sweep`], [`plot`], [`bench`], [`fuzzing`]: the CLI's `compare`, `sweep`,
 //!   `bench` and the fuzz targets' entry points.
 
@@ -53,6 +54,7 @@
 pub mod bench;
 pub mod code_path;
 pub mod compare;
+pub mod diagnostics;
 pub mod effects;
 pub mod engine;
 pub mod error;

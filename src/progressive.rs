@@ -247,6 +247,8 @@ pub struct Progressive {
     pub stats: RenderStats,
     /// What the passes did.
     pub progress: ProgressiveStats,
+    /// The last pass's job.
+    pub last: Option<Job>,
 }
 
 impl Progressive {
@@ -274,6 +276,7 @@ impl Progressive {
             grey: vec![(0.0, 0.0); settings.width as usize * settings.height as usize],
             stats: RenderStats::default(),
             progress,
+            last: None,
         }
     }
 
@@ -303,6 +306,7 @@ impl Progressive {
         let final_radii = [radii.global, radii.caustic];
         let pass = self.job.with_pass(Pass { seed: pass_seed(self.job.settings.seed, i), radii: Some(radii) })?;
         let (film, stats) = engine(&pass)?;
+        self.last = Some(pass);
         for ((s, g), p) in self.sum.iter_mut().zip(&mut self.grey).zip(&film.pixels) {
             *s += *p;
             let v = f64::from(p.beauty().element_sum()) / 3.0;
@@ -346,6 +350,7 @@ impl Progressive {
             height: self.job.settings.height,
             pixels: self.sum.iter().map(|t| *t * (1.0 / n)).collect(),
             noise: self.noise(),
+            diagnostics: None,
         }
     }
 
@@ -527,7 +532,10 @@ pub fn render_passes(
         shown = shown.max(done);
     }
     progress.finish();
-    let film = p.image();
+    let mut film = p.image();
+    if let Some(last) = &p.last {
+        crate::engine::add_diagnostics(scene, rays, last, &mut film, &mut p.stats);
+    }
     let error_95 = error_now.or_else(|| p.error_95());
     let mut stats = p.stats;
     let mut prog = p.progress;

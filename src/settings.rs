@@ -124,6 +124,10 @@ pub struct Settings {
     /// estimates stay plain). On by default; `false` gives the plain estimate, for comparison.
     /// One-pass (k-nearest) estimates are not corrected (measured: no better, BENCHMARKS.md).
     pub boundary_correction: bool,
+    /// Adds the diagnostic layers `radius.caustic`, `photons.caustic`, `radius.global` and
+    /// `photons.global` to the EXR (`crate::diagnostics`): where the estimates are starved or
+    /// blurred. Costs one pass's photon tracing again. Off by default.
+    pub diagnostics: bool,
 }
 
 impl Default for Settings {
@@ -154,6 +158,7 @@ impl Default for Settings {
             per_pixel_radii: true,
             visibility: false,
             boundary_correction: true,
+            diagnostics: false,
         }
     }
 }
@@ -221,6 +226,8 @@ pub struct Overrides {
     pub visibility: bool,
     /// `--no-boundary-correction`.
     pub no_boundary_correction: bool,
+    /// `--diagnostics` (turns them on; the scene file may too).
+    pub diagnostics: bool,
     /// `--force`, added to the scene file's.
     pub force: Vec<String>,
     /// `--passes`.
@@ -259,6 +266,7 @@ impl Overrides {
             s.final_gather = false;
         }
         s.visibility |= self.visibility;
+        s.diagnostics |= self.diagnostics;
         if self.no_boundary_correction {
             s.boundary_correction = false;
         }

@@ -125,6 +125,8 @@ pub struct PhaseTimes {
     pub map_build_s: f64,
     /// Camera pass.
     pub camera_s: f64,
+    /// The diagnostic layers' probe (`--diagnostics`), photon tracing included.
+    pub diagnostics_s: f64,
     /// Everything.
     pub total_s: f64,
 }

@@ -73,6 +73,12 @@ pub struct RenderArgs {
     /// surface (edges and corners then come out darker; for comparison) [on].
     #[arg(long)]
     pub no_boundary_correction: bool,
+    /// Add diagnostic EXR layers: per pixel, the radius and photon count of the caustic and the
+    /// global density estimates (`radius.caustic`, `photons.caustic`, `radius.global`,
+    /// `photons.global`), probed at one camera sample of the last pass; costs one pass's photon
+    /// tracing [off, or the scene file's `diagnostics`].
+    #[arg(long)]
+    pub diagnostics: bool,
     /// Force a part of the effects plan on even where the scene does not need it (repeatable):
     /// caustic_map, global_map, final_gather, refraction, shadow_rays.
     #[arg(long)]
@@ -158,6 +164,7 @@ fn overrides(args: &RenderArgs) -> Overrides {
         no_final_gather: args.no_final_gather,
         visibility: args.visibility,
         no_boundary_correction: args.no_boundary_correction,
+        diagnostics: args.diagnostics,
         force: args.force.clone(),
         passes: args.passes,
         target_error: args.target_error,

@@ -79,5 +79,9 @@ pub fn render_pixels(
         rays += r;
         numerics += n;
     }
-    (Film { width: job.settings.width, height: job.settings.height, pixels, noise: None }, rays, numerics)
+    (
+        Film { width: job.settings.width, height: job.settings.height, pixels, noise: None, diagnostics: None },
+        rays,
+        numerics,
+    )
 }

@@ -189,8 +189,13 @@ pub fn render_job(scene: Arc<Scene>, camera: &CameraRays, job: &Job, progress: &
     }
     progress.finish();
     let mut w = world.resource_mut::<CameraWork>();
-    let film =
-        Film { width: settings.width, height: settings.height, pixels: std::mem::take(&mut w.film), noise: None };
+    let film = Film {
+        width: settings.width,
+        height: settings.height,
+        pixels: std::mem::take(&mut w.film),
+        noise: None,
+        diagnostics: None,
+    };
     stats.rays += w.rays;
     stats.numerics += w.numerics;
     stats.times.camera_s = t.elapsed().as_secs_f64();

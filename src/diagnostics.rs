@@ -1,0 +1,99 @@
+//! Diagnostic layers (`--diagnostics`): where a render's density estimates are starved (few
+//! photons) or blurred (a wide radius). Reads a scene, its camera rays and the job of the
+//! render's last pass; writes, per pixel, the radius and the photons summed of the caustic and
+//! the global estimates ([`EstimateLayers`]).
+//!
+//! A probe, not a record kept by the engines: for each pixel, the pass's first camera sample is
+//! followed through mirrors and glass to its first non-specular point, as the engines follow it.
+//! There the caustic estimate is made as the camera's is; the global estimate is made where the
+//! render reads the global map — at each final-gather ray's first non-specular hit (the mean over
+//! the hits; the full map, as a gather ray reads it, even where the render reads precomputed
+//! irradiance instead, whose points were estimated the same way), or at the point itself with
+//! final gathering off. The pass's photon maps are traced again from its seed (the same photons
+//! the engines traced, by the transport core's streams), which costs one pass's photon tracing: a
+//! whole render's for a one-pass render, little for a progressive one.
+
+use crate::film::EstimateLayers;
+use crate::job::Job;
+use crate::parallel::map_chunks;
+use crate::reference::build_job_maps;
+use crate::scene::camera::CameraRays;
+use crate::scene::Scene;
+use crate::stats::RayCounts;
+use crate::transport::camera::camera_sample;
+use crate::transport::estimate::{caustic_estimate, global_estimate, indirect_estimate};
+use crate::transport::gather::gather_rays;
+use crate::transport::specular::first_non_specular;
+use crate::transport::{streams, Context};
+
+/// The diagnostic layers of `job`'s pass of `scene` seen through `rays` (see the module notes).
+/// Pixels whose sample finds no non-specular point, and estimates of a map the plan skipped,
+/// are 0.
+#[must_use]
+pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
+    let (maps, _, _) = build_job_maps(scene, job);
+    let ctx = Context::new(scene, &maps, job);
+    let settings = &job.settings;
+    let w = settings.width as usize;
+    let pixels = w * settings.height as usize;
+    let (caustic_on, global_on) = (ctx.effects.caustic_map.on, ctx.effects.global_map.on);
+    let gather_on = ctx.effects.final_gather.on;
+    let chunks = map_chunks(
+        pixels,
+        256,
+        job.threads,
+        |range| {
+            let mut scratch = Vec::new();
+            let mut counts = RayCounts::default();
+            range
+                .map(|pixel| {
+                    let (s, (fx, fy)) = camera_sample(job, pixel as u64 * u64::from(settings.spp));
+                    let (o, d) = rays.ray((pixel % w) as f32 + fx, (pixel / w) as f32 + fy);
+                    let chain = streams::CAMERA_CHAIN_BOUNCE;
+                    let Some((sp, d, _)) = first_non_specular(&ctx, o, d, &s, chain, &mut counts) else {
+                        return [0.0; 4];
+                    };
+                    let bsdf = &scene.materials[sp.material as usize].bsdf;
+                    let caustic = if caustic_on {
+                        let e = caustic_estimate(&ctx, &sp, bsdf, -d, Some(pixel), &mut scratch);
+                        [e.radius, e.count as f32]
+                    } else {
+                        [0.0; 2]
+                    };
+                    let global = if !global_on {
+                        [0.0; 2]
+                    } else if gather_on {
+                        let (mut sum, mut hits) = ([0.0f64; 2], 0u32);
+                        let gather = s.fork(streams::gather(0));
+                        gather_rays(&sp, -d, settings.gather_rays, &gather, |g, o, wi| {
+                            let chain = gather.fork(streams::gather_ray(g));
+                            let bounce = streams::GATHER_CHAIN_BOUNCE;
+                            if let Some((y, dy, _)) = first_non_specular(&ctx, o, wi, &chain, bounce, &mut counts) {
+                                let bsdf = &scene.materials[y.material as usize].bsdf;
+                                let e = global_estimate(&ctx, &y, bsdf, -dy, 0, None, &mut scratch);
+                                sum[0] += f64::from(e.radius);
+                                sum[1] += f64::from(e.count);
+                                hits += 1;
+                            }
+                        });
+                        let n = f64::from(hits.max(1));
+                        [(sum[0] / n) as f32, (sum[1] / n) as f32]
+                    } else {
+                        let e = indirect_estimate(&ctx, &sp, bsdf, -d, Some(pixel), &mut scratch);
+                        [e.radius, e.count as f32]
+                    };
+                    [caustic[0], caustic[1], global[0], global[1]]
+                })
+                .collect::<Vec<_>>()
+        },
+        |_| {},
+    );
+    let mut layers = EstimateLayers::default();
+    for [cr, cn, gr, gn] in chunks.into_iter().flatten() {
+        layers.caustic_radius.push(cr);
+        layers.caustic_photons.push(cn);
+        layers.global_radius.push(gr);
+        layers.global_photons.push(gn);
+    }
+    layers
+}
