@@ -13,14 +13,14 @@
 //! the engines traced, by the transport core's streams), which costs one pass's photon tracing: a
 //! whole render's for a one-pass render, little for a progressive one.
 
-use crate::film::EstimateLayers;
+use crate::film::{EstimateLayers, Film};
 use crate::job::Job;
 use crate::parallel::map_chunks;
 use crate::reference::build_job_maps;
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
-use crate::stats::RayCounts;
-use crate::transport::camera::camera_sample;
+use crate::stats::{RayCounts, RenderStats};
+use crate::transport::camera::first_surface_of_pixel;
 use crate::transport::estimate::{caustic_estimate, global_estimate, indirect_estimate};
 use crate::transport::gather::gather_rays;
 use crate::transport::specular::first_non_specular;
@@ -34,8 +34,7 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
     let (maps, _, _) = build_job_maps(scene, job);
     let ctx = Context::new(scene, &maps, job);
     let settings = &job.settings;
-    let w = settings.width as usize;
-    let pixels = w * settings.height as usize;
+    let pixels = settings.width as usize * settings.height as usize;
     let (caustic_on, global_on) = (ctx.effects.caustic_map.on, ctx.effects.global_map.on);
     let gather_on = ctx.effects.final_gather.on;
     let chunks = map_chunks(
@@ -47,10 +46,7 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
             let mut counts = RayCounts::default();
             range
                 .map(|pixel| {
-                    let (s, (fx, fy)) = camera_sample(job, pixel as u64 * u64::from(settings.spp));
-                    let (o, d) = rays.ray((pixel % w) as f32 + fx, (pixel / w) as f32 + fy);
-                    let chain = streams::CAMERA_CHAIN_BOUNCE;
-                    let Some((sp, d, _)) = first_non_specular(&ctx, o, d, &s, chain, &mut counts) else {
+                    let (s, Some((sp, d))) = first_surface_of_pixel(&ctx, job, rays, pixel, &mut counts) else {
                         return [0.0; 4];
                     };
                     let bsdf = &scene.materials[sp.material as usize].bsdf;
@@ -96,4 +92,15 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
         layers.global_photons.push(gn);
     }
     layers
+}
+
+/// With `diagnostics` on, adds the diagnostic layers of `pass` (the render's last pass) to `film`
+/// and their time to `stats`.
+pub fn add_layers(scene: &Scene, rays: &CameraRays, pass: &Job, film: &mut Film, stats: &mut RenderStats) {
+    if pass.settings.diagnostics {
+        let t = std::time::Instant::now();
+        film.diagnostics = Some(probe(scene, rays, pass));
+        stats.times.diagnostics_s = t.elapsed().as_secs_f64();
+        stats.times.total_s += stats.times.diagnostics_s;
+    }
 }

@@ -96,7 +96,7 @@ pub fn render_planned(
     }
     if !is_progressive(settings, budget) {
         let (mut film, mut stats) = render_job(scene, rays, job, engine, progress);
-        add_diagnostics(scene, rays, job, &mut film, &mut stats);
+        crate::diagnostics::add_layers(scene, rays, job, &mut film, &mut stats);
         return Ok((film, stats));
     }
     if engine == Engine::Path {
@@ -104,15 +104,4 @@ pub fn render_planned(
     }
     let run = |pass: &Job| Ok(render_job(scene, rays, pass, engine, &NoProgress));
     crate::progressive::render_passes(scene, rays, job, &run, budget, progress)
-}
-
-/// With `diagnostics` on, adds the diagnostic layers of `pass` (the render's last pass) to `film`
-/// and their time to `stats`.
-pub fn add_diagnostics(scene: &Scene, rays: &CameraRays, pass: &Job, film: &mut Film, stats: &mut RenderStats) {
-    if pass.settings.diagnostics {
-        let t = std::time::Instant::now();
-        film.diagnostics = Some(crate::diagnostics::probe(scene, rays, pass));
-        stats.times.diagnostics_s = t.elapsed().as_secs_f64();
-        stats.times.total_s += stats.times.diagnostics_s;
-    }
 }

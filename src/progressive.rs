@@ -31,9 +31,8 @@ use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::Settings;
 use crate::stats::RenderStats;
-use crate::transport::camera::camera_sample;
-use crate::transport::specular::first_non_specular;
-use crate::transport::{streams, Context, PhotonMaps};
+use crate::transport::camera::first_surface_of_pixel;
+use crate::transport::{Context, PhotonMaps};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -167,10 +166,7 @@ pub fn pixel_radii(
             let mut counts = crate::stats::RayCounts::default();
             range
                 .map(|pixel| {
-                    let (sampler, (fx, fy)) = camera_sample(job, pixel as u64 * u64::from(settings.spp));
-                    let (o, d) = rays.ray((pixel % w) as f32 + fx, (pixel / w) as f32 + fy);
-                    let chain = streams::CAMERA_CHAIN_BOUNCE;
-                    let Some((sp, d, _)) = first_non_specular(&ctx, o, d, &sampler, chain, &mut counts) else {
+                    let (_, Some((sp, d))) = first_surface_of_pixel(&ctx, job, rays, pixel, &mut counts) else {
                         return (fallback.global, fallback.caustic);
                     };
                     let (ng, _) = sp.frame.oriented(-d);
@@ -534,7 +530,7 @@ pub fn render_passes(
     progress.finish();
     let mut film = p.image();
     if let Some(last) = &p.last {
-        crate::engine::add_diagnostics(scene, rays, last, &mut film, &mut p.stats);
+        crate::diagnostics::add_layers(scene, rays, last, &mut film, &mut p.stats);
     }
     let error_95 = error_now.or_else(|| p.error_95());
     let mut stats = p.stats;

@@ -11,7 +11,10 @@ use crate::scene::camera::CameraRays;
 use crate::stats::{Numerics, RayCounts};
 use glam::Vec3;
 
-use super::streams::JITTER_BOUNCE;
+use super::specular::first_non_specular;
+use super::streams::{CAMERA_CHAIN_BOUNCE, JITTER_BOUNCE};
+use super::Context;
+use crate::scene::SurfacePoint;
 
 /// Camera sample `index` (sample `index % spp` of pixel `index / spp`) of `job`'s pass: its
 /// random stream and its position inside the pixel, jittered within its stratum when spp is a
@@ -29,6 +32,25 @@ pub fn camera_sample(job: &Job, index: u64) -> (Sampler, (f32, f32)) {
         (jx, jy)
     };
     (sampler, offset)
+}
+
+/// The first camera sample of `pixel` (row-major) in `job`'s pass, followed through mirrors and
+/// glass to its first non-specular point as the camera paths go ([`first_non_specular`]): the
+/// sample's stream, and the point with the direction that reached it (`None` if the path
+/// escapes or ends on mirrors and glass). For per-pixel probes: the pixel radii and the
+/// diagnostic layers.
+pub fn first_surface_of_pixel(
+    ctx: &Context,
+    job: &Job,
+    rays: &CameraRays,
+    pixel: usize,
+    counts: &mut RayCounts,
+) -> (Sampler, Option<(SurfacePoint, Vec3)>) {
+    let w = job.settings.width as usize;
+    let (sampler, (fx, fy)) = camera_sample(job, pixel as u64 * u64::from(job.settings.spp));
+    let (o, d) = rays.ray((pixel % w) as f32 + fx, (pixel / w) as f32 + fy);
+    let hit = first_non_specular(ctx, o, d, &sampler, CAMERA_CHAIN_BOUNCE, counts).map(|(sp, d, _)| (sp, d));
+    (sampler, hit)
 }
 
 /// Renders every pixel with `radiance(pixel, o, d, sampler, rays, scratch)`, which traces one
