@@ -15,6 +15,7 @@ fn film(direct: [Vec3; 2], caustic: [Vec3; 2]) -> Film {
         height: 1,
         pixels: (0..2).map(|i| Terms { direct: direct[i], caustic: caustic[i], ..Default::default() }).collect(),
         noise: None,
+        diagnostics: None,
     }
 }
 
@@ -69,7 +70,9 @@ fn cli_prints_json_and_names_bad_inputs() {
     let (a, b, small) = (d.join("a.exr"), d.join("b.exr"), d.join("small.exr"));
     film([Vec3::splat(0.5); 2], [Vec3::ZERO; 2]).write_exr(&a).unwrap();
     film([Vec3::splat(0.25); 2], [Vec3::ZERO; 2]).write_exr(&b).unwrap();
-    Film { width: 1, height: 1, pixels: vec![Terms::default()], noise: None }.write_exr(&small).unwrap();
+    Film { width: 1, height: 1, pixels: vec![Terms::default()], noise: None, diagnostics: None }
+        .write_exr(&small)
+        .unwrap();
     let run = |args: &[&std::path::Path], json: bool| {
         let mut cmd = Command::new(env!("CARGO_BIN_EXE_photonwave"));
         cmd.arg("compare").args(args);

@@ -1,0 +1,162 @@
+//! Progressive renders converge to the right answer, and their error estimate says how far off
+//! they are: checked against path-traced references of two bundled scenes, committed small
+//! (`tests/references/`, 32×32, made by `tests/references/make.sh`: photonwave's path tracer,
+//! 65 536 samples per pixel).
+//!
+//! The references' own noise, measured once from two independent 4 096-spp renders (their
+//! difference's spread, scaled by √(4 096/65 536)): on `cornell-box`, 0.21 % of a pixel's value
+//! (median; 0.8 % at the 90th percentile), 0.07 % of an 8×8 block's mean, 0.007 % of the image
+//! mean; on `cornell-spheres`, 0.8 % of a pixel (3 % at the 90th percentile, in the caustics).
+
+mod common;
+
+use common::load;
+use glam::Vec3;
+use photonwave::film::{read_exr_layer, Film};
+use photonwave::job::Job;
+use photonwave::progress::NoProgress;
+use photonwave::progressive::Progressive;
+use photonwave::settings::Settings;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+const SIZE: u32 = 32;
+
+/// A layer of the committed reference of `scene` (grey values, row-major; `""` is beauty).
+fn reference(scene: &str, layer: &str) -> Vec<f64> {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/references").join(format!("{scene}-32.exr"));
+    let (w, h, pixels) = read_exr_layer(&path, layer).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((w, h), (SIZE, SIZE));
+    pixels.iter().map(|&p| grey(p)).collect()
+}
+
+/// Reflected light: beauty less the emission the camera sees directly (exact in both renderers,
+/// but at one sample per pixel per pass the light's edge pixels flip between the light's
+/// radiance and the ceiling's, which made the passes' image means jump in steps of 9 %).
+fn reflected(t: &photonwave::film::Terms) -> f64 {
+    grey(t.beauty() - t.emitted)
+}
+
+/// Grey value of a beauty pixel.
+fn grey(v: Vec3) -> f64 {
+    f64::from(v.element_sum()) / 3.0
+}
+
+/// `passes` progressive passes of the bundled `scene` at 32×32 with its own settings (per pass:
+/// 1 spp and its photons spread as `render --passes` spreads them), seed `seed`: the image, and
+/// each pass's 8×8-block means of reflected light ([`reflected`]).
+fn passes(scene: &str, passes: u32, seed: u64) -> (Film, Vec<Vec<f64>>) {
+    let loaded = load(&format!("{scene}.toml"));
+    let file = Settings { width: SIZE, height: SIZE, seed, threads: 2, ..loaded.settings.clone() };
+    let settings = photonwave::progressive::per_pass(&file, Default::default());
+    let rays = loaded.camera.unwrap().prepare(SIZE, SIZE).unwrap();
+    let scene = Arc::new(loaded.scene);
+    let job = common::job(&scene, &settings);
+    let mut p = Progressive::new(&scene, &rays, &job);
+    let blocks = std::cell::RefCell::new(Vec::new());
+    let engine = |job: &Job| {
+        let (film, stats) = photonwave::wavefront::render_job(scene.clone(), &rays, job, &NoProgress);
+        blocks.borrow_mut().push(block_means(&film.pixels.iter().map(reflected).collect::<Vec<_>>()));
+        Ok((film, stats))
+    };
+    for _ in 0..passes {
+        p.step(&engine).unwrap();
+    }
+    (p.image(), blocks.into_inner())
+}
+
+/// The 16 8×8-block means of a 32×32 grey image.
+fn block_means(grey: &[f64]) -> Vec<f64> {
+    let n = SIZE as usize;
+    (0..16)
+        .map(|b| {
+            let (bx, by) = (b % 4 * 8, b / 4 * 8);
+            (0..64).map(|i| grey[(by + i / 8) * n + bx + i % 8]).sum::<f64>() / 64.0
+        })
+        .collect()
+}
+
+/// The bundled diffuse box, 64 progressive passes: the image mean and every 8×8 block's mean lie
+/// within a derived tolerance of the path-traced reference. The tolerance of each quantity is
+/// t·√(s²/N + σ²_ref): s the spread of that quantity between the N passes (which are
+/// independent), σ_ref the reference's measured noise (above), t Student's quantile for N − 1
+/// degrees of freedom at a two-sided 0.1 % per quantity (17 of them: a false alarm in under 2 %
+/// of seeds). So the test asserts what the issue asks: what is left of the bias is within the
+/// noise. Before the edge correction, the bias at the ceiling's and floor's edges put blocks
+/// outside (measured in BENCHMARKS.md).
+#[test]
+fn a_diffuse_box_converges_to_the_path_traced_image() {
+    let n = 64;
+    let emitted = reference("cornell-box", "emitted");
+    let reference: Vec<f64> = reference("cornell-box", "").iter().zip(&emitted).map(|(b, e)| b - e).collect();
+    let (image, per_pass) = passes("cornell-box", n, 3);
+    let grey: Vec<f64> = image.pixels.iter().map(reflected).collect();
+    let nf = f64::from(n);
+    // t for 63 degrees of freedom at two-sided 0.1 %: 3.39 (tables); the normal's is 3.29.
+    let t = 3.39;
+    let spread = |values: &[f64]| {
+        let mean = values.iter().sum::<f64>() / values.len() as f64;
+        (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (values.len() - 1) as f64).sqrt()
+    };
+    let reference_blocks = block_means(&reference);
+    let blocks = block_means(&grey);
+    for b in 0..16 {
+        let s = spread(&per_pass.iter().map(|p| p[b]).collect::<Vec<_>>());
+        let tol = t * (s * s / nf + (7e-4 * reference_blocks[b]).powi(2)).sqrt();
+        let d = blocks[b] - reference_blocks[b];
+        println!(
+            "block {b:2}: {:+.4} % (tolerance {:.4} %)",
+            100.0 * d / reference_blocks[b],
+            100.0 * tol / reference_blocks[b]
+        );
+        assert!(d.abs() <= tol, "block {b}: {} against {} (tolerance {tol})", blocks[b], reference_blocks[b]);
+    }
+    let means: Vec<f64> = per_pass.iter().map(|p| p.iter().sum::<f64>() / 16.0).collect();
+    let (mean, reference_mean) =
+        (grey.iter().sum::<f64>() / grey.len() as f64, reference.iter().sum::<f64>() / grey.len() as f64);
+    let tol = t * (spread(&means).powi(2) / nf + (7e-5 * reference_mean).powi(2)).sqrt();
+    println!("mean: {:+.4} % (tolerance {:.4} %)", 100.0 * (mean / reference_mean - 1.0), 100.0 * tol / reference_mean);
+    assert!((mean - reference_mean).abs() <= tol, "mean {mean} against {reference_mean} (tolerance {tol})");
+}
+
+/// The error layer is calibrated: on the bundled diffuse box after 32 passes, the share of
+/// pixels whose actual error (against the reference) lies within the `error` bound is at least
+/// its stated 95 %, less a binomial tolerance: 3 standard deviations of a share over n pixels,
+/// 3·√(0.95·0.05/n) = 2.0 % for the 1 024 pixels. (Pixels are not quite independent — the passes'
+/// photons are shared by all of them — so this is the tolerance the issue asks for, not an exact
+/// one.) Measured: 95.1 % (the noise alone 93.7 %); at 8, 16 and 24 passes 92.1, 93.6 and 95.5 %.
+///
+/// Not asserted on the glass-sphere box: it reaches 92.9 % at 32 passes (noise alone 90.2 %) and
+/// 90.8 % at 128, below the tolerance. Most misses are a little outside (|error|/bound 1.0–1.5),
+/// and the share falls as passes are added, as it must when the reference's own noise (0.8 % of a
+/// pixel at the median, 3 % in the caustics) grows against the render's shrinking bound; a few
+/// are the light's edge pixels, which one sample per pass never found on the light, so the passes'
+/// spread there is 0. A reference clean enough for that scene needs more than the path tracer's
+/// 65 536 samples per pixel in one render (to be merged from several: issue 16).
+#[test]
+fn the_error_bound_holds_for_95_percent_of_pixels() {
+    let (scene, n) = ("cornell-box", 32);
+    let reference = reference(scene, "");
+    let (image, _) = passes(scene, n, 5);
+    let error = image.error().expect("progressive passes have an error layer");
+    let lit: Vec<usize> = (0..reference.len()).filter(|&i| reference[i] > 1e-3).collect();
+    let inside =
+        lit.iter().filter(|&&i| (grey(image.pixels[i].beauty()) - reference[i]).abs() <= f64::from(error[i])).count();
+    let share = inside as f64 / lit.len() as f64;
+    let noise_only = lit
+        .iter()
+        .filter(|&&i| {
+            (grey(image.pixels[i].beauty()) - reference[i]).abs() <= f64::from(image.noise.as_ref().unwrap()[i])
+        })
+        .count() as f64
+        / lit.len() as f64;
+    let tol = 3.0 * (0.95 * 0.05 / lit.len() as f64).sqrt();
+    println!(
+        "{scene}: {:.1} % of {} pixels within the bound (noise alone {:.1} %), need ≥ {:.1} %",
+        100.0 * share,
+        lit.len(),
+        100.0 * noise_only,
+        100.0 * (0.95 - tol)
+    );
+    assert!(share >= 0.95 - tol, "{scene}: {share} of pixels within their bound");
+}
