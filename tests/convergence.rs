@@ -6,7 +6,8 @@
 //! The references' own noise, measured once from two independent 4 096-spp renders (their
 //! difference's spread, scaled by √(4 096/65 536)): on `cornell-box`, 0.21 % of a pixel's value
 //! (median; 0.8 % at the 90th percentile), 0.07 % of an 8×8 block's mean, 0.007 % of the image
-//! mean; on `cornell-spheres`, 0.8 % of a pixel (3 % at the 90th percentile, in the caustics).
+//! mean; on `cornell-spheres`, 0.8 % of a pixel (3 % at the 90th percentile, in the caustics)
+//! for one file, half that for the four the test averages.
 
 mod common;
 
@@ -22,12 +23,28 @@ use std::sync::Arc;
 
 const SIZE: u32 = 32;
 
-/// A layer of the committed reference of `scene` (grey values, row-major; `""` is beauty).
+/// A layer of the committed reference of `scene` (grey values, row-major; `""` is beauty): the
+/// mean of its files `SCENE-32-SEED.exr`, independent renders with the seeds in their names.
 fn reference(scene: &str, layer: &str) -> Vec<f64> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/references").join(format!("{scene}-32.exr"));
-    let (w, h, pixels) = read_exr_layer(&path, layer).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!((w, h), (SIZE, SIZE));
-    pixels.iter().map(|&p| grey(p)).collect()
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/references");
+    let prefix = format!("{scene}-32-");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "exr"))
+        .filter(|p| p.file_name().unwrap().to_string_lossy().starts_with(&prefix))
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "no reference for {scene} in {}", dir.display());
+    let mut sum = vec![0.0; (SIZE * SIZE) as usize];
+    for path in &files {
+        let (w, h, pixels) = read_exr_layer(path, layer).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!((w, h), (SIZE, SIZE));
+        for (s, &p) in sum.iter_mut().zip(&pixels) {
+            *s += grey(p);
+        }
+    }
+    sum.iter().map(|s| s / files.len() as f64).collect()
 }
 
 /// Reflected light: beauty less the emission the camera sees directly (exact in both renderers,
@@ -119,44 +136,36 @@ fn a_diffuse_box_converges_to_the_path_traced_image() {
     assert!((mean - reference_mean).abs() <= tol, "mean {mean} against {reference_mean} (tolerance {tol})");
 }
 
-/// The error layer is calibrated: on the bundled diffuse box after 32 passes, the share of
-/// pixels whose actual error (against the reference) lies within the `error` bound is at least
-/// its stated 95 %, less a binomial tolerance: 3 standard deviations of a share over n pixels,
-/// 3·√(0.95·0.05/n) = 2.0 % for the 1 024 pixels. (Pixels are not quite independent — the passes'
-/// photons are shared by all of them — so this is the tolerance the issue asks for, not an exact
-/// one.) Measured: 95.1 % (the noise alone 93.7 %); at 8, 16 and 24 passes 92.1, 93.6 and 95.5 %.
-///
-/// Not asserted on the glass-sphere box: it reaches 92.9 % at 32 passes (noise alone 90.2 %) and
-/// 90.8 % at 128, below the tolerance. Most misses are a little outside (|error|/bound 1.0–1.5),
-/// and the share falls as passes are added, as it must when the reference's own noise (0.8 % of a
-/// pixel at the median, 3 % in the caustics) grows against the render's shrinking bound; a few
-/// are the light's edge pixels, which one sample per pass never found on the light, so the passes'
-/// spread there is 0. A reference clean enough for that scene needs more than the path tracer's
-/// 65 536 samples per pixel in one render (to be merged from several: issue 16).
+/// The error layer is calibrated: on the bundled diffuse box and glass-sphere box after 32
+/// passes, the share of pixels whose actual error (against the reference) lies within the
+/// `error` bound is at least its stated 95 %, less a binomial tolerance: 3 standard deviations of
+/// a share over n pixels, 3·√(0.95·0.05/n) = 2.0 % for the 1 024 pixels. (Pixels are not quite
+/// independent — the passes' photons are shared by all of them — so this is the tolerance the
+/// issue asks for, not an exact one.) Measured: 95.1 % and 94.3 % (the noise alone 93.7 % and
+/// 91.1 %). The reference's own noise widens the actual error a little and is not allowed for;
+/// with one 65 536-spp reference instead of four the glass-sphere box fell to 92.9 % here and
+/// 90.8 % after 128 passes (95.4 % with four).
 #[test]
 fn the_error_bound_holds_for_95_percent_of_pixels() {
-    let (scene, n) = ("cornell-box", 32);
-    let reference = reference(scene, "");
-    let (image, _) = passes(scene, n, 5);
-    let error = image.error().expect("progressive passes have an error layer");
-    let lit: Vec<usize> = (0..reference.len()).filter(|&i| reference[i] > 1e-3).collect();
-    let inside =
-        lit.iter().filter(|&&i| (grey(image.pixels[i].beauty()) - reference[i]).abs() <= f64::from(error[i])).count();
-    let share = inside as f64 / lit.len() as f64;
-    let noise_only = lit
-        .iter()
-        .filter(|&&i| {
-            (grey(image.pixels[i].beauty()) - reference[i]).abs() <= f64::from(image.noise.as_ref().unwrap()[i])
-        })
-        .count() as f64
-        / lit.len() as f64;
-    let tol = 3.0 * (0.95 * 0.05 / lit.len() as f64).sqrt();
-    println!(
-        "{scene}: {:.1} % of {} pixels within the bound (noise alone {:.1} %), need ≥ {:.1} %",
-        100.0 * share,
-        lit.len(),
-        100.0 * noise_only,
-        100.0 * (0.95 - tol)
-    );
-    assert!(share >= 0.95 - tol, "{scene}: {share} of pixels within their bound");
+    for scene in ["cornell-box", "cornell-spheres"] {
+        let reference = reference(scene, "");
+        let (image, _) = passes(scene, 32, 5);
+        let error = image.error().expect("progressive passes have an error layer");
+        let noise = image.noise.as_ref().unwrap();
+        let lit: Vec<usize> = (0..reference.len()).filter(|&i| reference[i] > 1e-3).collect();
+        let share = |bound: &[f32]| {
+            let error = |i: usize| (grey(image.pixels[i].beauty()) - reference[i]).abs();
+            lit.iter().filter(|&&i| error(i) <= f64::from(bound[i])).count() as f64 / lit.len() as f64
+        };
+        let (inside, noise_only) = (share(&error), share(noise));
+        let tol = 3.0 * (0.95 * 0.05 / lit.len() as f64).sqrt();
+        println!(
+            "{scene}: {:.1} % of {} pixels within the bound (noise alone {:.1} %), need ≥ {:.1} %",
+            100.0 * inside,
+            lit.len(),
+            100.0 * noise_only,
+            100.0 * (0.95 - tol)
+        );
+        assert!(inside >= 0.95 - tol, "{scene}: {inside} of pixels within their bound");
+    }
 }
