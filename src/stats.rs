@@ -227,7 +227,7 @@ impl RenderStats {
         };
         format!(
             "summary ({} engine, {} code path, {} threads)\n{}{}  rays: {} total ({} camera, {} shadow, {} gather, {} photon)\n  \
-             time: load {:.2} s, global photons {:.2} s, caustic photons {:.2} s, maps {:.2} s, camera {:.2} s, total {:.2} s\n  \
+             time: load {:.2} s, global photons {:.2} s, caustic photons {:.2} s, maps {:.2} s, camera {:.2} s{}, total {:.2} s\n  \
              non-finite values dropped: {} photon emissions, {} photon bounces ({} more with a zero pdf), \
              {} camera samples; \
              {} pixel sums overflowed; {} vertex normals replaced at load; {} photon rays escaped a \
@@ -248,6 +248,7 @@ impl RenderStats {
             t.caustic_photons_s,
             t.map_build_s,
             t.camera_s,
+            if t.diagnostics_s > 0.0 { format!(", diagnostics {:.2} s", t.diagnostics_s) } else { String::new() },
             t.total_s,
             self.numerics.photon_emission,
             self.numerics.photon_scatter,
