@@ -77,6 +77,9 @@ pub struct FixedRadii {
     pub pixels: Option<std::sync::Arc<PixelRadii>>,
     /// This pass's radius over the first pass's (√ of ∏ (j+α)/(j+1)).
     pub scale: f32,
+    /// The estimates also estimate their bias ([`crate::photon_map::Estimate::bias`]); a
+    /// progressive render asks for it in some passes only (`progressive::BIAS_EVERY`).
+    pub bias: bool,
 }
 
 /// The first progressive pass's radii per pixel (row-major), in scene units.
@@ -93,7 +96,7 @@ impl FixedRadii {
     /// The same radius everywhere.
     #[must_use]
     pub fn uniform(global: f32, caustic: f32) -> Self {
-        FixedRadii { global, caustic, pixels: None, scale: 1.0 }
+        FixedRadii { global, caustic, pixels: None, scale: 1.0, bias: true }
     }
 
     /// The caustic radius at `pixel`'s camera paths (`None`: anywhere else).

@@ -48,6 +48,13 @@ pub struct Budget {
 /// Photons sampled for the first radii.
 pub const RADIUS_SAMPLES: usize = 1024;
 
+/// Passes 0, 4, 8, … estimate their bias, and the image's bias is extrapolated from them: the
+/// bias is ∝ r², so pass i's is sᵢ·b with sᵢ = r²ᵢ/r²₁, and the mean over all N passes is
+/// (Σ sᵢ / N) · (Σ_S Bᵢ / Σ_S sᵢ) over the estimating passes S. The bias sum costs about a tenth
+/// of a fixed-radius estimate (BENCHMARKS.md); the bias estimate's own noise is far below the
+/// image's (0.2–0.3 % of a pixel against 2–10 %), so a quarter of the passes are enough.
+pub const BIAS_EVERY: u32 = 4;
+
 pub use crate::settings::PerPass;
 pub use crate::stats::{ImageError, ProgressiveStats};
 
@@ -235,6 +242,8 @@ pub struct Progressive {
     first: FixedRadii,
     /// r² of the next pass over r² of the first ([`radius2_scale`], kept as a running product).
     scale2: f64,
+    /// Σ sᵢ (sᵢ = r²ᵢ/r²₁) over all passes so far, and over those that estimated their bias.
+    scale2_sums: [f64; 2],
     sum: Vec<Terms>,
     /// Per pixel, the sums of the passes' beauty grey value and of its square (f64: the
     /// variance is a small difference of large sums).
@@ -268,6 +277,7 @@ impl Progressive {
             job: job.clone(),
             first,
             scale2: 1.0,
+            scale2_sums: [0.0; 2],
             sum: vec![Terms::default(); settings.width as usize * settings.height as usize],
             grey: vec![(0.0, 0.0); settings.width as usize * settings.height as usize],
             stats: RenderStats::default(),
@@ -285,6 +295,18 @@ impl Progressive {
             caustic: self.first.caustic * s,
             pixels: self.first.pixels.clone(),
             scale: s,
+            bias: self.progress.passes.is_multiple_of(BIAS_EVERY),
+        }
+    }
+
+    /// What turns the summed per-pixel bias of the estimating passes into the image's:
+    /// (Σ sᵢ / N) / Σ_S sᵢ ([`BIAS_EVERY`]).
+    fn bias_scale(&self) -> f32 {
+        let n = f64::from(self.progress.passes.max(1));
+        if self.scale2_sums[1] > 0.0 {
+            (self.scale2_sums[0] / n / self.scale2_sums[1]) as f32
+        } else {
+            0.0
         }
     }
 
@@ -300,6 +322,10 @@ impl Progressive {
         let i = self.progress.passes;
         let radii = self.next_radii();
         let final_radii = [radii.global, radii.caustic];
+        self.scale2_sums[0] += self.scale2;
+        if radii.bias {
+            self.scale2_sums[1] += self.scale2;
+        }
         let pass = self.job.with_pass(Pass { seed: pass_seed(self.job.settings.seed, i), radii: Some(radii) })?;
         let (film, stats) = engine(&pass)?;
         self.last = Some(pass);
@@ -341,10 +367,11 @@ impl Progressive {
     #[must_use]
     pub fn image(&self) -> Film {
         let n = self.progress.passes.max(1) as f32;
+        let bias = self.bias_scale();
         Film {
             width: self.job.settings.width,
             height: self.job.settings.height,
-            pixels: self.sum.iter().map(|t| *t * (1.0 / n)).collect(),
+            pixels: self.sum.iter().map(|t| Terms { bias: t.bias * bias, ..*t * (1.0 / n) }).collect(),
             noise: self.noise(),
             diagnostics: None,
         }
@@ -358,7 +385,8 @@ impl Progressive {
         let pixels = self.grey.len().max(1) as f64;
         let n = f64::from(self.progress.passes);
         let noise = self.half_widths()?.sum::<f64>() / pixels;
-        let bias = self.sum.iter().map(|t| (f64::from(t.bias.element_sum()) / 3.0 / n).abs()).sum::<f64>() / pixels;
+        let scale = f64::from(self.bias_scale());
+        let bias = self.sum.iter().map(|t| (f64::from(t.bias.element_sum()) / 3.0 * scale).abs()).sum::<f64>() / pixels;
         let mean_grey = (self.grey.iter().map(|g| g.0).sum::<f64>() / n / pixels).max(f64::MIN_POSITIVE);
         Some(ImageError { error: (noise + bias) / mean_grey, noise: noise / mean_grey, bias: bias / mean_grey })
     }

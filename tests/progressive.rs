@@ -355,7 +355,8 @@ fn progressive_indirect_light_matches_the_path_tracer() {
 /// The noise is the half-width of a 95 % Student-t interval of each pixel's mean over the
 /// passes: with passes whose beauty grey value alternates a ± d in every pixel (exactly
 /// representable values), it must equal t(N−1)·s/√N, s the passes' sample standard deviation,
-/// to 1e-6 relative; and the `error` bound adds the size of the passes' mean bias's grey value.
+/// to 1e-6 relative; and the `error` bound adds the size of the passes' mean bias's grey value,
+/// extrapolated from the passes that estimate it (`BIAS_EVERY`) as ∝ r².
 /// One pass has neither. The t quantile itself is checked against tables (0.5 %).
 #[test]
 fn the_error_layer_is_the_passes_spread_plus_the_bias() {
@@ -370,12 +371,15 @@ fn the_error_layer_is_the_passes_spread_plus_the_bias() {
     let n = (settings.width * settings.height) as usize;
     // Pass k gives a + d for even k and a − d for odd k.
     let calls = std::cell::Cell::new(0u32);
-    let fake = |_: &Job| -> photonwave::Result<(Film, photonwave::stats::RenderStats)> {
+    // A pass that estimates its bias reports one ∝ r² (the model the extrapolation assumes).
+    let fake = |job: &Job| -> photonwave::Result<(Film, photonwave::stats::RenderStats)> {
         let v = if calls.get().is_multiple_of(2) { a + d } else { a - d };
         calls.set(calls.get() + 1);
+        let radii = job.pass.radii.as_ref().unwrap();
+        let s = if radii.bias { radii.scale * radii.scale } else { 0.0 };
         let t = photonwave::film::Terms {
             direct: glam::Vec3::splat(v),
-            bias: glam::Vec3::new(-3.0, 1.0, 0.5) * bias,
+            bias: glam::Vec3::new(-3.0, 1.0, 0.5) * bias * s,
             ..Default::default()
         };
         let film =
@@ -396,9 +400,11 @@ fn the_error_layer_is_the_passes_spread_plus_the_bias() {
     let noise = image.noise.as_ref().expect("eight passes have a noise estimate");
     assert!(want > 0.0, "the passes must differ for this test to mean anything");
     assert!(noise.iter().all(|&e| (f64::from(e) / want - 1.0).abs() < 1e-6), "{} vs {want}", noise[0]);
-    // The bound adds the size of the bias's grey value: |(−3 + 1 + 0.5)/3 · bias| = bias / 2.
+    // The bound adds the size of the bias's grey value, |(−3 + 1 + 0.5)/3 · bias| = bias / 2, times
+    // the passes' mean r²/r²₁: estimated in passes 0 and 4 only, extrapolated to all eight.
     let error = image.error().expect("and an error bound");
-    let want = want + f64::from(bias) / 2.0;
+    let mean_s = (1..=8).map(|i| radius2_scale(i, settings.alpha)).sum::<f64>() / 8.0;
+    let want = want + f64::from(bias) / 2.0 * mean_s;
     assert!(error.iter().all(|&e| (f64::from(e) / want - 1.0).abs() < 1e-6), "{} vs {want}", error[0]);
 }
 

@@ -30,6 +30,7 @@ use super::packing::key_normal;
 use super::{Kernel, PhotonMap};
 use glam::Vec3;
 use std::sync::OnceLock;
+use wide::f32x8;
 
 /// At most this many other surfaces per estimate (a corner has two, a box's foot corner three).
 pub const MAX_PLANES: usize = 4;
@@ -143,15 +144,19 @@ impl Neighbours {
         if count == 0 {
             return Coverage::WHOLE;
         }
+        // The quadrature 8 points at a time: a point counts where it is inside every cut.
         let table = quadrature(kernel);
-        let (mut inside, mut bias, mut total) = (0.0f32, 0.0f32, 0.0f32);
-        for &(x, y, w, wb) in table.iter() {
-            total += w;
-            if cuts[..count].iter().all(|&(ca, cb, cc)| ca * x + cb * y + cc > 0.0) {
-                inside += w;
-                bias += wb;
+        let (mut inside, mut bias) = (f32x8::ZERO, f32x8::ZERO);
+        for k in 0..RINGS * ANGLES / 8 {
+            let (x, y) = (f32x8::from(table.x[k]), f32x8::from(table.y[k]));
+            let mut valid = f32x8::splat(f32::from_bits(u32::MAX));
+            for &(ca, cb, cc) in &cuts[..count] {
+                valid &= (f32x8::splat(ca) * x + f32x8::splat(cb) * y + f32x8::splat(cc)).simd_gt(f32x8::ZERO);
             }
+            inside += valid.select(f32x8::from(table.weight[k]), f32x8::ZERO);
+            bias += valid.select(f32x8::from(table.bias_weight[k]), f32x8::ZERO);
         }
+        let (inside, bias, total) = (inside.reduce_add(), bias.reduce_add(), table.total);
         Coverage { fraction: (inside / total).max(MIN_COVERAGE), bias_weight: bias / total }
     }
 }
@@ -173,8 +178,15 @@ impl Coverage {
     pub const WHOLE: Coverage = Coverage { fraction: 1.0, bias_weight: 0.0 };
 }
 
-/// Quadrature points: (x, y, kernel weight, bias weight).
-type Quadrature = [(f32, f32, f32, f32); RINGS * ANGLES];
+/// The quadrature's points in rows of 8 (x, y, kernel weight, bias weight), and the sum of the
+/// kernel weights.
+struct Quadrature {
+    x: [[f32; 8]; RINGS * ANGLES / 8],
+    y: [[f32; 8]; RINGS * ANGLES / 8],
+    weight: [[f32; 8]; RINGS * ANGLES / 8],
+    bias_weight: [[f32; 8]; RINGS * ANGLES / 8],
+    total: f32,
+}
 
 /// The polar quadrature of `kernel` over the unit disk: points (x, y) at ring midpoints and
 /// evenly spaced angles, each weighted by its cell's exact integral of the kernel weight and of
@@ -196,13 +208,25 @@ fn quadrature(kernel: Kernel) -> &'static Quadrature {
     // Kernel::bias_weight = 2ρ² − 1.
     let bias_part = |rho: f64| rho.powi(4) / 2.0 - rho * rho / 2.0;
     TABLES[slot].get_or_init(|| {
-        std::array::from_fn(|k| {
+        let mut q = Quadrature {
+            x: [[0.0; 8]; RINGS * ANGLES / 8],
+            y: [[0.0; 8]; RINGS * ANGLES / 8],
+            weight: [[0.0; 8]; RINGS * ANGLES / 8],
+            bias_weight: [[0.0; 8]; RINGS * ANGLES / 8],
+            total: 0.0,
+        };
+        for k in 0..RINGS * ANGLES {
             let (ring, angle) = (k / ANGLES, k % ANGLES);
             let (a, b) = (ring as f64 / RINGS as f64, (ring + 1) as f64 / RINGS as f64);
             let rho = ((a + b) / 2.0) as f32;
             let theta = (angle as f32 + 0.5) * std::f32::consts::TAU / ANGLES as f32;
-            let (x, y) = (rho * theta.cos(), rho * theta.sin());
-            (x, y, (kernel_part(b) - kernel_part(a)) as f32, (bias_part(b) - bias_part(a)) as f32)
-        })
+            let (row, lane) = (k / 8, k % 8);
+            q.x[row][lane] = rho * theta.cos();
+            q.y[row][lane] = rho * theta.sin();
+            q.weight[row][lane] = (kernel_part(b) - kernel_part(a)) as f32;
+            q.bias_weight[row][lane] = (bias_part(b) - bias_part(a)) as f32;
+            q.total += q.weight[row][lane];
+        }
+        q
     })
 }

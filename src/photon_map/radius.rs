@@ -12,18 +12,43 @@ impl PhotonMap {
     /// Reflected radiance at `q.p` from every photon within the fixed radius `q.r_max`, as if
     /// the whole disk lay on the query's surface.
     pub fn estimate_radius(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>) -> Estimate {
-        self.estimate_fixed(set, q, f, None)
+        self.estimate_fixed::<true>(set, q, f, None)
     }
 
     /// [`Self::estimate_radius`] divided by the part of the kernel's disk that lies on the
     /// query's surface ([`Neighbours::coverage`]): no darkening at edges and in corners. `edges`
     /// are cuts the photons cannot show (open edges of the query's surface).
     pub fn estimate_radius_on_surface(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>, edges: &[Cut]) -> Estimate {
-        self.estimate_fixed(set, q, f, Some(edges))
+        self.estimate_fixed::<true>(set, q, f, Some(edges))
     }
 
-    /// The fixed-radius estimate, boundary-corrected when `on_surface` is given.
-    fn estimate_fixed(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>, on_surface: Option<&[Cut]>) -> Estimate {
+    /// [`Self::estimate_radius`] (`on_surface` `None`) or [`Self::estimate_radius_on_surface`],
+    /// with the bias estimated only if `bias` (it costs about a tenth of the estimate; without
+    /// it the radiance is the same to the bit and the bias 0).
+    pub fn estimate_radius_with(
+        &self,
+        set: CodePath,
+        q: &Lookup,
+        f: Reflectance<'_>,
+        on_surface: Option<&[Cut]>,
+        bias: bool,
+    ) -> Estimate {
+        if bias {
+            self.estimate_fixed::<true>(set, q, f, on_surface)
+        } else {
+            self.estimate_fixed::<false>(set, q, f, on_surface)
+        }
+    }
+
+    /// The fixed-radius estimate, boundary-corrected when `on_surface` is given, with its bias
+    /// when `BIAS`.
+    fn estimate_fixed<const BIAS: bool>(
+        &self,
+        set: CodePath,
+        q: &Lookup,
+        f: Reflectance<'_>,
+        on_surface: Option<&[Cut]>,
+    ) -> Estimate {
         let r2 = q.r_max * q.r_max;
         if self.is_empty() || !(r2 > 0.0) || !r2.is_finite() {
             return Estimate { radius: q.r_max, ..Default::default() };
@@ -61,14 +86,22 @@ impl PhotonMap {
                             0.0
                         }
                     }));
-                    let r2_8 = f32x8::splat(r2);
-                    let weights = [q.kernel.weight8(d2, r2_8), Kernel::bias_weight8(d2, r2_8)];
-                    let [c, b] = Self::contributions8(self.key8(base), self.power8(base), lanes, weights, f);
-                    for (s, v) in sum8.iter_mut().zip(c) {
-                        *s += v;
-                    }
-                    for (s, v) in bias8.iter_mut().zip(b) {
-                        *s += v;
+                    let (key, power) = (self.key8(base), self.power8(base));
+                    if BIAS {
+                        let r2_8 = f32x8::splat(r2);
+                        let weights = [q.kernel.weight8(d2, r2_8), Kernel::bias_weight8(d2, r2_8)];
+                        let [c, b] = Self::contributions8(key, power, lanes, weights, f);
+                        for (s, v) in sum8.iter_mut().zip(c) {
+                            *s += v;
+                        }
+                        for (s, v) in bias8.iter_mut().zip(b) {
+                            *s += v;
+                        }
+                    } else {
+                        let c = Self::contribution8(key, power, lanes, d2, r2, q.kernel, f);
+                        for (s, v) in sum8.iter_mut().zip(c) {
+                            *s += v;
+                        }
                     }
                 }
             } else {
@@ -77,9 +110,13 @@ impl PhotonMap {
                     if d2 < r2 {
                         match Self::test(self.key[i], &q.filter) {
                             Test::Accepted => {
-                                let (c, b) = self.contribution_and_bias(i, d2, r2, q.kernel, f);
-                                sum += c;
-                                bias += b;
+                                if BIAS {
+                                    let (c, b) = self.contribution_and_bias(i, d2, r2, q.kernel, f);
+                                    sum += c;
+                                    bias += b;
+                                } else {
+                                    sum += self.contribution(i, d2, r2, q.kernel, f);
+                                }
                                 count += 1;
                             }
                             Test::Normal => {

@@ -47,12 +47,13 @@ fn map_estimate(
     // Fixed radii (progressive passes) are corrected at edges and corners; k-nearest estimates
     // are not: on CornellBox-Original the correction moved the one-pass image from 0.3 % dark
     // to 0.2 % bright and its 16×16-block error from 1.2 % to 1.6 % (BENCHMARKS.md).
+    let bias = ctx.fixed.is_some_and(|r| r.bias);
     let e = match (fixed, ctx.settings.visibility) {
         (Some(r), false) if ctx.settings.boundary_correction => {
             let (edges, len) = open_edge_cuts(ctx.scene, sp, r);
-            map.estimate_radius_on_surface(set, &Lookup { r_max: r, ..lookup }, f, &edges[..len])
+            map.estimate_radius_with(set, &Lookup { r_max: r, ..lookup }, f, Some(&edges[..len]), bias)
         }
-        (Some(r), false) => map.estimate_radius(set, &Lookup { r_max: r, ..lookup }, f),
+        (Some(r), false) => map.estimate_radius_with(set, &Lookup { r_max: r, ..lookup }, f, None, bias),
         (None, false) => map.estimate(set, &lookup, f, scratch),
         (fixed, true) => {
             let lookup = fixed.map_or(lookup, |r| Lookup { r_max: r, k: 0, ..lookup });
