@@ -448,7 +448,8 @@ fn open_edges_cut_the_disk_where_no_photons_show_it() {
 /// is 2 % of the bias. The plain estimate minus L(q) is the same bias (the same 2 %). On a
 /// uniform floor near a wall's foot, the boundary-corrected bias estimate is ~0: under 2 % of
 /// the radiance (measured ≤ 1.5 % box, ≤ 0.8 % cone: the 8 × 32 polar quadrature of a thin cut
-/// segment), where without the correction the cut disk reads as curvature of 8–15 %. Both code
+/// segment), where without the correction the cut disk reads as curvature of 8–15 %; without the
+/// bias sum (passes that skip it) the radiance is the same to the bit and the bias 0. Both code
 /// paths agree to 1e-5.
 #[test]
 fn bias_estimates_return_the_kernel_bias_of_quadratic_radiance() {
@@ -510,6 +511,9 @@ fn bias_estimates_return_the_kernel_bias_of_quadratic_radiance() {
                 let e = map.estimate_radius_on_surface(set, &q, f, &[]);
                 let what = format!("{kernel:?} at {p}, {set:?}");
                 assert!(e.bias.x.abs() < 0.02 * e.radiance.x, "{what}: bias {} of {}", e.bias.x, e.radiance.x);
+                // Without the bias sum: the same radiance to the bit, and no bias at all.
+                let plain_sum = map.estimate_radius_with(set, &q, f, Some(&[]), false);
+                assert_eq!((plain_sum.radiance, plain_sum.bias), (e.radiance, Vec3::ZERO), "{what}");
                 // Uncorrected, the missing outer part of the disk reads as strong curvature.
                 if p != Vec3::ZERO {
                     let plain = map.estimate_radius(set, &q, f);

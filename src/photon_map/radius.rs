@@ -139,8 +139,12 @@ impl PhotonMap {
         let (sum, bias) = (sum + reduce(sum8), bias + reduce(bias8));
         let radiance = sum * q.kernel.normalisation(r2) / coverage.fraction;
         // A cut disk's bias sum is not zero even for a uniform density: subtract that part.
-        let bias = (bias - sum * (coverage.bias_weight / coverage.fraction)) * q.kernel.bias_normalisation(r2)
-            / coverage.fraction;
+        let bias = if BIAS {
+            (bias - sum * (coverage.bias_weight / coverage.fraction)) * q.kernel.bias_normalisation(r2)
+                / coverage.fraction
+        } else {
+            Vec3::ZERO
+        };
         Estimate { radiance, bias, radius: q.r_max, count, rejected }
     }
 }
