@@ -15,12 +15,11 @@
 
 use crate::film::{EstimateLayers, Film};
 use crate::job::Job;
-use crate::parallel::map_chunks;
 use crate::reference::build_job_maps;
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
-use crate::stats::{RayCounts, RenderStats};
-use crate::transport::camera::first_surface_of_pixel;
+use crate::stats::RenderStats;
+use crate::transport::camera::probe_first_surfaces;
 use crate::transport::estimate::{caustic_estimate, global_estimate, indirect_estimate};
 use crate::transport::gather::gather_rays;
 use crate::transport::specular::first_non_specular;
@@ -34,58 +33,42 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
     let (maps, _, _) = build_job_maps(scene, job);
     let ctx = Context::new(scene, &maps, job);
     let settings = &job.settings;
-    let pixels = settings.width as usize * settings.height as usize;
     let (caustic_on, global_on) = (ctx.effects.caustic_map.on, ctx.effects.global_map.on);
     let gather_on = ctx.effects.final_gather.on;
-    let chunks = map_chunks(
-        pixels,
-        256,
-        job.threads,
-        |range| {
-            let mut scratch = Vec::new();
-            let mut counts = RayCounts::default();
-            range
-                .map(|pixel| {
-                    let (s, Some((sp, d))) = first_surface_of_pixel(&ctx, job, rays, pixel, &mut counts) else {
-                        return [0.0; 4];
-                    };
-                    let bsdf = &scene.materials[sp.material as usize].bsdf;
-                    let caustic = if caustic_on {
-                        let e = caustic_estimate(&ctx, &sp, bsdf, -d, Some(pixel), &mut scratch);
-                        [e.radius, e.count as f32]
-                    } else {
-                        [0.0; 2]
-                    };
-                    let global = if !global_on {
-                        [0.0; 2]
-                    } else if gather_on {
-                        let (mut sum, mut hits) = ([0.0f64; 2], 0u32);
-                        let gather = s.fork(streams::gather(0));
-                        gather_rays(&sp, -d, settings.gather_rays, &gather, |g, o, wi| {
-                            let chain = gather.fork(streams::gather_ray(g));
-                            let bounce = streams::GATHER_CHAIN_BOUNCE;
-                            if let Some((y, dy, _)) = first_non_specular(&ctx, o, wi, &chain, bounce, &mut counts) {
-                                let bsdf = &scene.materials[y.material as usize].bsdf;
-                                let e = global_estimate(&ctx, &y, bsdf, -dy, 0, None, &mut scratch);
-                                sum[0] += f64::from(e.radius);
-                                sum[1] += f64::from(e.count);
-                                hits += 1;
-                            }
-                        });
-                        let n = f64::from(hits.max(1));
-                        [(sum[0] / n) as f32, (sum[1] / n) as f32]
-                    } else {
-                        let e = indirect_estimate(&ctx, &sp, bsdf, -d, Some(pixel), &mut scratch);
-                        [e.radius, e.count as f32]
-                    };
-                    [caustic[0], caustic[1], global[0], global[1]]
-                })
-                .collect::<Vec<_>>()
-        },
-        |_| {},
-    );
+    let found = probe_first_surfaces(&ctx, job, rays, [0.0; 4], |pixel, s, sp, d, scratch, counts| {
+        let bsdf = &scene.materials[sp.material as usize].bsdf;
+        let caustic = if caustic_on {
+            let e = caustic_estimate(&ctx, sp, bsdf, -d, Some(pixel), scratch);
+            [e.radius, e.count as f32]
+        } else {
+            [0.0; 2]
+        };
+        let global = if !global_on {
+            [0.0; 2]
+        } else if gather_on {
+            let (mut sum, mut hits) = ([0.0f64; 2], 0u32);
+            let gather = s.fork(streams::gather(0));
+            gather_rays(sp, -d, settings.gather_rays, &gather, |g, o, wi| {
+                let chain = gather.fork(streams::gather_ray(g));
+                if let Some((y, dy, _)) = first_non_specular(&ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, counts)
+                {
+                    let bsdf = &scene.materials[y.material as usize].bsdf;
+                    let e = global_estimate(&ctx, &y, bsdf, -dy, 0, None, scratch);
+                    sum[0] += f64::from(e.radius);
+                    sum[1] += f64::from(e.count);
+                    hits += 1;
+                }
+            });
+            let n = f64::from(hits.max(1));
+            [(sum[0] / n) as f32, (sum[1] / n) as f32]
+        } else {
+            let e = indirect_estimate(&ctx, sp, bsdf, -d, Some(pixel), scratch);
+            [e.radius, e.count as f32]
+        };
+        [caustic[0], caustic[1], global[0], global[1]]
+    });
     let mut layers = EstimateLayers::default();
-    for [cr, cn, gr, gn] in chunks.into_iter().flatten() {
+    for [cr, cn, gr, gn] in found {
         layers.caustic_radius.push(cr);
         layers.caustic_photons.push(cn);
         layers.global_radius.push(gr);

@@ -23,7 +23,6 @@ use crate::code_path::CodePath;
 use crate::error::Result;
 use crate::film::{Film, Terms};
 use crate::job::{FixedRadii, Job, Pass, PixelRadii};
-use crate::parallel::map_chunks;
 use crate::photon_map::{flags, Filter, Kernel, Lookup, PhotonMap};
 use crate::progress::Progress;
 use crate::reference::build_job_maps;
@@ -31,7 +30,7 @@ use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::Settings;
 use crate::stats::RenderStats;
-use crate::transport::camera::first_surface_of_pixel;
+use crate::transport::camera::probe_first_surfaces;
 use crate::transport::{Context, PhotonMaps};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -152,8 +151,6 @@ pub fn pixel_radii(
 ) -> PixelRadii {
     let settings = &job.settings;
     let ctx = Context::new(scene, maps, job);
-    let w = settings.width as usize;
-    let pixels = w * settings.height as usize;
     let want_global = ctx.effects.global_map.on && !ctx.effects.final_gather.on;
     let knn = |map: &PhotonMap, k: u32, r_max: f32, q: Lookup, scratch: &mut Vec<(f32, u32)>| {
         map.nearest(settings.code_path, &Lookup { k: k as usize, r_max, ..q }, scratch);
@@ -164,40 +161,20 @@ pub fn pixel_radii(
             r_max
         }
     };
-    let chunks = map_chunks(
-        pixels,
-        256,
-        job.threads,
-        |range| {
-            let mut scratch = Vec::new();
-            let mut counts = crate::stats::RayCounts::default();
-            range
-                .map(|pixel| {
-                    let (_, Some((sp, d))) = first_surface_of_pixel(&ctx, job, rays, pixel, &mut counts) else {
-                        return (fallback.global, fallback.caustic);
-                    };
-                    let (ng, _) = sp.frame.oriented(-d);
-                    let q = Lookup {
-                        p: sp.p,
-                        k: 0,
-                        r_max: 0.0,
-                        kernel: settings.kernel,
-                        filter: Filter { n: ng, flags_mask: 0 },
-                    };
-                    let caustic = knn(&maps.caustic, settings.caustic_k, ctx.caustic_radius, q, &mut scratch);
-                    let global = if want_global {
-                        let q = Lookup { filter: Filter { n: ng, flags_mask: flags::OWN_TERMS }, ..q };
-                        knn(&maps.global, settings.k, ctx.global_radius, q, &mut scratch)
-                    } else {
-                        fallback.global
-                    };
-                    (global, caustic)
-                })
-                .collect::<Vec<_>>()
-        },
-        |_| {},
-    );
-    let (global, caustic): (Vec<f32>, Vec<f32>) = chunks.into_iter().flatten().unzip();
+    let miss = (fallback.global, fallback.caustic);
+    let found = probe_first_surfaces(&ctx, job, rays, miss, |_, _, sp, d, scratch, _| {
+        let (ng, _) = sp.frame.oriented(-d);
+        let q = Lookup { p: sp.p, k: 0, r_max: 0.0, kernel: settings.kernel, filter: Filter { n: ng, flags_mask: 0 } };
+        let caustic = knn(&maps.caustic, settings.caustic_k, ctx.caustic_radius, q, scratch);
+        let global = if want_global {
+            let q = Lookup { filter: Filter { n: ng, flags_mask: flags::OWN_TERMS }, ..q };
+            knn(&maps.global, settings.k, ctx.global_radius, q, scratch)
+        } else {
+            fallback.global
+        };
+        (global, caustic)
+    });
+    let (global, caustic): (Vec<f32>, Vec<f32>) = found.into_iter().unzip();
     PixelRadii { global: if want_global { global } else { Vec::new() }, caustic }
 }
 

@@ -457,12 +457,18 @@ fn bias_estimates_return_the_kernel_bias_of_quadratic_radiance() {
     let n = (0.3 / h) as i32;
     let at = |i: i32| (i as f32 + 0.5) * h;
     let radiance = |x: f32, z: f32| 1.0 + c * (x * x + z * z);
+    let photon = |position: Vec3, power: f32, normal: Vec3| Photon {
+        position,
+        power: Vec3::splat(power),
+        wi: normal,
+        normal,
+        flags: 0,
+    };
     let mut photons = Vec::new();
     for i in -n..n {
         for j in -n..n {
             let (x, z) = (at(i), at(j));
-            let power = Vec3::splat(radiance(x, z) * h * h);
-            photons.push(Photon { position: Vec3::new(x, 0.0, z), power, wi: Vec3::Y, normal: Vec3::Y, flags: 0 });
+            photons.push(photon(Vec3::new(x, 0.0, z), radiance(x, z) * h * h, Vec3::Y));
         }
     }
     let map = PhotonMap::build(photons);
@@ -489,17 +495,9 @@ fn bias_estimates_return_the_kernel_bias_of_quadratic_radiance() {
     let mut photons = Vec::new();
     for i in 0..2 * n {
         for j in -n..n {
-            let power = Vec3::splat(h * h);
-            photons.push(Photon {
-                position: Vec3::new(-at(i), 0.0, at(j)),
-                power,
-                wi: Vec3::Y,
-                normal: Vec3::Y,
-                flags: 0,
-            });
+            photons.push(photon(Vec3::new(-at(i), 0.0, at(j)), h * h, Vec3::Y));
             if i % 2 == 0 && j % 2 == 0 {
-                let normal = Vec3::NEG_X;
-                photons.push(Photon { position: Vec3::new(0.0, at(i), at(j)), power, wi: normal, normal, flags: 0 });
+                photons.push(photon(Vec3::new(0.0, at(i), at(j)), h * h, Vec3::NEG_X));
             }
         }
     }

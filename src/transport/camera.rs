@@ -34,23 +34,40 @@ pub fn camera_sample(job: &Job, index: u64) -> (Sampler, (f32, f32)) {
     (sampler, offset)
 }
 
-/// The first camera sample of `pixel` (row-major) in `job`'s pass, followed through mirrors and
-/// glass to its first non-specular point as the camera paths go ([`first_non_specular`]): the
-/// sample's stream, and the point with the direction that reached it (`None` if the path
-/// escapes or ends on mirrors and glass). For per-pixel probes: the pixel radii and the
-/// diagnostic layers.
-pub fn first_surface_of_pixel(
+/// Per-pixel probes (the pixel radii, the diagnostic layers): each pixel's first camera sample
+/// of `job`'s pass, followed through mirrors and glass to its first non-specular point as camera
+/// paths go ([`first_non_specular`]), is handed to `probe(pixel, sampler, point, direction that
+/// reached it, scratch, rays)`; a pixel whose path escapes or ends on mirrors and glass gets
+/// `miss`. Pixels in parallel; the results row-major.
+pub fn probe_first_surfaces<T: Send + Sync + Clone>(
     ctx: &Context,
     job: &Job,
     rays: &CameraRays,
-    pixel: usize,
-    counts: &mut RayCounts,
-) -> (Sampler, Option<(SurfacePoint, Vec3)>) {
+    miss: T,
+    probe: impl Fn(usize, &Sampler, &SurfacePoint, Vec3, &mut Vec<(f32, u32)>, &mut RayCounts) -> T + Sync,
+) -> Vec<T> {
     let w = job.settings.width as usize;
-    let (sampler, (fx, fy)) = camera_sample(job, pixel as u64 * u64::from(job.settings.spp));
-    let (o, d) = rays.ray((pixel % w) as f32 + fx, (pixel / w) as f32 + fy);
-    let hit = first_non_specular(ctx, o, d, &sampler, CAMERA_CHAIN_BOUNCE, counts).map(|(sp, d, _)| (sp, d));
-    (sampler, hit)
+    let pixels = w * job.settings.height as usize;
+    let chunks = map_chunks(
+        pixels,
+        256,
+        job.threads,
+        |range| {
+            let (mut scratch, mut counts) = (Vec::new(), RayCounts::default());
+            range
+                .map(|pixel| {
+                    let (s, (fx, fy)) = camera_sample(job, pixel as u64 * u64::from(job.settings.spp));
+                    let (o, d) = rays.ray((pixel % w) as f32 + fx, (pixel / w) as f32 + fy);
+                    match first_non_specular(ctx, o, d, &s, CAMERA_CHAIN_BOUNCE, &mut counts) {
+                        Some((sp, d, _)) => probe(pixel, &s, &sp, d, &mut scratch, &mut counts),
+                        None => miss.clone(),
+                    }
+                })
+                .collect::<Vec<_>>()
+        },
+        |_| {},
+    );
+    chunks.into_iter().flatten().collect()
 }
 
 /// Renders every pixel with `radiance(pixel, o, d, sampler, rays, scratch)`, which traces one
