@@ -50,10 +50,9 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
             let gather = s.fork(streams::gather(0));
             gather_rays(sp, -d, settings.gather_rays, &gather, |g, o, wi| {
                 let chain = gather.fork(streams::gather_ray(g));
-                if let Some((y, dy, _)) = first_non_specular(&ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, counts)
-                {
-                    let bsdf = &scene.materials[y.material as usize].bsdf;
-                    let e = global_estimate(&ctx, &y, bsdf, -dy, 0, None, scratch);
+                if let Some(end) = first_non_specular(&ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, counts) {
+                    let bsdf = &scene.materials[end.point.material as usize].bsdf;
+                    let e = global_estimate(&ctx, &end.point, bsdf, -end.dir, 0, None, scratch);
                     sum[0] += f64::from(e.radius);
                     sum[1] += f64::from(e.count);
                     hits += 1;

@@ -32,7 +32,13 @@ impl Effects {
         let final_gather = if !global_map.on {
             Part::new(false, "no global map to gather from")
         } else if settings.final_gather {
-            Part::new(true, format!("{} cosine-weighted rays per sample read the global map", settings.gather_rays))
+            let rays = format!("{} cosine-weighted rays per sample read the global map", settings.gather_rays);
+            if settings.secondary_gather > 0.0 {
+                let near = format!("those landing within {} radii bounce once more", settings.secondary_gather);
+                Part::new(true, format!("{rays}; {near} (secondary gather)"))
+            } else {
+                Part::new(true, rays)
+            }
         } else if forced("final_gather") {
             Part::new(true, "forced on by the `force` setting")
         } else {

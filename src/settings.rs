@@ -16,6 +16,10 @@ pub const MAX_PATHS_PER_PHOTON: u64 = 256;
 /// Passes a `target_error` render runs before it trusts the spread between passes.
 pub const MIN_PASSES_FOR_TARGET: u32 = 4;
 
+/// Default [`Settings::secondary_gather`], in global-map radii (chosen by measurement:
+/// BENCHMARKS.md, "Secondary gather").
+pub const SECONDARY_GATHER: f32 = 3.0;
+
 /// Which per-pass amounts were given explicitly (by a flag, a sweep knob or a preset); those are
 /// used as they are in every pass instead of being spread over the passes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -79,6 +83,14 @@ pub struct Settings {
     /// nearest-neighbour search instead of k. Slightly blurrier, several times faster. Not used
     /// by progressive passes, where it would be biased (see `transport::maps::precompute_irradiance`).
     pub precompute_irradiance: bool,
+    /// Jensen's secondary gather: a final-gather ray that lands on a Lambertian surface closer
+    /// to its origin than this many global-map radii (the pass's fixed radius in progressive
+    /// passes, `global_radius` otherwise), straight from its origin, does not read the global
+    /// map there. It takes direct light and the caustic map at that point and continues with one
+    /// cosine-weighted bounce that reads the maps where it lands (`transport::gather`). A read
+    /// that close averages the light of its disk into the corner the gather leaves, which
+    /// brightens dark corners. 0 turns it off.
+    pub secondary_gather: f32,
     /// Longest photon path and longest specular chain of a camera path (bounces).
     pub max_depth: u32,
     /// Area-light samples per shading point.
@@ -147,6 +159,7 @@ impl Default for Settings {
             gather_rays: 16,
             final_gather: true,
             precompute_irradiance: true,
+            secondary_gather: SECONDARY_GATHER,
             max_depth: 10,
             light_samples: 1,
             seed: 1,
@@ -222,6 +235,8 @@ pub struct Overrides {
     pub gather_rays: Option<u32>,
     /// `--no-final-gather`.
     pub no_final_gather: bool,
+    /// `--secondary-gather`.
+    pub secondary_gather: Option<f32>,
     /// `--visibility` (turns it on; the scene file may too).
     pub visibility: bool,
     /// `--no-boundary-correction`.
@@ -256,7 +271,7 @@ impl Overrides {
             ($($f:ident),*) => { $( if let Some(v) = self.$f { s.$f = v; } )* };
         }
         set!(width, height, spp, photons, caustic_photons, gather_rays, max_depth, seed, threads, kernel, code_path);
-        set!(passes, alpha, target_error);
+        set!(passes, alpha, target_error, secondary_gather);
         if let Some(k) = self.k {
             s.k = k;
             s.caustic_k = k;
@@ -309,6 +324,9 @@ impl Settings {
         }
         if !(self.caustic_radius > 0.0 && self.caustic_radius <= 1.0) {
             return err("caustic_radius", "must be in (0, 1] (fraction of the scene diagonal)");
+        }
+        if !(0.0..=100.0).contains(&self.secondary_gather) {
+            return err("secondary_gather", "must be between 0 (off) and 100 global-map radii");
         }
         if self.final_gather && !(1..=4096).contains(&self.gather_rays) {
             return err("gather_rays", "must be between 1 and 4096 with final gather on");

@@ -150,6 +150,11 @@ fn the_cli_reports_errors_with_a_nonzero_exit() {
     assert!(code != 0 && e.contains("camera.target"), "{e}");
     let (code, e) = cli(&["render", scene, "--k", "1", "-o", out]);
     assert!(code != 0 && e.contains("`k`"), "{e}");
+    for bad in ["NaN", "-1", "1000"] {
+        let flag = format!("--secondary-gather={bad}");
+        let (code, e) = cli(&["render", scene, &flag, "-o", out]);
+        assert!(code != 0 && e.contains("`secondary_gather`"), "{bad}: {e}");
+    }
     let (code, e) = cli(&["render", scene, "-o", "x.png"]);
     assert!(code != 0 && e.contains("--output") && e.contains("x.png") && e.contains("--png"), "{e}");
     let (code, e) = cli(&["render", scene, "-o", out, "--png", "x.exr"]);

@@ -65,6 +65,10 @@ pub struct RenderArgs {
     /// Read the global map directly at the first diffuse hit instead of final gathering.
     #[arg(long)]
     pub no_final_gather: bool,
+    /// Secondary gather: a gather ray landing closer than this many global-map radii takes one
+    /// more diffuse bounce instead of reading the map there (dark corners stay dark); 0 = off [3].
+    #[arg(long, value_name = "RADII")]
+    pub secondary_gather: Option<f32>,
     /// Count only photons visible from each estimate's point (no light through thin walls; one
     /// short occlusion ray per candidate photon) [off, or the scene file's `visibility`].
     #[arg(long)]
@@ -162,6 +166,7 @@ fn overrides(args: &RenderArgs) -> Overrides {
         code_path: args.code_path,
         gather_rays: args.gather_rays,
         no_final_gather: args.no_final_gather,
+        secondary_gather: args.secondary_gather,
         visibility: args.visibility,
         no_boundary_correction: args.no_boundary_correction,
         diagnostics: args.diagnostics,

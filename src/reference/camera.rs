@@ -1,7 +1,8 @@
 //! The oracle's camera pass, one ray at a time: jittered camera rays; mirrors and glass by ray
 //! tracing; at the first non-specular hit, Jensen's terms — direct light by light sampling,
-//! caustics from the caustic map, indirect diffuse by final gather over the global map (or the
-//! global map read directly), and the glossy lobe by one traced ray. Every vertex is the
+//! caustics from the caustic map, indirect diffuse by final gather over the global map (with the
+//! secondary gather where a gather ray lands near; or the global map read directly), and the
+//! glossy lobe by one traced ray. Every vertex is the
 //! transport core's; only the loops are here.
 //!
 //! Double counting is avoided by construction: final-gather and glossy rays never add emission
@@ -19,8 +20,8 @@ use crate::stats::{Numerics, RayCounts};
 use crate::transport::camera::render_pixels;
 use crate::transport::direct::direct_light;
 use crate::transport::estimate::{caustic_estimate, indirect_estimate, map_radiance};
-use crate::transport::gather::{gather_rays, glossy_ray};
-use crate::transport::specular::{continue_ray, emission_toward, first_non_specular};
+use crate::transport::gather::{chain_lands_near, gather_rays, glossy_ray};
+use crate::transport::specular::{continue_ray, emission_toward, first_non_specular, ChainEnd};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
 
@@ -114,7 +115,8 @@ impl From<crate::photon_map::Estimate> for Estimated {
 }
 
 /// Final gather: `kd/N · Σ L(x, ωi)` over the N gather rays, L read from the photon maps at
-/// each ray's first non-specular hit (following mirrors and glass, adding no emission).
+/// each ray's first non-specular hit (following mirrors and glass, adding no emission), or by
+/// the secondary gather where that hit is near ([`gather_hit`]).
 pub fn final_gather(
     ctx: &Context,
     sp: &SurfacePoint,
@@ -132,14 +134,44 @@ pub fn final_gather(
     let (mut sum, mut bias) = (Vec3::ZERO, Vec3::ZERO);
     gather_rays(sp, wo, n, s, |g, o, wi| {
         let chain = s.fork(streams::gather_ray(g));
-        if let Some((y, d, beta)) = first_non_specular(ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, rays) {
-            let bsdf = &ctx.scene.materials[y.material as usize].bsdf;
-            let e = map_radiance(ctx, &y, bsdf, -d, scratch);
-            sum += beta * e.radiance;
-            bias += beta * e.bias;
+        if let Some(end) = first_non_specular(ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, rays) {
+            let e = gather_hit(ctx, &end, &chain, rays, scratch);
+            sum += end.beta * e.radiance;
+            bias += end.beta * e.bias;
         }
     });
     Estimated { radiance: kd * sum / n as f32, bias: kd * bias / n as f32 }
+}
+
+/// Radiance a gather ray (stream `chain`) finds where it ends: the photon maps' there, or, where
+/// it lands near its origin, the secondary gather's — direct light, the caustic map and one more
+/// gather ray that reads the maps (`transport::gather`).
+fn gather_hit(
+    ctx: &Context,
+    end: &ChainEnd,
+    chain: &Sampler,
+    rays: &mut RayCounts,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Estimated {
+    let (y, wo) = (&end.point, -end.dir);
+    let bsdf = &ctx.scene.materials[y.material as usize].bsdf;
+    if !chain_lands_near(end, bsdf, ctx.secondary_gather) {
+        return map_radiance(ctx, y, bsdf, wo, scratch).into();
+    }
+    let direct = direct_light(ctx, y, bsdf, wo, &chain.fork(streams::SECONDARY_LIGHT), rays);
+    let caustic = caustic_estimate(ctx, y, bsdf, wo, None, scratch);
+    let bounce = chain.fork(streams::SECONDARY_GATHER);
+    let mut far = Estimated::default();
+    gather_rays(y, wo, 1, &bounce, |g, o, wi| {
+        let chain = bounce.fork(streams::gather_ray(g));
+        if let Some(z) = first_non_specular(ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, rays) {
+            let b = &ctx.scene.materials[z.point.material as usize].bsdf;
+            let e = map_radiance(ctx, &z.point, b, -z.dir, scratch);
+            far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias };
+        }
+    });
+    let kd = bsdf.diffuse();
+    Estimated { radiance: direct + caustic.radiance + kd * far.radiance, bias: caustic.bias + kd * far.bias }
 }
 
 /// The glossy lobe's reflection: one ray sampled from the lobe; at its first non-specular hit,
@@ -156,7 +188,9 @@ pub fn glossy_reflection(
     scratch: &mut Vec<(f32, u32)>,
 ) -> Estimated {
     let Some(ray) = glossy_ray(sp, bsdf, wo, s) else { return Estimated::default() };
-    let Some((y, d, beta)) = first_non_specular(ctx, ray.origin, ray.dir, s, streams::GLOSSY_CHAIN_BOUNCE, rays) else {
+    let Some(ChainEnd { point: y, dir: d, beta, .. }) =
+        first_non_specular(ctx, ray.origin, ray.dir, s, streams::GLOSSY_CHAIN_BOUNCE, rays)
+    else {
         return Estimated::default();
     };
     let b = &ctx.scene.materials[y.material as usize].bsdf;

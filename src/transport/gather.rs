@@ -1,13 +1,26 @@
 //! Ray generation at a camera path's non-specular hit for the two terms that trace further:
 //! final gathering (Jensen's soft indirect term: `kd/N · Σ L(x, ωi)` over N cosine-weighted
-//! rays, where the 1/π and the cosine cancel) and the glossy lobe's one reflected ray.
+//! rays, where the 1/π and the cosine cancel) and the glossy lobe's one reflected ray; and
+//! Jensen's secondary gather, which decides where a gather ray does not read the maps.
+//!
+//! Secondary gather: a gather ray that lands on a Lambertian surface within a few global-map
+//! radii of its origin (no mirror or glass between) would read an estimate whose disk reaches
+//! back toward the point being gathered. In a corner that disk averages the dark corner with the
+//! brighter surface beyond, and the gathered light comes out too bright: on CornellBox-Original
+//! the front face of the short box where it meets the floor was 2 % too bright at 120 s, with
+//! or without the boundary correction (BENCHMARKS.md). There the ray instead takes direct light
+//! and the caustic map at its hit, and one cosine-weighted gather ray (weight kd) that reads the
+//! maps where it lands, farther away. It is still the same sum over paths, only one bounce later
+//! read from the maps; LuxCore's PhotonGI does the same below its "usage threshold".
 
 use super::specular::Bounce;
+use super::specular::ChainEnd;
 use crate::geometry::offset::offset_ray_origin;
+use crate::job::Job;
 use crate::material::Bsdf;
 use crate::rng::Sampler;
 use crate::sampling::{cosine_hemisphere, Frame};
-use crate::scene::SurfacePoint;
+use crate::scene::{Scene, SurfacePoint};
 use glam::Vec3;
 
 /// The `n` final-gather rays at `sp` seen from `wo`: cosine-weighted directions about the
@@ -39,4 +52,29 @@ pub fn glossy_ray(sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler) -> Opti
         weight: bs.weight,
         delta: false,
     })
+}
+
+/// The distance below which a gather ray's hit takes the secondary gather, in scene units:
+/// [`Settings::secondary_gather`](crate::settings::Settings::secondary_gather) global-map radii
+/// (the pass's fixed radius in progressive passes, the maximum k-nearest radius otherwise); 0
+/// when it is off.
+#[must_use]
+pub fn secondary_gather_distance(scene: &Scene, job: &Job) -> f32 {
+    let radius = job.pass.radii.as_ref().map_or(job.settings.global_radius * scene.diagonal(), |r| r.global);
+    job.settings.secondary_gather * radius
+}
+
+/// Whether a gather ray ending at `end` on `bsdf` takes the secondary gather there: a Lambertian
+/// hit closer than `distance` ([`secondary_gather_distance`]) straight from the ray's origin.
+#[must_use]
+#[inline]
+pub fn lands_near(end_t: f32, bounces: u32, bsdf: &Bsdf, distance: f32) -> bool {
+    bounces == 0 && end_t < distance && matches!(bsdf, Bsdf::Lambert { .. })
+}
+
+/// [`lands_near`] for a chain's end.
+#[must_use]
+#[inline]
+pub fn chain_lands_near(end: &ChainEnd, bsdf: &Bsdf, distance: f32) -> bool {
+    lands_near(end.t, end.bounces, bsdf, distance)
 }

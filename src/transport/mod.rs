@@ -7,7 +7,7 @@
 //! - [`specular`]: continuing a ray at a surface, and following mirrors and glass;
 //! - [`photon`]: photon emission, deposit, scattering and the exact-count emission tally;
 //! - [`direct`]: direct light by light sampling (shadow rays);
-//! - [`gather`]: final-gather and glossy ray generation;
+//! - [`gather`]: final-gather and glossy ray generation, and where the secondary gather applies;
 //! - [`estimate`]: photon-map density estimates at a surface point;
 //! - [`maps`]: the photon maps of a render and Christensen's precomputed irradiance.
 //!
@@ -50,6 +50,9 @@ pub struct Context<'a> {
     pub global_radius: f32,
     /// Caustic-map maximum radius in scene units.
     pub caustic_radius: f32,
+    /// Gather rays landing closer than this take the secondary gather
+    /// ([`gather::secondary_gather_distance`]).
+    pub secondary_gather: f32,
     /// Photons the normal filter turned away in this context's estimates
     /// ([`Numerics::photons_filtered`](crate::stats::Numerics::photons_filtered)).
     pub filtered: AtomicU64,
@@ -68,6 +71,7 @@ impl<'a> Context<'a> {
             fixed: job.pass.radii.as_ref(),
             global_radius: job.settings.global_radius * d,
             caustic_radius: job.settings.caustic_radius * d,
+            secondary_gather: gather::secondary_gather_distance(scene, job),
             filtered: AtomicU64::new(0),
         }
     }

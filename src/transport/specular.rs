@@ -38,9 +38,24 @@ pub fn continue_ray(sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler, bounc
     })
 }
 
+/// Where a chain through mirrors and glass ends: its first non-specular hit.
+#[derive(Clone, Copy, Debug)]
+pub struct ChainEnd {
+    /// The hit.
+    pub point: SurfacePoint,
+    /// Direction of the segment arriving there.
+    pub dir: Vec3,
+    /// Throughput of the specular chain (1 without mirrors or glass on the way).
+    pub beta: Vec3,
+    /// Length of the arriving segment (the hit's ray distance; directions are unit).
+    pub t: f32,
+    /// Mirrors and glass on the way (0: the ray's own first hit).
+    pub bounces: u32,
+}
+
 /// Follows a ray through mirrors and glass (at most `max_depth` bounces, sampling each with `s`
-/// at bounce `first_bounce + depth`) to its first non-specular hit: that point, the incoming
-/// direction and the throughput of the specular chain. `None` if it escapes or is absorbed.
+/// at bounce `first_bounce + depth`) to its first non-specular hit. `None` if it escapes or is
+/// absorbed.
 pub fn first_non_specular(
     ctx: &Context,
     mut o: Vec3,
@@ -48,7 +63,7 @@ pub fn first_non_specular(
     s: &Sampler,
     first_bounce: u32,
     rays: &mut RayCounts,
-) -> Option<(SurfacePoint, Vec3, Vec3)> {
+) -> Option<ChainEnd> {
     let scene = ctx.scene;
     let mut beta = Vec3::ONE;
     for depth in 0..=ctx.settings.max_depth {
@@ -57,7 +72,7 @@ pub fn first_non_specular(
         let sp = scene.surface(&hit);
         let bsdf = &scene.materials[sp.material as usize].bsdf;
         if !bsdf.is_delta() {
-            return Some((sp, d, beta));
+            return Some(ChainEnd { point: sp, dir: d, beta, t: hit.t, bounces: depth });
         }
         let next = continue_ray(&sp, bsdf, -d, s, first_bounce + depth)?;
         beta *= next.weight;

@@ -12,6 +12,9 @@
 //!   (dim 0 picks the light, dims 1–2 the point on it);
 //! - fork [`gather`]`(d)`: final gather at the `d`-th hit, bounce `g` dims 0–1 = direction of
 //!   gather ray `g`; the ray's own specular chain forks [`gather_ray`]`(g)` and samples from bounce 0;
+//!   where it lands near its origin (secondary gather) its stream forks [`SECONDARY_LIGHT`] for
+//!   direct light there and [`SECONDARY_GATHER`] for its one more gather ray, drawn as gather ray 0
+//!   of a one-ray final gather;
 //! - fork [`glossy`]`(d)`: the glossy lobe at the `d`-th hit, bounce 0 dims 0–1 = its direction;
 //!   its specular chain samples from bounce 1; direct light where it lands forks
 //!   [`GLOSSY_HIT_LIGHT`].
@@ -37,6 +40,10 @@ pub const CAMERA_CHAIN_BOUNCE: u32 = 1;
 pub const GATHER_CHAIN_BOUNCE: u32 = 0;
 /// Fork of a glossy ray's stream for the direct light where it lands.
 pub const GLOSSY_HIT_LIGHT: u64 = 7;
+/// Fork of a gather ray's stream for direct light where it lands near its origin.
+pub const SECONDARY_LIGHT: u64 = 8;
+/// Fork of a gather ray's stream for the one-ray gather where it lands near its origin.
+pub const SECONDARY_GATHER: u64 = 9;
 
 /// Fork tag of direct light at a camera path's `depth`-th hit.
 #[must_use]

@@ -1,10 +1,12 @@
 //! Classify: splits the lanes of the last intersected queue into diffuse (diffuse or glossy),
-//! mirror, glass and escaped, by the material hit. Reads hit columns; writes the lane lists.
+//! mirror, glass and escaped, by the material hit; then marks the gather lanes that landed near
+//! their origin for the secondary gather. Reads hit columns; writes the lane lists and kinds.
 
-use super::queues::{Classified, HitColumns};
+use super::queues::{Classified, HitColumns, PathKind};
 use super::{CameraWork, PhotonWork, Shared, StageStats};
 use crate::material::Bsdf;
 use crate::scene::Scene;
+use crate::transport::gather::{lands_near, secondary_gather_distance};
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
@@ -42,4 +44,30 @@ pub fn classify_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut sta
     let w = &mut *work;
     classify(&shared.scene, &w.paths.hits, &mut w.classified);
     stats.record("classify_paths", w.paths.len(), t);
+}
+
+/// Gather lanes at diffuse hits that landed near their origin become
+/// [`PathKind::NearGather`] (`transport::gather`'s secondary gather).
+pub fn mark_near_gathers(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+    let t = Instant::now();
+    let distance = secondary_gather_distance(&shared.scene, &shared.job);
+    if distance <= 0.0 {
+        return;
+    }
+    let scene = &*shared.scene;
+    let w = &mut *work;
+    let mut n = 0;
+    for &l in &w.classified.diffuse {
+        let i = l as usize;
+        if w.paths.kind[i] != PathKind::Gather {
+            continue;
+        }
+        let tri = w.paths.hits.tri[i] as usize;
+        let bsdf = &scene.materials[scene.material[tri] as usize].bsdf;
+        if lands_near(w.paths.hits.t[i], w.paths.depth[i], bsdf, distance) {
+            w.paths.kind[i] = PathKind::NearGather;
+            n += 1;
+        }
+    }
+    stats.record("mark_near_gathers", n, t);
 }

@@ -1,7 +1,7 @@
 //! Gather: photon-map density estimates where lanes reached a diffuse surface — the caustic map
-//! for camera and glossy rays, the global map for gather rays (precomputed irradiance where it
-//! applies), and the global map without direct and caustic photons for glossy rays and for camera
-//! rays when final gathering is off. Reads the diffuse lane list, hits and maps; writes the wave's
+//! for camera, glossy and near-landed gather rays, the global map for the other gather rays
+//! (precomputed irradiance where it applies), and the global map without direct and caustic
+//! photons for glossy rays and for camera rays when final gathering is off. Reads the diffuse lane list, hits and maps; writes the wave's
 //! terms in lane order.
 
 use super::queues::PathKind;
@@ -63,7 +63,7 @@ fn estimate_at_diffuse_hits(
     lanes.len()
 }
 
-/// Caustic-map estimates at the diffuse hits of camera and glossy rays.
+/// Caustic-map estimates at the diffuse hits of camera, glossy and near-landed gather rays.
 pub fn gather_caustics(
     shared: Res<Shared>,
     maps: Res<Maps>,
@@ -75,16 +75,17 @@ pub fn gather_caustics(
         &shared,
         &maps,
         &mut work,
-        |kind| kind != PathKind::Gather,
+        |kind| !kind.reads_maps(),
         Term::Caustic,
         |ctx, sp, bsdf, wo, _, pixel, scratch| caustic_estimate(ctx, sp, bsdf, wo, pixel, scratch),
     );
     stats.record("gather_caustics", n, t);
 }
 
-/// Global-map estimates at diffuse hits: gather rays read the maps' radiance; glossy rays, and
-/// camera rays when final gathering is off, read the global map without direct and caustic
-/// photons (those terms are computed separately).
+/// Global-map estimates at diffuse hits: gather rays read the maps' radiance (not those that
+/// landed near, whose secondary gather reads them a bounce later); glossy rays, and camera rays
+/// when final gathering is off, read the global map without direct and caustic photons (those
+/// terms are computed separately).
 pub fn gather_global(
     shared: Res<Shared>,
     maps: Res<Maps>,
@@ -97,11 +98,18 @@ pub fn gather_global(
         &shared,
         &maps,
         &mut work,
-        |kind| !(kind == PathKind::Camera && gather_on),
+        |kind| match kind {
+            PathKind::Camera => !gather_on,
+            PathKind::NearGather => false,
+            _ => true,
+        },
         Term::Indirect,
-        |ctx, sp, bsdf, wo, kind, pixel, scratch| match kind {
-            PathKind::Gather => map_radiance(ctx, sp, bsdf, wo, scratch),
-            _ => indirect_estimate(ctx, sp, bsdf, wo, pixel, scratch),
+        |ctx, sp, bsdf, wo, kind, pixel, scratch| {
+            if kind.reads_maps() {
+                map_radiance(ctx, sp, bsdf, wo, scratch)
+            } else {
+                indirect_estimate(ctx, sp, bsdf, wo, pixel, scratch)
+            }
         },
     );
     stats.record("gather_global", n, t);

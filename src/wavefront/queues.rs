@@ -274,10 +274,23 @@ soa_queue! {
 pub enum PathKind {
     /// A camera ray or its continuation through mirrors and glass.
     Camera = 0,
-    /// A final-gather ray: reads the photon maps where it lands.
+    /// A final-gather ray: reads the photon maps where it lands, unless it lands near.
     Gather = 1,
     /// A glossy-lobe ray: direct light, caustics and the global map where it lands.
     Glossy = 2,
+    /// A gather ray that landed near its origin (secondary gather): direct light and caustics
+    /// where it landed, and one more gather ray.
+    NearGather = 3,
+    /// The secondary gather's one more gather ray: reads the photon maps where it lands.
+    SecondaryGather = 4,
+}
+
+impl PathKind {
+    /// Reads the photon maps' radiance where it lands (a gather ray that did not land near).
+    #[must_use]
+    pub fn reads_maps(self) -> bool {
+        matches!(self, PathKind::Gather | PathKind::SecondaryGather)
+    }
 }
 
 soa_queue! {

@@ -89,7 +89,7 @@ pub fn schedules() -> [Schedule; 4] {
     camera_bounce.configure_sets(stages());
     camera_bounce.add_systems((
         (intersect::trace_shadow_rays, intersect::intersect_paths).chain().in_set(Stage::Intersect),
-        classify::classify_paths.in_set(Stage::Classify),
+        (classify::classify_paths, classify::mark_near_gathers.run_if(final_gather_on)).chain().in_set(Stage::Classify),
         deposit::deposit_emission.in_set(Stage::Deposit),
         (gather::gather_caustics.run_if(caustics_on), gather::gather_global.run_if(global_on))
             .chain()

@@ -1,6 +1,7 @@
 //! Shade: what each lane does next. Photons scatter (BSDF sample, Russian roulette) into the
 //! next photon queue. Camera-pass lanes at diffuse hits queue shadow rays (direct light) and
-//! spawn final-gather and glossy rays; lanes at mirrors and glass continue. After the bounce loop,
+//! spawn final-gather and glossy rays; gather lanes that landed near queue shadow rays and spawn
+//! their secondary gather's ray; lanes at mirrors and glass continue. After the bounce loop,
 //! `resolve_wave` turns the wave's samples into pixels. Reads classified lanes and hits; writes
 //! the next queues, the shadow queue and the film.
 
@@ -83,13 +84,14 @@ pub fn refract_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
     stats.record("refract_photons", lanes.len(), t);
 }
 
-/// Diffuse lanes of camera and glossy rays queue their shadow rays (direct light).
+/// Diffuse lanes of camera, glossy and near-landed gather rays queue their shadow rays (direct
+/// light).
 pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
     let w = &*work;
     let lanes: Vec<u32> =
-        w.classified.diffuse.iter().copied().filter(|&l| w.paths.kind[l as usize] != PathKind::Gather).collect();
+        w.classified.diffuse.iter().copied().filter(|&l| !w.paths.kind[l as usize].reads_maps()).collect();
     let mut queued = ShadowQueue::default();
     par_columns(
         lanes.len(),
@@ -106,6 +108,7 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
                     PathKind::Camera => {
                         (s.fork(streams::light(w.paths.depth[i])), Term::Direct.seen(w.paths.through_specular[i]))
                     }
+                    PathKind::NearGather => (s.fork(streams::SECONDARY_LIGHT), w.paths.term[i]),
                     _ => (s.fork(streams::GLOSSY_HIT_LIGHT), w.paths.term[i]),
                 };
                 let (beta, sample) = (w.paths.beta[i], w.paths.sample[i]);
@@ -128,7 +131,8 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
     stats.record("shade_direct", n, t);
 }
 
-/// Diffuse camera lanes spawn `gather_rays` cosine-weighted rays, each weighted beta·kd/N.
+/// Diffuse camera lanes spawn `gather_rays` cosine-weighted rays, each weighted beta·kd/N;
+/// near-landed gather lanes spawn their secondary gather's one ray, weighted beta·kd.
 pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let scene = &*shared.scene;
@@ -136,8 +140,12 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
     // Chunks append straight to the next queue (disjoint fields of the work resource).
     let CameraWork { paths, classified, next, .. } = &mut *work;
     let w = &*paths;
-    let lanes: Vec<u32> =
-        classified.diffuse.iter().copied().filter(|&l| w.kind[l as usize] == PathKind::Camera).collect();
+    let lanes: Vec<u32> = classified
+        .diffuse
+        .iter()
+        .copied()
+        .filter(|&l| matches!(w.kind[l as usize], PathKind::Camera | PathKind::NearGather))
+        .collect();
     let before = next.len();
     next.reserve(lanes.len() * n as usize);
     par_columns(
@@ -154,15 +162,23 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
                 if kd == glam::Vec3::ZERO {
                     continue;
                 }
-                let gs = Sampler::from_key(w.key[i]).fork(streams::gather(w.depth[i]));
-                let weight = w.beta[i] * kd / n as f32;
-                let term = Term::Indirect.seen(w.through_specular[i]);
-                gather_rays(&sp, -w.rays.direction(i), n, &gs, |g, origin, dir| {
+                let s = Sampler::from_key(w.key[i]);
+                let (gs, rays, kind, term) = match w.kind[i] {
+                    PathKind::Camera => (
+                        s.fork(streams::gather(w.depth[i])),
+                        n,
+                        PathKind::Gather,
+                        Term::Indirect.seen(w.through_specular[i]),
+                    ),
+                    _ => (s.fork(streams::SECONDARY_GATHER), 1, PathKind::SecondaryGather, w.term[i]),
+                };
+                let weight = w.beta[i] * kd / rays as f32;
+                gather_rays(&sp, -w.rays.direction(i), rays, &gs, |g, origin, dir| {
                     out.push(Segment {
                         origin,
                         dir,
                         sample: w.sample[i],
-                        kind: PathKind::Gather,
+                        kind,
                         key: gs.fork(streams::gather_ray(g)).key(),
                         base: streams::GATHER_CHAIN_BOUNCE as u8,
                         depth: 0,
