@@ -128,6 +128,15 @@ fn well_conditioned(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3, target: Vec3)
     if u1 == Vec3::ZERO || u2 == Vec3::ZERO || v.length() == 0.0 || u1.dot(u2).abs() > 0.95 {
         return false;
     }
+    // The ray must cross the edge, not run along it (sine of their angle ≥ 0.1), and the edge
+    // must be long against the f32 rounding of the ray's aim (a quarter of it, the least margin to
+    // the segment's ends, ≥ 64 ε of the coordinates): otherwise the ray may rightly pass beside the
+    // segment, where a closed mesh has its other faces. (Found by the fuzzer: a ray along an edge
+    // 6.5e-12 long from 9.4e-4 away, passing 2e-9 from it.)
+    let dist = (o - target).length();
+    if v.length() < 0.1 * dist || len < 256.0 * f32::EPSILON * (o.length() + dist) {
+        return false;
+    }
     // v, like u1 and u2, is perpendicular to the edge: v = α u1 + β u2 with α, β clearly positive.
     let g = u1.dot(u2);
     let (x, y) = (v.dot(u1), v.dot(u2));

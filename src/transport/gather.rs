@@ -13,8 +13,7 @@
 //! maps where it lands, farther away. It is still the same sum over paths, only one bounce later
 //! read from the maps; LuxCore's PhotonGI does the same below its "usage threshold".
 
-use super::specular::Bounce;
-use super::specular::ChainEnd;
+use super::specular::{Bounce, ChainEnd};
 use crate::geometry::offset::offset_ray_origin;
 use crate::job::Job;
 use crate::material::Bsdf;
