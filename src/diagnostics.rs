@@ -21,8 +21,7 @@ use crate::scene::Scene;
 use crate::stats::RenderStats;
 use crate::transport::camera::probe_first_surfaces;
 use crate::transport::estimate::{caustic_estimate, global_estimate, indirect_estimate};
-use crate::transport::gather::gather_rays;
-use crate::transport::specular::first_non_specular;
+use crate::transport::gather::trace_gather_rays;
 use crate::transport::{streams, Context};
 
 /// The diagnostic layers of `job`'s pass of `scene` seen through `rays` (see the module notes).
@@ -48,15 +47,12 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
         } else if gather_on {
             let (mut sum, mut hits) = ([0.0f64; 2], 0u32);
             let gather = s.fork(streams::gather(0));
-            gather_rays(sp, -d, settings.gather_rays, &gather, |g, o, wi| {
-                let chain = gather.fork(streams::gather_ray(g));
-                if let Some(end) = first_non_specular(&ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, counts) {
-                    let bsdf = &scene.materials[end.point.material as usize].bsdf;
-                    let e = global_estimate(&ctx, &end.point, bsdf, -end.dir, 0, None, scratch);
-                    sum[0] += f64::from(e.radius);
-                    sum[1] += f64::from(e.count);
-                    hits += 1;
-                }
+            trace_gather_rays(&ctx, sp, -d, settings.gather_rays, &gather, counts, |end, _, _| {
+                let bsdf = &scene.materials[end.point.material as usize].bsdf;
+                let e = global_estimate(&ctx, &end.point, bsdf, -end.dir, 0, None, scratch);
+                sum[0] += f64::from(e.radius);
+                sum[1] += f64::from(e.count);
+                hits += 1;
             });
             let n = f64::from(hits.max(1));
             [(sum[0] / n) as f32, (sum[1] / n) as f32]

@@ -214,6 +214,12 @@ pub struct EstimateLayers {
 }
 
 impl Film {
+    /// A single render's film: its pixels, without noise or diagnostic layers.
+    #[must_use]
+    pub fn new(width: u32, height: u32, pixels: Vec<Terms>) -> Self {
+        Film { width, height, pixels, noise: None, diagnostics: None }
+    }
+
     /// Beauty image as RGB triples.
     #[must_use]
     pub fn beauty(&self) -> Vec<Vec3> {
@@ -448,7 +454,7 @@ mod tests {
                 }
             })
             .collect();
-        let film = Film { width: w, height: h, pixels, noise: None, diagnostics: None };
+        let film = Film::new(w, h, pixels);
         let dir = std::env::temp_dir().join(format!("photonwave-film-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let bytes = |name: &str| {

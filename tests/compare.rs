@@ -10,13 +10,7 @@ use std::process::Command;
 
 /// A 2×1 film whose only non-zero terms are `direct` and `caustic`.
 fn film(direct: [Vec3; 2], caustic: [Vec3; 2]) -> Film {
-    Film {
-        width: 2,
-        height: 1,
-        pixels: (0..2).map(|i| Terms { direct: direct[i], caustic: caustic[i], ..Default::default() }).collect(),
-        noise: None,
-        diagnostics: None,
-    }
+    Film::new(2, 1, (0..2).map(|i| Terms { direct: direct[i], caustic: caustic[i], ..Default::default() }).collect())
 }
 
 fn close(a: f64, b: f64) -> bool {
@@ -70,9 +64,7 @@ fn cli_prints_json_and_names_bad_inputs() {
     let (a, b, small) = (d.join("a.exr"), d.join("b.exr"), d.join("small.exr"));
     film([Vec3::splat(0.5); 2], [Vec3::ZERO; 2]).write_exr(&a).unwrap();
     film([Vec3::splat(0.25); 2], [Vec3::ZERO; 2]).write_exr(&b).unwrap();
-    Film { width: 1, height: 1, pixels: vec![Terms::default()], noise: None, diagnostics: None }
-        .write_exr(&small)
-        .unwrap();
+    Film::new(1, 1, vec![Terms::default()]).write_exr(&small).unwrap();
     let run = |args: &[&std::path::Path], json: bool| {
         let mut cmd = Command::new(env!("CARGO_BIN_EXE_photonwave"));
         cmd.arg("compare").args(args);

@@ -138,15 +138,7 @@ fn huge_images_are_refused_with_the_estimate() {
 fn an_exr_header_cannot_claim_more_than_the_file_holds() {
     let d = scratch_dir("exr-header");
     let small = d.join("small.exr");
-    photonwave::film::Film {
-        width: 8,
-        height: 4,
-        pixels: vec![Default::default(); 32],
-        noise: None,
-        diagnostics: None,
-    }
-    .write_exr(&small)
-    .unwrap();
+    photonwave::film::Film::new(8, 4, vec![Default::default(); 32]).write_exr(&small).unwrap();
     let mut bytes = std::fs::read(&small).unwrap();
     let key = b"dataWindow\0box2i\0";
     let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;

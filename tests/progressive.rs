@@ -382,8 +382,7 @@ fn the_error_layer_is_the_passes_spread_plus_the_bias() {
             bias: glam::Vec3::new(-3.0, 1.0, 0.5) * bias * s,
             ..Default::default()
         };
-        let film =
-            Film { width: settings.width, height: settings.height, pixels: vec![t; n], noise: None, diagnostics: None };
+        let film = Film::new(settings.width, settings.height, vec![t; n]);
         Ok((film, photonwave::stats::RenderStats::default()))
     };
     p.step(&fake).unwrap();

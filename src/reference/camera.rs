@@ -20,7 +20,7 @@ use crate::stats::{Numerics, RayCounts};
 use crate::transport::camera::render_pixels;
 use crate::transport::direct::direct_light;
 use crate::transport::estimate::{caustic_estimate, indirect_estimate, map_radiance};
-use crate::transport::gather::{chain_lands_near, gather_rays, glossy_ray};
+use crate::transport::gather::{chain_lands_near, glossy_ray, trace_gather_rays};
 use crate::transport::specular::{continue_ray, emission_toward, first_non_specular, ChainEnd};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
@@ -132,13 +132,10 @@ pub fn final_gather(
     }
     let n = ctx.settings.gather_rays;
     let (mut sum, mut bias) = (Vec3::ZERO, Vec3::ZERO);
-    gather_rays(sp, wo, n, s, |g, o, wi| {
-        let chain = s.fork(streams::gather_ray(g));
-        if let Some(end) = first_non_specular(ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, rays) {
-            let e = gather_hit(ctx, &end, &chain, rays, scratch);
-            sum += end.beta * e.radiance;
-            bias += end.beta * e.bias;
-        }
+    trace_gather_rays(ctx, sp, wo, n, s, rays, |end, chain, rays| {
+        let e = gather_hit(ctx, end, chain, rays, scratch);
+        sum += end.beta * e.radiance;
+        bias += end.beta * e.bias;
     });
     Estimated { radiance: kd * sum / n as f32, bias: kd * bias / n as f32 }
 }
@@ -160,15 +157,10 @@ fn gather_hit(
     }
     let direct = direct_light(ctx, y, bsdf, wo, &chain.fork(streams::SECONDARY_LIGHT), rays);
     let caustic = caustic_estimate(ctx, y, bsdf, wo, None, scratch);
-    let bounce = chain.fork(streams::SECONDARY_GATHER);
     let mut far = Estimated::default();
-    gather_rays(y, wo, 1, &bounce, |g, o, wi| {
-        let chain = bounce.fork(streams::gather_ray(g));
-        if let Some(z) = first_non_specular(ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, rays) {
-            let b = &ctx.scene.materials[z.point.material as usize].bsdf;
-            let e = map_radiance(ctx, &z.point, b, -z.dir, scratch);
-            far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias };
-        }
+    trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, _| {
+        let e = map_radiance(ctx, &z.point, &ctx.scene.materials[z.point.material as usize].bsdf, -z.dir, scratch);
+        far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias };
     });
     let kd = bsdf.diffuse();
     Estimated { radiance: direct + caustic.radiance + kd * far.radiance, bias: caustic.bias + kd * far.bias }

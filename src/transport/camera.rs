@@ -118,9 +118,5 @@ pub fn render_pixels(
         rays += r;
         numerics += n;
     }
-    (
-        Film { width: job.settings.width, height: job.settings.height, pixels, noise: None, diagnostics: None },
-        rays,
-        numerics,
-    )
+    (Film::new(job.settings.width, job.settings.height, pixels), rays, numerics)
 }

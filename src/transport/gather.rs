@@ -13,13 +13,15 @@
 //! maps where it lands, farther away. It is still the same sum over paths, only one bounce later
 //! read from the maps; LuxCore's PhotonGI does the same below its "usage threshold".
 
-use super::specular::{Bounce, ChainEnd};
+use super::specular::{first_non_specular, Bounce, ChainEnd};
+use super::{streams, Context};
 use crate::geometry::offset::offset_ray_origin;
 use crate::job::Job;
 use crate::material::Bsdf;
 use crate::rng::Sampler;
 use crate::sampling::{cosine_hemisphere, Frame};
 use crate::scene::{Scene, SurfacePoint};
+use crate::stats::RayCounts;
 use glam::Vec3;
 
 /// The `n` final-gather rays at `sp` seen from `wo`: cosine-weighted directions about the
@@ -37,6 +39,26 @@ pub fn gather_rays(sp: &SurfacePoint, wo: Vec3, n: u32, s: &Sampler, mut emit: i
         }
         emit(g, offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, wi), wi);
     }
+}
+
+/// Traces the final-gather rays of [`gather_rays`] through mirrors and glass, each on its own
+/// stream (forked [`streams::gather_ray`]`(g)` from `s`), and calls `read(end, stream, rays)` at
+/// each one's first non-specular hit, in ray order. Rays that escape or are absorbed read nothing.
+pub fn trace_gather_rays(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    wo: Vec3,
+    n: u32,
+    s: &Sampler,
+    rays: &mut RayCounts,
+    mut read: impl FnMut(&ChainEnd, &Sampler, &mut RayCounts),
+) {
+    gather_rays(sp, wo, n, s, |g, o, wi| {
+        let chain = s.fork(streams::gather_ray(g));
+        if let Some(end) = first_non_specular(ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, rays) {
+            read(&end, &chain, rays);
+        }
+    });
 }
 
 /// The glossy lobe's ray at `sp` seen from `wo`, drawn from bounce 0 (dims 0–1) of `s`, with

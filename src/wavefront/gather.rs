@@ -1,8 +1,8 @@
 //! Gather: photon-map density estimates where lanes reached a diffuse surface — the caustic map
 //! for camera, glossy and near-landed gather rays, the global map for the other gather rays
 //! (precomputed irradiance where it applies), and the global map without direct and caustic
-//! photons for glossy rays and for camera rays when final gathering is off. Reads the diffuse lane list, hits and maps; writes the wave's
-//! terms in lane order.
+//! photons for glossy rays and for camera rays when final gathering is off. Reads the diffuse
+//! lane list, hits and maps; writes the wave's terms in lane order.
 
 use super::queues::PathKind;
 use super::{par_lanes, CameraWork, Maps, Shared, StageStats, GATHER_CHUNK};

@@ -189,13 +189,7 @@ pub fn render_job(scene: Arc<Scene>, camera: &CameraRays, job: &Job, progress: &
     }
     progress.finish();
     let mut w = world.resource_mut::<CameraWork>();
-    let film = Film {
-        width: settings.width,
-        height: settings.height,
-        pixels: std::mem::take(&mut w.film),
-        noise: None,
-        diagnostics: None,
-    };
+    let film = Film::new(settings.width, settings.height, std::mem::take(&mut w.film));
     stats.rays += w.rays;
     stats.numerics += w.numerics;
     stats.times.camera_s = t.elapsed().as_secs_f64();
