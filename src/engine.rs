@@ -62,18 +62,9 @@ pub fn render(
     render_planned(scene, rays, &Job::new(scene, settings)?, engine, budget, progress)
 }
 
-/// Renders `scene` as `job` says: once, or — when `settings.passes > 1` or a budget is given —
-/// progressive passes with the job's settings as each pass's (see
-/// [`crate::progressive::per_pass`]). `progress` sees one phase per pass in a single render, or
-/// one bar over the passes (or the budget's milliseconds) in a progressive one.
-pub fn render_planned(
-    scene: &Arc<Scene>,
-    rays: &CameraRays,
-    job: &Job,
-    engine: Engine,
-    budget: Option<Budget>,
-    progress: &dyn Progress,
-) -> Result<(Film, RenderStats)> {
+/// Refuses what `job` cannot render with `engine`: a map the plan needs left empty, more memory
+/// than the machine has (before any of it is allocated), diagnostics from the path tracer.
+pub fn check_planned(job: &Job, engine: Engine) -> Result<()> {
     let settings = &job.settings;
     if engine != Engine::Path {
         job.plan.check(settings)?;
@@ -94,6 +85,23 @@ pub fn render_planned(
             "the diagnostic layers show photon-map estimates; the path tracer makes none",
         ));
     }
+    Ok(())
+}
+
+/// Renders `scene` as `job` says: once, or — when `settings.passes > 1` or a budget is given —
+/// progressive passes with the job's settings as each pass's (see
+/// [`crate::progressive::per_pass`]). `progress` sees one phase per pass in a single render, or
+/// one bar over the passes (or the budget's milliseconds) in a progressive one.
+pub fn render_planned(
+    scene: &Arc<Scene>,
+    rays: &CameraRays,
+    job: &Job,
+    engine: Engine,
+    budget: Option<Budget>,
+    progress: &dyn Progress,
+) -> Result<(Film, RenderStats)> {
+    check_planned(job, engine)?;
+    let settings = &job.settings;
     if !is_progressive(settings, budget) {
         let (mut film, mut stats) = render_job(scene, rays, job, engine, progress);
         crate::diagnostics::add_layers(scene, rays, job, &mut film, &mut stats);

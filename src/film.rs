@@ -273,6 +273,13 @@ impl Film {
 
     /// Writes the EXR: default layer R, G, B = beauty; one layer per term (`direct.R`, …).
     pub fn write_exr(&self, path: &Path) -> Result<()> {
+        self.write_exr_with(path, Vec::new(), &[])
+    }
+
+    /// [`Film::write_exr`] with `extra` u32 channels (name, one value per pixel) and `text`
+    /// header attributes (name, value; characters beyond U+00FF are not allowed by EXR and
+    /// must be escaped by the caller).
+    pub fn write_exr_with(&self, path: &Path, extra: Vec<(String, Vec<u32>)>, text: &[(&str, String)]) -> Result<()> {
         use exr::prelude::*;
         let size = Vec2(self.width as usize, self.height as usize);
         let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
@@ -283,11 +290,20 @@ impl Film {
                 channels.push(AnyChannel::new(full.as_str(), FlatSamples::F32(data)));
             }
         }
+        for (name, data) in extra {
+            channels.push(AnyChannel::new(name.as_str(), FlatSamples::U32(data)));
+        }
+        let mut attributes = LayerAttributes::default();
+        for (name, value) in text {
+            let text = Text::new_or_none(value)
+                .ok_or_else(|| PwError::output(path, format!("attribute `{name}` has characters EXR cannot hold")))?;
+            attributes.other.insert(Text::new_or_panic(name), AttributeValue::Text(text));
+        }
         // Blocks in increasing order: with the default (unspecified) order the encoder writes
         // blocks as its threads finish them, and two renders of the same image gave files that
         // differed byte for byte.
         let encoding = Encoding { line_order: LineOrder::Increasing, ..Encoding::FAST_LOSSLESS };
-        let layer = Layer::new(size, LayerAttributes::default(), encoding, AnyChannels::sort(channels.into()));
+        let layer = Layer::new(size, attributes, encoding, AnyChannels::sort(channels.into()));
         let image = Image::from_layer(layer);
         crate::files::replace(path, |tmp| image.write().to_file(tmp).map_err(|e| PwError::output(path, e)))
     }
@@ -370,15 +386,26 @@ fn check_exr_size(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Reads every RGB layer of the first part of the EXR at `path`. A damaged file is an error
-/// naming it, never a crash: sizes are checked before decoding ([`check_exr_size`]), and a
-/// panic inside the decoder is caught and reported as damage.
-pub fn read_exr(path: &Path) -> Result<ExrLayers> {
-    use exr::prelude::*;
+/// An EXR decoded whole: every channel of every layer, as stored.
+pub type DecodedExr = exr::image::FlatImage;
+
+/// Decodes the EXR at `path` whole. A damaged file is an error naming it, never a crash: sizes
+/// are checked before decoding ([`check_exr_size`]), and a panic inside the decoder is caught
+/// and reported as damage.
+pub fn decode_exr(path: &Path) -> Result<DecodedExr> {
     check_exr_size(path)?;
-    let image = std::panic::catch_unwind(|| read_all_flat_layers_from_file(path))
+    std::panic::catch_unwind(|| exr::prelude::read_all_flat_layers_from_file(path))
         .map_err(|_| PwError::parse(path, 0, "damaged EXR: the decoder failed on it"))?
-        .map_err(|e| PwError::parse(path, 0, format!("not a readable EXR: {e}")))?;
+        .map_err(|e| PwError::parse(path, 0, format!("not a readable EXR: {e}")))
+}
+
+/// Reads every RGB layer of the first part of the EXR at `path` ([`decode_exr`], [`rgb_layers`]).
+pub fn read_exr(path: &Path) -> Result<ExrLayers> {
+    rgb_layers(path, &decode_exr(path)?)
+}
+
+/// Every RGB layer of the first part of `image`, decoded from `path`.
+pub fn rgb_layers(path: &Path, image: &DecodedExr) -> Result<ExrLayers> {
     let l = image.layer_data.first().ok_or_else(|| PwError::parse(path, 0, "EXR has no layer"))?;
     let (w, h) = (l.size.0, l.size.1);
     let channel = |name: &str| {

@@ -28,6 +28,9 @@
 //! - [`stats`]: plain records of what a render did (rays, times, maps, numerics);
 //! - [`film`]: the five [`film::Term`]s per pixel, EXR and PNG output;
 //! - [`job`]: one render's validated settings, plan and pass (seed, progressive radii);
+//! - [`pass_set`]: which progressive passes a render runs (all, a range, worker K of N) and has run;
+//! - [`exact`]: per-pixel fixed-point integer sums of passes, the same in any order;
+//! - [`pass_sums`]: the mean, noise and bias of a set of passes from their exact sums;
 //!
 //! **Physics** — written once:
 //! - [`transport`]: every vertex both engines and the path tracer share — camera samples,
@@ -40,7 +43,9 @@
 //! - [`path`]: an unbiased path tracer for checking energy;
 //!
 //! **Drivers and tools**:
-//! - [`progressive`]: progressive passes with shrinking radii and a time budget;
+//! - [`progressive`]: progressive passes with shrinking radii, a time budget and a stop request;
+//! - [`partial`] and [`merge`]: partial films of divided or interrupted renders, and their exact
+//!   merge;
 //! - [`engine`]: the one render entry point — a single render or progressive passes;
 //! - [`diagnostics`]: the diagnostic layers — estimate radii and photon counts per pixel;
 //! - [`compare`], [`sweep`], [`plot`], [`bench`], [`fuzzing`]: the CLI's `compare`, `sweep`,
@@ -58,6 +63,7 @@ pub mod diagnostics;
 pub mod effects;
 pub mod engine;
 pub mod error;
+pub mod exact;
 pub mod files;
 pub mod film;
 pub mod fuzzing;
@@ -65,7 +71,11 @@ pub mod geometry;
 pub mod job;
 pub mod material;
 pub mod memory;
+pub mod merge;
 pub mod parallel;
+pub mod partial;
+pub mod pass_set;
+pub mod pass_sums;
 pub mod path;
 pub mod photon_map;
 pub mod plan;

@@ -1,5 +1,5 @@
-//! The photonwave command line: `photonwave render SCENE [flags]`, `bench`, `compare` and
-//! `sweep`, one module each under `cli/`.
+//! The photonwave command line: `photonwave render SCENE [flags]`, `merge`, `bench`, `compare`
+//! and `sweep`, one module each under `cli/`.
 
 mod cli;
 
@@ -17,6 +17,9 @@ struct Cli {
 enum Command {
     /// Render a scene (.toml scene file or bare .obj) to a multi-layer EXR.
     Render(Box<cli::render::RenderArgs>),
+    /// Merge partial films (from `render --pass-set K/N`, `--passes A..B`, checkpoints) into the
+    /// image of all their passes: bit for bit what an undivided render of them writes.
+    Merge(cli::merge::MergeArgs),
     /// Throughput of the SIMD kernels against their baselines on identical rays and queries:
     /// packet vs obvhs single-ray traversal, SIMD vs scalar density estimates.
     Bench(cli::bench::BenchArgs),
@@ -33,6 +36,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => cli::render::run(*args),
+        Command::Merge(args) => cli::merge::run(&args),
         Command::Bench(args) => cli::bench::run(args),
         Command::Compare(args) => cli::compare::run(&args),
         Command::Sweep(args) => cli::sweep::run(*args),

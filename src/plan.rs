@@ -3,10 +3,10 @@
 
 use crate::error::{Error, Result};
 use crate::settings::Settings;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// One part of the plan.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Part {
     /// Whether it runs.
     pub on: bool,
@@ -22,7 +22,7 @@ impl Part {
 }
 
 /// What to simulate.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Effects {
     /// Caustic photon pass, caustic map and caustic estimates.
     pub caustic_map: Part,

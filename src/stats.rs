@@ -1,9 +1,9 @@
 //! The render summary printed at the end and written by `--stats FILE.json`.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Rays traced, by purpose.
-#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq, Eq)]
 pub struct RayCounts {
     /// Primary rays and rays continuing camera paths through mirrors and glass.
     pub camera: u64,
@@ -33,7 +33,7 @@ impl std::ops::AddAssign for RayCounts {
 }
 
 /// One photon map: whether it was built, why, and what it holds.
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct MapStats {
     /// Whether the map was built.
     pub built: bool,
@@ -75,7 +75,7 @@ impl MapStats {
 
 /// Values that could not be used, per stage of the pipeline where they were caught. Nothing
 /// counted here reaches the film or a photon map.
-#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct Numerics {
     /// Load: vertex normals given with zero length, replaced by their face's geometric normal
     /// (non-finite ones are refused with an error naming the line).
@@ -113,7 +113,7 @@ impl std::ops::AddAssign for Numerics {
 }
 
 /// Wall time per phase, seconds.
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct PhaseTimes {
     /// Loading and BVH build.
     pub load_s: f64,
@@ -132,7 +132,8 @@ pub struct PhaseTimes {
 }
 
 /// Everything the summary reports.
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(default)]
 pub struct RenderStats {
     /// Engine that rendered.
     pub engine: String,
@@ -182,6 +183,25 @@ pub struct RenderStats {
 }
 
 impl RenderStats {
+    /// Adds `o`'s totals — rays, values caught, photon-pass, map and camera times, photons, and
+    /// per-system work — to these (another pass's, or another worker's passes'). The load's count
+    /// of replaced normals is the scene's, the same in every pass, and is kept.
+    pub fn add_totals(&mut self, o: &RenderStats) {
+        self.rays += o.rays;
+        let load_normals = self.numerics.load_normals;
+        self.numerics += o.numerics;
+        self.numerics.load_normals = load_normals;
+        self.times.global_photons_s += o.times.global_photons_s;
+        self.times.caustic_photons_s += o.times.caustic_photons_s;
+        self.times.map_build_s += o.times.map_build_s;
+        self.times.camera_s += o.times.camera_s;
+        self.global_map += &o.global_map;
+        self.caustic_map += &o.caustic_map;
+        if let (Some(s), Some(os)) = (self.stages.as_mut(), o.stages.as_ref()) {
+            *s += os;
+        }
+    }
+
     /// The stats of a render about to start: engine, scene size, image and sampling settings.
     #[must_use]
     pub fn new(
@@ -313,7 +333,7 @@ impl RenderStats {
 }
 
 /// Work done by one system.
-#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct StageStat {
     /// Times the system ran.
     pub runs: u64,
@@ -324,7 +344,7 @@ pub struct StageStat {
 }
 
 /// Per-system counts and times.
-#[derive(bevy_ecs::resource::Resource, Default, Clone, Debug, Serialize, PartialEq)]
+#[derive(bevy_ecs::resource::Resource, Default, Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct StageStats(pub std::collections::BTreeMap<String, StageStat>);
 
 impl std::ops::AddAssign<&StageStats> for StageStats {
@@ -350,7 +370,7 @@ impl StageStats {
 }
 
 /// What a progressive render did (in `--stats` and the summary).
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct ProgressiveStats {
     /// Passes rendered.
     pub passes: u32,
@@ -381,7 +401,7 @@ pub struct ProgressiveStats {
 
 /// A progressive image's error estimate, each part a mean over pixels over the image's mean
 /// beauty grey value: `error` = `noise` + `bias`, the mean of the EXR's `error` layer.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ImageError {
     /// The error bound: noise plus the bias's size.
     pub error: f64,

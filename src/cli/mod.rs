@@ -1,9 +1,13 @@
-//! The command line's pieces: one module per command ([`render`], [`bench`], [`compare`],
-//! [`sweep`]), the progress bars ([`bars`]), and the parsers and printing they share.
+//! The command line's pieces: one module per command ([`render`] with its progressive path
+//! [`passes`] and signal watch [`interrupt`], [`merge`], [`bench`], [`compare`], [`sweep`]),
+//! the progress bars ([`bars`]), and the parsers and printing they share.
 
 pub mod bars;
 pub mod bench;
 pub mod compare;
+pub mod interrupt;
+pub mod merge;
+pub mod passes;
 pub mod render;
 pub mod sweep;
 

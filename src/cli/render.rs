@@ -2,12 +2,14 @@
 //! renders once or progressively, and writes the EXR, the PNG preview and the JSON stats.
 
 use super::bars::Bars;
+use super::passes::{PassFlags, Setup};
 use super::{parse_duration, parse_vec3, significant, Say};
 use glam::Vec3;
 use photonwave::engine::{Budget, Engine};
 use photonwave::error::{Error, Result};
 use photonwave::files::{check_outputs, Output};
 use photonwave::job::Job;
+use photonwave::partial::Identity;
 use photonwave::scene::file::{fitted_camera_to, load_scene_lit};
 use photonwave::scene::{Camera, Light, LightPreset};
 use photonwave::settings::{Kernel, Overrides, Preset};
@@ -88,9 +90,31 @@ pub struct RenderArgs {
     #[arg(long)]
     pub force: Vec<String>,
     /// Progressive passes: each traces fresh photons and estimates with fixed radii that shrink
-    /// pass by pass (α); the image is their mean [1 = one k-nearest-neighbour render].
+    /// pass by pass (α); the image is their mean [1 = one k-nearest-neighbour render]. A range
+    /// `A..B` renders passes A to B−1 only, a part of a divided render: the output is then a
+    /// partial film for `photonwave merge`.
+    #[arg(long, value_name = "N|A..B", value_parser = super::passes::parse_passes)]
+    pub passes: Option<super::passes::PassesArg>,
+    /// Render worker K's share of a divided render of N workers: passes K, K+N, K+2N, … (below
+    /// `--passes`, or until `--time` or `--target-error` stops it). The output is a partial film
+    /// for `photonwave merge`, whose merge of all N equals the undivided render bit for bit.
+    #[arg(long, value_name = "K/N")]
+    pub pass_set: Option<String>,
+    /// Write the output as a partial film (viewable, plus the exact sums `merge` and `--resume`
+    /// read) even for an undivided progressive render.
     #[arg(long)]
-    pub passes: Option<u32>,
+    pub partial: bool,
+    /// Write the passes so far to this partial film every `--checkpoint-every`, and when the
+    /// render ends; written atomically, so a crash mid-write keeps the previous one.
+    #[arg(long, value_name = "FILE.exr")]
+    pub checkpoint: Option<PathBuf>,
+    /// How often to write `--checkpoint`, e.g. `60s`, `10m` [60s].
+    #[arg(long, value_parser = parse_duration, default_value = "60s", requires = "checkpoint")]
+    pub checkpoint_every: std::time::Duration,
+    /// Continue the render whose passes this partial film or checkpoint holds (the same scene and
+    /// flags); passes it holds are not rendered again.
+    #[arg(long, value_name = "PART.exr")]
+    pub resume: Option<PathBuf>,
     /// Progressive passes until the image's estimated error (the `error` layer's mean — 95 %
     /// noise half-width plus estimated bias — over the image mean) is at most E, a fraction
     /// (0.01 = 1 %); with
@@ -171,7 +195,7 @@ fn overrides(args: &RenderArgs) -> Overrides {
         no_boundary_correction: args.no_boundary_correction,
         diagnostics: args.diagnostics,
         force: args.force.clone(),
-        passes: args.passes,
+        passes: args.passes.map(super::passes::PassesArg::total),
         target_error: args.target_error,
         alpha: args.alpha,
         max_depth: args.max_depth,
@@ -187,6 +211,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let mut outputs = vec![Output { flag: "--output", path: &args.output, ext: "exr" }];
     outputs.extend(args.png.as_deref().map(|path| Output { flag: "--png", path, ext: "png" }));
     outputs.extend(args.stats.as_deref().map(|path| Output { flag: "--stats", path, ext: "json" }));
+    outputs.extend(args.checkpoint.as_deref().map(|path| Output { flag: "--checkpoint", path, ext: "exr" }));
     // Every output is checked before any work, and again against every file the scene read.
     check_outputs(&outputs, std::slice::from_ref(&args.scene))?;
     // `--light` presets are placed from the camera, which may be fitted to the meshes' bounds
@@ -237,17 +262,48 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     let bars = Bars::new(args.quiet);
     let budget = args.time.map(|limit| Budget { limit, start: t0 });
-    let job = if photonwave::engine::is_progressive(settings, budget) {
-        let pass = Job { settings: photonwave::progressive::per_pass(settings, per_pass), ..job.clone() };
-        if args.engine != Engine::Path {
-            say.info(photonwave::progressive::describe(&pass.plan, &pass.settings, args.time));
+    let flags = PassFlags {
+        passes: args.passes,
+        pass_set: args.pass_set.as_deref(),
+        partial: args.partial,
+        checkpoint: args.checkpoint.as_deref(),
+        checkpoint_every: args.checkpoint_every,
+        resume: args.resume.as_deref(),
+        output: &args.output,
+    };
+    let progressive = photonwave::engine::is_progressive(settings, budget) || flags.any();
+    let job = if progressive {
+        if args.engine == Engine::Path {
+            return Err(Error::setting(
+                "--engine",
+                "progressive passes (--passes, --time, --pass-set) need a photon-mapping engine",
+            ));
         }
+        let pass = Job { settings: photonwave::progressive::per_pass(settings, per_pass), ..job.clone() };
+        say.info(photonwave::progressive::describe(&pass.plan, &pass.settings, args.time));
         pass
     } else {
         job
     };
     let settings = &job.settings;
-    let (film, mut stats) = photonwave::engine::render_planned(&scene, &rays, &job, args.engine, budget, &bars)?;
+    let (film, mut stats, signal) = if progressive {
+        photonwave::engine::check_planned(&job, args.engine)?;
+        let lights: Vec<String> = args.light.iter().map(|l| format!("{l:?}")).collect();
+        let identity = Identity::new(
+            &loaded.inputs,
+            settings,
+            &format!("{camera:?}"),
+            &lights,
+            &format!("{:?}", args.engine).to_lowercase(),
+        )?;
+        let setup = Setup { scene: &scene, rays: &rays, job: &job, engine: args.engine, budget, t0, identity };
+        let r = super::passes::render(&setup, &flags, &bars, say)?;
+        (r.film, r.stats, r.signal)
+    } else {
+        let (film, stats) = photonwave::engine::render_planned(&scene, &rays, &job, args.engine, budget, &bars)?;
+        film.write_exr(&args.output)?;
+        (film, stats, None)
+    };
     if let Some(w) = stats.progressive.as_ref().and_then(photonwave::progressive::budget_warning) {
         say.warn(w);
     }
@@ -264,8 +320,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
     stats.times.load_s = load_s;
     stats.times.total_s += load_s;
 
-    film.write_exr(&args.output)?;
-    say.info(format!("wrote {}\n", args.output.display()));
+    if signal.is_none() {
+        say.info(format!("wrote {}\n", args.output.display()));
+    }
     if let Some(p) = &args.png {
         film.write_png(p)?;
         say.info(format!("wrote {}\n", p.display()));
@@ -278,6 +335,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
         let json = serde_json::to_string_pretty(&stats).map_err(|e| Error::output(p, e))?;
         photonwave::files::write_bytes(p, json.as_bytes())?;
         say.info(format!("wrote {}\n", p.display()));
+    }
+    if let Some(sig) = signal {
+        std::process::exit(128 + sig);
     }
     Ok(())
 }

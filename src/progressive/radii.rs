@@ -1,0 +1,133 @@
+//! The first radii of a progressive render, from a pilot photon pass: reads the scene, the
+//! camera rays and the job, and writes each map's first radius and, with `per_pixel_radii`,
+//! each pixel's. Deterministic given the seed, so every worker of a divided render derives the
+//! same radii.
+
+use crate::code_path::CodePath;
+use crate::job::{FixedRadii, Job, Pass, PixelRadii};
+use crate::photon_map::{flags, Filter, Kernel, Lookup, PhotonMap};
+use crate::reference::build_job_maps;
+use crate::scene::camera::CameraRays;
+use crate::scene::Scene;
+use crate::settings::Settings;
+use crate::transport::camera::probe_first_surfaces;
+use crate::transport::{Context, PhotonMaps};
+use std::sync::Arc;
+
+/// Photons sampled for the first radii.
+pub const RADIUS_SAMPLES: usize = 1024;
+
+/// The seed of pass `i`: pass 0 keeps the user's seed; later ones are mixed from it.
+#[must_use]
+pub fn pass_seed(seed: u64, i: u32) -> u64 {
+    if i == 0 {
+        return seed;
+    }
+    crate::rng::mix64(seed ^ u64::from(i).wrapping_mul(0x9e37_79b9_7f4a_7c15))
+}
+
+/// Median distance from a photon of `map` to its `k`-th nearest neighbour (same-facing photons,
+/// within `r_max`), over up to [`RADIUS_SAMPLES`] photons spread through the map. `None` for an
+/// empty map or when no sampled photon has k neighbours within `r_max`.
+#[must_use]
+pub fn median_knn_radius(map: &PhotonMap, k: u32, r_max: f32, code_path: CodePath) -> Option<f32> {
+    if map.is_empty() {
+        return None;
+    }
+    let step = map.len().div_ceil(RADIUS_SAMPLES).max(1);
+    let mut scratch = Vec::new();
+    let mut radii: Vec<f32> = (0..map.len())
+        .step_by(step)
+        .filter_map(|i| {
+            let p = map.photon(i);
+            let q = Lookup {
+                p: p.position,
+                k: k as usize,
+                r_max,
+                kernel: Kernel::Box,
+                filter: Filter { n: p.normal, flags_mask: 0 },
+            };
+            map.nearest(code_path, &q, &mut scratch);
+            (scratch.len() == k as usize).then(|| scratch.iter().map(|c| c.0).fold(0.0, f32::max).sqrt())
+        })
+        .collect();
+    if radii.is_empty() {
+        return None;
+    }
+    let mid = radii.len() / 2;
+    Some(*radii.select_nth_unstable_by(mid, f32::total_cmp).1)
+}
+
+/// The pilot photon pass's seed: its photons are independent of every pass's.
+#[must_use]
+pub fn pilot_seed(seed: u64) -> u64 {
+    pass_seed(seed, u32::MAX)
+}
+
+/// The first pass's radii from a pilot photon pass (traced with [`pilot_seed`]): per map, the
+/// median k-th-neighbour distance over the pilot's photons (the maximum radius where a map is
+/// empty or too sparse); with `per_pixel_radii`, each pixel's own as well ([`pixel_radii`]).
+/// `job` is the render's, whose pass (the user's seed, no radii) is the first.
+#[must_use]
+pub fn initial_radii(scene: &Scene, rays: &CameraRays, job: &Job) -> FixedRadii {
+    let settings = &job.settings;
+    let d = scene.diagonal();
+    let (r_global, r_caustic) = (settings.global_radius * d, settings.caustic_radius * d);
+    let pilot = Job {
+        settings: Settings { precompute_irradiance: false, ..settings.clone() },
+        pass: Pass { seed: pilot_seed(settings.seed), radii: None },
+        ..job.clone()
+    };
+    let (maps, _, _) = build_job_maps(scene, &pilot);
+    let uniform = FixedRadii::uniform(
+        median_knn_radius(&maps.global, settings.k, r_global, settings.code_path).unwrap_or(r_global),
+        median_knn_radius(&maps.caustic, settings.caustic_k, r_caustic, settings.code_path).unwrap_or(r_caustic),
+    );
+    // The pixels' first radii follow the first pass's camera samples: `job`'s own seed.
+    let pixels = settings.per_pixel_radii.then(|| Arc::new(pixel_radii(scene, rays, job, &maps, &uniform)));
+    FixedRadii { pixels, ..uniform }
+}
+
+/// Each pixel's first radii: the radius a k-nearest-neighbour estimate would use at the first
+/// non-specular point of the pixel's first camera sample (reached through mirrors and glass as
+/// that sample's path goes) — the distance to the k-th nearest same-facing photon of `maps`,
+/// or the maximum radius where fewer than k lie within it (`caustic_k` and the caustic map;
+/// `k` and the global map without direct and caustic photons). `fallback`'s radii where the
+/// path finds no such point. Global radii are found only where the camera reads the global
+/// map (final gathering off).
+#[must_use]
+pub fn pixel_radii(
+    scene: &Scene,
+    rays: &CameraRays,
+    job: &Job,
+    maps: &PhotonMaps,
+    fallback: &FixedRadii,
+) -> PixelRadii {
+    let settings = &job.settings;
+    let ctx = Context::new(scene, maps, job);
+    let want_global = ctx.effects.global_map.on && !ctx.effects.final_gather.on;
+    let knn = |map: &PhotonMap, k: u32, r_max: f32, q: Lookup, scratch: &mut Vec<(f32, u32)>| {
+        map.nearest(settings.code_path, &Lookup { k: k as usize, r_max, ..q }, scratch);
+        let r = scratch.iter().map(|c| c.0).fold(0.0, f32::max).sqrt();
+        if scratch.len() == k as usize && r > 0.0 && r.is_finite() {
+            r
+        } else {
+            r_max
+        }
+    };
+    let miss = (fallback.global, fallback.caustic);
+    let found = probe_first_surfaces(&ctx, job, rays, miss, |_, _, sp, d, scratch, _| {
+        let (ng, _) = sp.frame.oriented(-d);
+        let q = Lookup { p: sp.p, k: 0, r_max: 0.0, kernel: settings.kernel, filter: Filter { n: ng, flags_mask: 0 } };
+        let caustic = knn(&maps.caustic, settings.caustic_k, ctx.caustic_radius, q, scratch);
+        let global = if want_global {
+            let q = Lookup { filter: Filter { n: ng, flags_mask: flags::OWN_TERMS }, ..q };
+            knn(&maps.global, settings.k, ctx.global_radius, q, scratch)
+        } else {
+            fallback.global
+        };
+        (global, caustic)
+    });
+    let (global, caustic): (Vec<f32>, Vec<f32>) = found.into_iter().unzip();
+    PixelRadii { global: if want_global { global } else { Vec::new() }, caustic }
+}
