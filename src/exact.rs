@@ -5,9 +5,11 @@
 //! render exactly. Floating-point sums would not: `(a + b) + c ≠ a + (b + c)`.
 //!
 //! Each value `x` is stored as `round(x · 2⁶⁴)` in an `i128` (its square as `round(x² · 2⁴⁸)`):
-//! resolution 5·10⁻²⁰ (squares 4·10⁻¹⁵), sums up to ±9·10¹⁸ (squares 6·10²³) before they
-//! saturate — far beyond any radiance an f32 film holds usefully. The conversion is IEEE
-//! arithmetic only (a power-of-two product, round, integer cast), the same on every machine.
+//! resolution 5·10⁻²⁰ (squares 4·10⁻¹⁵); one value saturates at ±2¹²⁶ units (±4.6·10¹⁸), and
+//! sums add in two's complement (wrapping), which keeps them independent of order even past
+//! ±9·10¹⁸ (squares ±6·10²³), where they would wrap — far beyond any radiance an f32 film holds
+//! usefully. The conversion is IEEE arithmetic only (a power-of-two product, floor, round, integer
+//! casts), the same on every machine.
 
 use crate::film::{Film, Terms};
 use glam::Vec3;
@@ -46,7 +48,7 @@ const SQUARE_SCALE: f64 = 281_474_976_710_656.0;
 /// Index of the grey value; the square follows.
 const GREY: usize = 18;
 
-/// 2⁶⁴ and its inverse, for splitting a fixed-point value into 64-bit halves.
+/// 2⁶⁴, for splitting a fixed-point value into 64-bit halves.
 const TWO64: f64 = 18_446_744_073_709_551_616.0;
 /// 2¹²⁶: beyond it a value saturates.
 const LIMIT: f64 = 85_070_591_730_234_615_865_843_651_857_942_052_864.0;
@@ -81,11 +83,11 @@ fn add_pixels(sums: &mut [[i128; VALUES]], pixels: &[Terms]) {
     for (s, p) in sums.iter_mut().zip(pixels) {
         let v = [p.emitted, p.direct, p.specular, p.caustic, p.indirect, p.bias];
         for (k, c) in v.iter().flat_map(|c| c.to_array()).enumerate() {
-            s[k] = s[k].saturating_add(quantise(f64::from(c), VALUE_SCALE));
+            s[k] = s[k].wrapping_add(quantise(f64::from(c), VALUE_SCALE));
         }
         let grey = f64::from(p.beauty().element_sum()) / 3.0;
-        s[GREY] = s[GREY].saturating_add(quantise(grey, VALUE_SCALE));
-        s[GREY + 1] = s[GREY + 1].saturating_add(quantise(grey * grey, SQUARE_SCALE));
+        s[GREY] = s[GREY].wrapping_add(quantise(grey, VALUE_SCALE));
+        s[GREY + 1] = s[GREY + 1].wrapping_add(quantise(grey * grey, SQUARE_SCALE));
     }
 }
 
@@ -130,11 +132,12 @@ impl ExactSums {
         });
     }
 
-    /// Adds another set of sums (the same size): the sums of both sets of passes.
+    /// Adds another set of sums (the same size): the sums of both sets of passes (wrapping, so
+    /// that any order gives the same bits).
     pub fn add(&mut self, o: &ExactSums) {
         for (s, t) in self.sums.iter_mut().zip(&o.sums) {
             for k in 0..VALUES {
-                s[k] = s[k].saturating_add(t[k]);
+                s[k] = s[k].wrapping_add(t[k]);
             }
         }
     }

@@ -20,92 +20,114 @@ pub struct Merged {
     pub stats: RenderStats,
     /// The merged sums (for writing a partial film of them).
     pub sums: PassSums,
-    /// Passes below the largest that no file holds.
-    pub missing: PassList,
+    /// Passes below the largest that no file holds, as compact text.
+    pub missing: Option<String>,
+    /// Which render the parts belong to.
+    pub identity: crate::partial::Identity,
+    /// Samples per pixel in each pass.
+    pub spp: u32,
     /// What went into the film that its user should know (a missing diagnostic layer).
     pub warnings: Vec<String>,
 }
 
-/// Merges `parts` (at least one), checking that they are parts of one render and hold
-/// disjoint passes.
-pub fn merge(parts: &[Partial]) -> Result<Merged> {
-    let first = parts.first().ok_or_else(|| Error::setting("PART", "give at least one partial film to merge"))?;
-    for p in &parts[1..] {
-        if let Some(why) = first.identity.difference(&first.path, &p.identity, &p.path) {
+/// What the merge keeps of a partial film once its sums are added: its passes and stats.
+struct Part {
+    path: std::path::PathBuf,
+    done: PassList,
+    stats: RenderStats,
+    spp: u32,
+}
+
+/// Merges the partial films `parts` yields (at least one), checking that they are parts of one
+/// render and hold disjoint passes. Each film's sums are added as it is read and then dropped,
+/// so memory holds two films' sums at most, however many files there are.
+pub fn merge(parts: impl IntoIterator<Item = Result<Partial>>) -> Result<Merged> {
+    let mut parts = parts.into_iter();
+    let first = parts.next().ok_or_else(|| Error::setting("PART", "give at least one partial film to merge"))??;
+    let (identity, alpha, spp) = (first.identity.clone(), first.sums.alpha(), first.spp);
+    let first_path = first.path.clone();
+    let mut sums = first.sums.sums.clone();
+    // The diagnostic layers of the film holding the last pass, as in an undivided render.
+    let mut last: (Option<u32>, Option<crate::film::EstimateLayers>, usize) =
+        (first.sums.done.last(), first.diagnostics.clone(), 0);
+    let mut kept = vec![Part { path: first.path, done: first.sums.done, stats: first.stats, spp }];
+    for p in parts {
+        let p = p?;
+        let (a, b) = (first_path.display().to_string(), p.path.display().to_string());
+        if let Some(why) = identity.difference(&a, &p.identity, &b) {
             return Err(Error::parse(&p.path, 0, format!("cannot be merged: {why}")));
         }
-        let (a, b) = (&first.sums.sums, &p.sums.sums);
-        if (a.width, a.height) != (b.width, b.height) || first.spp != p.spp {
+        if (sums.width, sums.height) != (p.sums.sums.width, p.sums.sums.height) || p.spp != spp {
             return Err(Error::parse(
                 &p.path,
                 0,
-                format!("cannot be merged: it and {} differ in image size or samples per pass", first.path.display()),
+                format!("cannot be merged: its image size or samples per pass differ from {a}'s"),
             ));
         }
+        sums.add(&p.sums.sums);
+        if p.sums.done.last() > last.0 {
+            last = (p.sums.done.last(), p.diagnostics, kept.len());
+        }
+        kept.push(Part { path: p.path, done: p.sums.done, stats: p.stats, spp: p.spp });
     }
     // Every pass once: sort (pass, file) pairs and look for neighbours with the same pass.
     let mut owners: Vec<(u32, usize)> =
-        parts.iter().enumerate().flat_map(|(f, p)| p.sums.done.indices().iter().map(move |&i| (i, f))).collect();
+        kept.iter().enumerate().flat_map(|(f, p)| p.done.indices().iter().map(move |&i| (i, f))).collect();
     owners.sort_unstable();
     if let Some(w) = owners.windows(2).find(|w| w[0].0 == w[1].0) {
-        let (a, b) = (&parts[w[0].1].path, &parts[w[1].1].path);
-        let both = parts[w[0].1].sums.done.overlap(&parts[w[1].1].sums.done);
+        let (a, b) = (&kept[w[0].1], &kept[w[1].1]);
         return Err(Error::parse(
-            b,
+            &b.path,
             0,
             format!(
                 "cannot be merged: it and {} both hold passes {} (a file given twice, or two workers with \
                  overlapping pass sets)",
-                a.display(),
-                both.to_text()
+                a.path.display(),
+                a.done.overlap(&b.done).to_text()
             ),
         ));
     }
     if owners.is_empty() {
-        let names: Vec<String> = parts.iter().map(|p| p.path.display().to_string()).collect();
+        let names: Vec<String> = kept.iter().map(|p| p.path.display().to_string()).collect();
+        let verb = if kept.len() == 1 { "holds" } else { "hold" };
         return Err(Error::parse(
-            &first.path,
+            &first_path,
             0,
-            format!("{} hold no passes (stopped before the first ended): nothing to merge", names.join(", ")),
+            format!("{} {verb} no passes (stopped before the first ended): nothing to merge", names.join(", ")),
         ));
     }
     let done = PassList::new(owners.iter().map(|o| o.0).collect()).unwrap_or_default();
-    let mut sums = first.sums.sums.clone();
-    for p in &parts[1..] {
-        sums.add(&p.sums.sums);
-    }
-    let sums = PassSums::from_sums(sums, done, first.sums.alpha());
-    let missing = sums.done.gaps();
+    let sums = PassSums::from_sums(sums, done, alpha);
     let mut film = sums.image();
-    // The diagnostic layers are those of the last pass, as in an undivided render.
-    let last = parts.iter().max_by_key(|p| p.sums.done.last()).unwrap_or(first);
     let mut warnings = Vec::new();
-    let wanted = first.identity.image.get("diagnostics").and_then(serde_json::Value::as_bool) == Some(true);
-    if wanted {
-        film.diagnostics.clone_from(&last.diagnostics);
-        if last.diagnostics.is_none() {
+    if identity.image.get("diagnostics").and_then(serde_json::Value::as_bool) == Some(true) {
+        film.diagnostics = last.1;
+        if film.diagnostics.is_none() {
             warnings.push(format!(
-                "no diagnostic layers: {}, which holds the last pass, has none (it was interrupted or checkpointed \
-                 before it finished)",
-                last.path.display()
+                "no diagnostic layers: {}, which holds the last pass, has none (it was stopped or checkpointed before \
+                 it finished)",
+                kept[last.2].path.display()
             ));
         }
     }
-    let stats = merged_stats(parts, last, &sums, &film);
-    Ok(Merged { film, stats, sums, missing, warnings })
+    let stats = merged_stats(&kept, last.2, &sums, &film);
+    let (count, text) = sums.done.gaps();
+    let missing = (count > 0).then_some(text);
+    Ok(Merged { film, stats, sums, missing, identity, spp, warnings })
 }
 
 /// The stats of the merged render: counts and phase times summed over the files, the rest
-/// from the file holding the last pass.
-fn merged_stats(parts: &[Partial], last: &Partial, sums: &PassSums, film: &Film) -> RenderStats {
-    let mut stats = RenderStats { progressive: None, ..last.stats.clone() };
-    let mut progressive = last.stats.progressive.clone().unwrap_or_default();
+/// from `kept[last]`, the file holding the last pass.
+fn merged_stats(kept: &[Part], last: usize, sums: &PassSums, film: &Film) -> RenderStats {
+    let l = &kept[last];
+    let mut stats = RenderStats { progressive: None, ..l.stats.clone() };
+    let mut progressive = l.stats.progressive.clone().unwrap_or_default();
     let (mut pass_seconds, mut elapsed) = (Vec::new(), 0.0f64);
-    for p in parts.iter().filter(|p| !std::ptr::eq(*p, last)) {
-        stats.add_totals(&p.stats);
-        stats.times.total_s += p.stats.times.total_s;
-    }
-    for p in parts {
+    for (k, p) in kept.iter().enumerate() {
+        if k != last {
+            stats.add_totals(&p.stats);
+            stats.times.total_s += p.stats.times.total_s;
+        }
         if let Some(pp) = &p.stats.progressive {
             pass_seconds.extend_from_slice(&pp.pass_seconds);
             elapsed = elapsed.max(pp.elapsed_s);
@@ -116,8 +138,8 @@ fn merged_stats(parts: &[Partial], last: &Partial, sums: &PassSums, film: &Film)
     progressive.elapsed_s = elapsed;
     progressive.budget_s = None;
     progressive.error_95 = sums.error_95(std::thread::available_parallelism().map_or(1, |n| n.get()));
-    stats.spp = last.spp.saturating_mul(sums.passes());
-    stats.phases = vec![format!("{} progressive passes merged from {} partial films", sums.passes(), parts.len())];
+    stats.spp = l.spp.saturating_mul(sums.passes());
+    stats.phases = vec![format!("{} progressive passes merged from {} partial films", sums.passes(), kept.len())];
     stats.mean_rgb = film.mean().to_array();
     stats.progressive = Some(progressive);
     stats

@@ -43,6 +43,18 @@ pub struct Identity {
     pub image_hash: String,
 }
 
+/// This build: the version, the source's git commit (when built from a git checkout) and the
+/// compiler flags — builds that differ in any of them may render different bits.
+#[must_use]
+pub fn build() -> String {
+    format!(
+        "{} (commit {}, flags `{}`)",
+        env!("CARGO_PKG_VERSION"),
+        env!("PHOTONWAVE_COMMIT"),
+        env!("PHOTONWAVE_RUSTFLAGS").trim()
+    )
+}
+
 /// FNV-1a 64 of `bytes`, continuing from `h`.
 fn fnv1a(mut h: u64, bytes: &[u8]) -> u64 {
     for &b in bytes {
@@ -76,7 +88,7 @@ impl Identity {
         image.insert("lights".into(), lights.to_vec().into());
         let text = serde_json::to_string(&image).unwrap_or_default();
         Ok(Identity {
-            version: env!("CARGO_PKG_VERSION").to_string(),
+            version: build(),
             engine: engine.to_string(),
             seed: settings.seed,
             scene_hash: format!("{:016x}", fnv1a(FNV_START, &(h.to_le_bytes()))),
@@ -85,13 +97,12 @@ impl Identity {
         })
     }
 
-    /// Why `o` (of the film at `o_path`) is not part of the same render as `self` (of
-    /// `self_path`), naming the first difference; `None` when it is.
+    /// Why `o` (named `b`, e.g. its file) is not part of the same render as `self` (named `a`),
+    /// naming the first difference; `None` when it is.
     #[must_use]
-    pub fn difference(&self, self_path: &Path, o: &Identity, o_path: &Path) -> Option<String> {
-        let (a, b) = (self_path.display(), o_path.display());
+    pub fn difference(&self, a: &str, o: &Identity, b: &str) -> Option<String> {
         if self.version != o.version {
-            return Some(format!("photonwave {} wrote {a}, photonwave {} wrote {b}", self.version, o.version));
+            return Some(format!("{a} is of photonwave {}, {b} of photonwave {}", self.version, o.version));
         }
         if self.engine != o.engine {
             return Some(format!("{a} was rendered by the {} engine, {b} by the {}", self.engine, o.engine));
@@ -128,9 +139,6 @@ struct Record {
     passes: String,
     /// Samples per pixel in each pass.
     spp: u32,
-    /// The radius reduction α, as the bits of its f32 (the radius sequence's sums need it
-    /// exactly).
-    alpha_bits: u32,
     /// The stats of the passes summed.
     stats: RenderStats,
 }
@@ -195,7 +203,6 @@ pub fn write(
         identity: identity.clone(),
         passes: sums.done.to_text(),
         spp,
-        alpha_bits: sums.alpha().to_bits(),
         stats: stats.clone(),
     };
     film.write_exr_with(path, extra, &[(ATTRIBUTE, ascii_json(&record))])
@@ -217,12 +224,20 @@ pub fn read(path: &Path) -> Result<Partial> {
                 .into()))
         }
     };
-    let record: Record =
-        serde_json::from_str(&text).map_err(|e| bad(format!("its `photonwave` attribute is damaged: {e}")))?;
-    if record.format != FORMAT {
-        return Err(bad(format!("a partial film of format `{}`; this photonwave reads `{FORMAT}`", record.format)));
+    let damaged = |e: serde_json::Error| bad(format!("its `photonwave` attribute is damaged: {e}"));
+    // The format first, so that a film of another format says so rather than fail to read.
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(damaged)?;
+    let format = value.get("format").and_then(serde_json::Value::as_str).unwrap_or("none");
+    if format != FORMAT {
+        return Err(bad(format!("a partial film of format `{format}`; this photonwave reads `{FORMAT}`")));
     }
-    let done = PassList::parse(&record.passes, &format!("{}: passes", path.display()))?;
+    let record: Record = serde_json::from_value(value).map_err(damaged)?;
+    let done = PassList::parse(&record.passes).map_err(|m| bad(format!("its passes: {m}")))?;
+    // α as the settings hold it: an f32 whose f64 value JSON keeps exactly.
+    let alpha = record.identity.image.get("alpha").and_then(serde_json::Value::as_f64).map(|a| a as f32);
+    let Some(alpha) = alpha.filter(|a| *a > 0.0 && *a < 1.0) else {
+        return Err(bad("its settings have no valid `alpha` (in (0, 1)): damaged".into()));
+    };
     let (w, h) = (layers.width, layers.height);
     let channel = |k: usize, word: usize| -> Option<&Vec<u32>> {
         let name = format!("sum.{}.w{word}", NAMES[k]);
@@ -244,7 +259,6 @@ pub fn read(path: &Path) -> Result<Partial> {
         )));
     }
     let sums = ExactSums::from_words(w, h, &words);
-    let alpha = f32::from_bits(record.alpha_bits);
     let layer_of = |name: &str| {
         layers.layers.iter().find(|(n, _)| n == name).map(|(_, p)| p.iter().map(|v| v.x).collect::<Vec<f32>>())
     };

@@ -3,7 +3,13 @@
 //! as compact text). Passes are independent given the seed and their index (Knaus & Zwicker's
 //! probabilistic form), so disjoint sets rendered anywhere sum to the same image.
 
-use crate::error::{Error, Result};
+/// The largest pass index accepted (2³⁰ − 1): far beyond any render (a pass takes at least
+/// milliseconds), and small enough that index arithmetic never overflows and a hostile list
+/// cannot ask for unbounded memory.
+pub const MAX_INDEX: u32 = (1 << 30) - 1;
+
+/// The most indices a list read from a file may hold (2²⁶, 256 MB as u32).
+pub const MAX_LISTED: usize = 1 << 26;
 
 /// The pass indices a render may run, in increasing order: `start, start + step, …` below
 /// `end` (`u32::MAX`: no end — a time budget or an error target stops the render).
@@ -37,6 +43,9 @@ impl PassSet {
             t.trim().parse::<u32>().map_err(|_| format!("`{s}`: expected a range A..B of pass indices, such as 32..64"))
         };
         let (a, b) = (num(a)?, num(b)?);
+        if b > MAX_INDEX + 1 {
+            return Err(format!("`{s}`: pass indices above {MAX_INDEX} are not supported"));
+        }
         if a >= b {
             return Err(format!("`{s}`: the range of passes is empty (A..B renders passes A to B−1)"));
         }
@@ -51,6 +60,9 @@ impl PassSet {
         if n == 0 || k >= n {
             return Err(format!("`{s}`: K must be below N (workers are numbered 0 to N−1)"));
         }
+        if n > MAX_INDEX {
+            return Err(format!("`{s}`: at most {MAX_INDEX} workers"));
+        }
         Ok(PassSet { start: k, step: n, end })
     }
 
@@ -58,12 +70,6 @@ impl PassSet {
     #[must_use]
     pub fn is_unbounded(&self) -> bool {
         self.end == u32::MAX
-    }
-
-    /// Whether `i` is in the set.
-    #[must_use]
-    pub fn contains(&self, i: u32) -> bool {
-        i >= self.start && i < self.end && (i - self.start).is_multiple_of(self.step)
     }
 
     /// How many indices the set holds (`None` when unbounded).
@@ -86,7 +92,7 @@ impl PassSet {
             Some(i) if i < self.start => self.start,
             Some(i) => self.start.checked_add(((i - self.start) / self.step + 1).checked_mul(self.step)?)?,
         };
-        (next < self.end).then_some(next)
+        (next < self.end && next <= MAX_INDEX).then_some(next)
     }
 
     /// Whether this is every pass from 0 on, as an undivided render runs them.
@@ -158,16 +164,19 @@ impl PassList {
         PassList(self.0.iter().copied().filter(|i| o.0.binary_search(i).is_ok()).collect())
     }
 
-    /// The indices below the largest that the list lacks: what is missing from 0..=last.
+    /// The indices below the largest that the list lacks — what is missing from 0..=last — as
+    /// their count and compact text (`3..5,9`), without listing them one by one.
     #[must_use]
-    pub fn gaps(&self) -> PassList {
-        let mut missing = Vec::new();
-        let mut next = 0;
+    pub fn gaps(&self) -> (u64, String) {
+        let (mut count, mut runs, mut next) = (0u64, Vec::new(), 0u32);
         for &i in &self.0 {
-            missing.extend(next..i);
+            if i > next {
+                count += u64::from(i - next);
+                runs.push(if i - next == 1 { next.to_string() } else { format!("{next}..{i}") });
+            }
             next = i + 1;
         }
-        PassList(missing)
+        (count, runs.join(","))
     }
 
     /// Compact text: runs of equal steps as `a..b` (step 1, b exclusive) or `a..b/s`, single
@@ -198,26 +207,33 @@ impl PassList {
         parts.join(",")
     }
 
-    /// Reads [`PassList::to_text`]'s form; `what` names the text in errors.
-    pub fn parse(text: &str, what: &str) -> Result<Self> {
-        let bad = |detail: &str| Error::setting(what, format!("`{text}` is not a list of pass indices: {detail}"));
+    /// Reads [`PassList::to_text`]'s form; the error says what is wrong with the text.
+    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+        let bad = |detail: &str| format!("`{text}` is not a list of pass indices: {detail}");
         let mut out = Vec::new();
         for part in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-            let num = |t: &str| t.trim().parse::<u32>().map_err(|_| bad(&format!("`{t}` is not an index")));
-            match part.split_once("..") {
-                None => out.push(num(part)?),
-                Some((a, rest)) => {
-                    let (b, step) = match rest.split_once('/') {
-                        Some((b, s)) => (num(b)?, num(s)?),
-                        None => (num(rest)?, 1),
-                    };
-                    let a = num(a)?;
-                    if step == 0 || a >= b || (b - a).div_ceil(step) > 1 << 26 {
-                        return Err(bad(&format!("`{part}` is not a valid run")));
-                    }
-                    out.extend((a..b).step_by(step as usize));
+            let num = |t: &str| match t.trim().parse::<u32>() {
+                Ok(i) if i <= MAX_INDEX + 1 => Ok(i),
+                Ok(_) => Err(bad(&format!("`{t}` is above the largest pass index, {MAX_INDEX}"))),
+                Err(_) => Err(bad(&format!("`{t}` is not an index"))),
+            };
+            let (a, b, step) = match part.split_once("..") {
+                None => {
+                    let a = num(part)?;
+                    (a, a + 1, 1)
                 }
+                Some((a, rest)) => match rest.split_once('/') {
+                    Some((b, st)) => (num(a)?, num(b)?, num(st)?),
+                    None => (num(a)?, num(rest)?, 1),
+                },
+            };
+            if step == 0 || a >= b || a > MAX_INDEX {
+                return Err(bad(&format!("`{part}` is not a valid run")));
             }
+            if out.len() + (b - a).div_ceil(step) as usize > MAX_LISTED {
+                return Err(bad(&format!("more than {MAX_LISTED} passes")));
+            }
+            out.extend((a..b).step_by(step as usize));
         }
         PassList::new(out).map_err(|i| bad(&format!("pass {i} is listed twice")))
     }
@@ -232,13 +248,13 @@ mod tests {
         for v in [vec![], vec![5], vec![0, 1, 2, 3], vec![3, 19, 35, 51], vec![0, 2, 3, 7, 8, 9, 20, 30], vec![1, 9]] {
             let list = PassList::new(v.clone()).unwrap();
             let text = list.to_text();
-            assert_eq!(PassList::parse(&text, "t").unwrap().indices(), &v[..], "{text}");
+            assert_eq!(PassList::parse(&text).unwrap().indices(), &v[..], "{text}");
         }
         assert_eq!(PassList::new(vec![3, 19, 35, 51]).unwrap().to_text(), "3..52/16");
         assert_eq!(PassList::new(vec![0, 1, 2, 9]).unwrap().to_text(), "0..3,9");
-        assert!(PassList::parse("1,1", "t").is_err());
-        assert!(PassList::parse("4..2", "t").is_err());
-        assert!(PassList::parse("x", "t").is_err());
+        assert!(PassList::parse("1,1").is_err());
+        assert!(PassList::parse("4..2").is_err());
+        assert!(PassList::parse("x").is_err());
     }
 
     #[test]
@@ -252,12 +268,18 @@ mod tests {
         }
         assert_eq!(got, [3, 19, 35, 51]);
         assert_eq!(s.count(), Some(4));
-        assert!(s.contains(35) && !s.contains(36) && !s.contains(67));
         assert_eq!(PassSet::parse_range("32..64").unwrap(), Some(PassSet { start: 32, step: 1, end: 64 }));
         assert_eq!(PassSet::parse_range("8").unwrap(), None);
         assert!(PassSet::parse_range("9..9").is_err());
         assert!(PassSet::parse_stride("16/16", 5).is_err());
         assert_eq!(PassSet::unbounded().next_after(Some(u32::MAX - 1)), None);
-        assert_eq!(PassList::new(vec![0, 3, 4, 7]).unwrap().gaps().indices(), &[1, 2, 5, 6]);
+        assert_eq!(PassList::new(vec![0, 3, 4, 7]).unwrap().gaps(), (4, "1..3,5..7".to_string()));
+        assert_eq!(PassList::new(vec![2, 3]).unwrap().gaps(), (2, "0..2".to_string()));
+        assert!(PassSet::parse_range("0..4000000000").is_err());
+        assert_eq!(PassSet::unbounded().next_after(Some(MAX_INDEX)), None);
+        // Hostile lists are refused before they are built.
+        let many = ["0..60000000"; 3].join(",");
+        assert!(PassList::parse(&many).is_err());
+        assert!(PassList::parse("4294967295").is_err());
     }
 }

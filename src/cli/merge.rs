@@ -43,13 +43,11 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     outputs.extend(args.png.as_deref().map(|path| Output { flag: "--png", path, ext: "png" }));
     outputs.extend(args.stats.as_deref().map(|path| Output { flag: "--stats", path, ext: "json" }));
     check_outputs(&outputs, &args.parts)?;
-    let parts = args.parts.iter().map(|p| photonwave::partial::read(p)).collect::<Result<Vec<_>>>()?;
-    let read_s = t.elapsed().as_secs_f64();
-    let merged = photonwave::merge::merge(&parts)?;
-    if !merged.missing.is_empty() {
+    let merged = photonwave::merge::merge(args.parts.iter().map(|p| photonwave::partial::read(p)))?;
+    if let Some(missing) = &merged.missing {
         let text = format!(
-            "passes {} are missing (below the largest, {}): the image is the mean of the {} passes held",
-            merged.missing.to_text(),
+            "passes {missing} are missing (below the largest, {}; `a..b` is a to b−1): the image is the mean of \
+             the {} passes held",
             merged.sums.done.last().unwrap_or(0),
             merged.sums.passes()
         );
@@ -62,22 +60,15 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         say.warn(w);
     }
     if args.partial {
-        let first = &parts[0];
-        photonwave::partial::write(
-            &args.output,
-            &first.identity,
-            &merged.sums,
-            first.spp,
-            &merged.film,
-            &merged.stats,
-        )?;
+        let m = &merged;
+        photonwave::partial::write(&args.output, &m.identity, &m.sums, m.spp, &m.film, &m.stats)?;
     } else {
         merged.film.write_exr(&args.output)?;
     }
     say.info(format!(
-        "merged {} passes from {} files (read in {read_s:.2} s, {:.2} s in all); wrote {}\n",
+        "merged {} passes from {} files in {:.2} s; wrote {}\n",
         merged.sums.passes(),
-        parts.len(),
+        args.parts.len(),
         t.elapsed().as_secs_f64(),
         args.output.display()
     ));

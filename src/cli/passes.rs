@@ -106,7 +106,13 @@ impl PassFlags<'_> {
                 PassSet::parse_stride(s, end).map_err(|m| Error::setting("--pass-set", m))
             }
             (_, None) if self.any() && !open && settings.passes <= 1 => Err(Error::setting(
-                if self.resume.is_some() { "--resume" } else { "--checkpoint" },
+                if self.resume.is_some() {
+                    "--resume"
+                } else if self.checkpoint.is_some() {
+                    "--checkpoint"
+                } else {
+                    "--partial"
+                },
                 "checkpoints, partial films and resuming are for progressive renders: add --passes N, --time or \
                  --target-error",
             )),
@@ -151,7 +157,8 @@ pub fn render(s: &Setup, flags: &PassFlags, progress: &dyn Progress, say: Say) -
     let mut state = Progressive::new(s.scene, s.rays, s.job);
     if let Some(path) = flags.resume {
         let part = partial::read(path)?;
-        if let Some(why) = s.identity.difference(Path::new("this render"), &part.identity, path) {
+        let file = path.display().to_string();
+        if let Some(why) = s.identity.difference("this render", &part.identity, &file) {
             return Err(Error::setting("--resume", format!("cannot resume: {why}")));
         }
         // The file's passes must be the first of this run's set, so that continuing the set
@@ -173,7 +180,7 @@ pub fn render(s: &Setup, flags: &PassFlags, progress: &dyn Progress, say: Say) -
             }
         }
         say.info(format!("resuming from {}: {} passes done\n", path.display(), part.sums.passes()));
-        state.resume(part.sums, part.stats);
+        state.resume(part.sums, part.stats)?;
     }
     let divided = flags.divided() || flags.partial;
     if !set.is_whole() {
@@ -198,7 +205,10 @@ pub fn render(s: &Setup, flags: &PassFlags, progress: &dyn Progress, say: Say) -
     let mut after_pass = |p: &Progressive| -> Result<()> {
         if let Some(path) = flags.checkpoint {
             if last_checkpoint.elapsed() >= flags.checkpoint_every {
-                partial::write(path, &identity, &p.sums, spp, &p.image(), &p.stats_now())?;
+                // A failed checkpoint (a full disk) keeps the previous one and the render going.
+                if let Err(e) = partial::write(path, &identity, &p.sums, spp, &p.image(), &p.stats_now()) {
+                    say.warn(format!("checkpoint not written, the render goes on: {e}"));
+                }
                 last_checkpoint = Instant::now();
             }
         }
@@ -222,6 +232,11 @@ pub fn render(s: &Setup, flags: &PassFlags, progress: &dyn Progress, say: Say) -
         let mut stats = guard.stats_now();
         stats.times.total_s = t.elapsed().as_secs_f64();
         return Ok(Rendered { film: guard.image(), stats, signal: Some(sig) });
+    }
+    // Every pass is done: with diagnostic layers still to make (a photon pass), save the passes
+    // first, so that a signal or a kill meanwhile loses nothing.
+    if settings.diagnostics && (divided || flags.checkpoint.is_some()) {
+        write_partial(&guard)?;
     }
     let start = s.budget.map_or(s.t0, |b| b.start);
     let (film, mut stats) = progressive::finish(&guard, s.scene, s.rays, s.budget, start, true);

@@ -43,8 +43,8 @@ fn lock(state: &Mutex<Progressive>) -> std::sync::MutexGuard<'_, Progressive> {
 /// Runs the passes `d.set` holds after the last one summed in `state`, each rendered by `run`
 /// given the pass's job, until the set ends, the budget is spent
 /// ([`Progressive::another_fits`]), the error target is met or `d.stop` says so. The lock is
-/// held only to prepare and to add a pass, so that another thread can write the sums while a
-/// pass renders. `progress` gets one bar: passes, or the budget's milliseconds, with the pass
+/// not held while a pass renders (only to prepare it, and to add it, estimate the error and
+/// call `after_pass`), so that another thread can write the sums meanwhile. `progress` gets one bar: passes, or the budget's milliseconds, with the pass
 /// number and time left as its message.
 pub fn drive(
     state: &Mutex<Progressive>,
@@ -70,15 +70,16 @@ pub fn drive(
     // The image's error after the last pass (computed once a pass: it reads every pixel).
     let mut error_now: Option<ImageError> = lock(state).error_95();
     let ended = loop {
-        if (d.stop)() {
-            break Ended::Stopped;
-        }
         let passes = lock(state).passes();
         let reached = target > 0.0
             && passes >= crate::settings::MIN_PASSES_FOR_TARGET
             && error_now.is_some_and(|e| e.error <= target);
         let fits = d.budget.is_none_or(|b| lock(state).another_fits(start.elapsed(), b.limit));
         let Some(i) = next.filter(|_| !reached && fits) else { break Ended::Done };
+        // After the check for the end: a signal during the last pass still finishes the render.
+        if (d.stop)() {
+            break Ended::Stopped;
+        }
         let t = Instant::now();
         let pass = lock(state).pass_job(i)?;
         let (film, stats) = run(&pass)?;

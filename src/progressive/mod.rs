@@ -108,15 +108,19 @@ impl Progressive {
     }
 
     /// Continues from passes rendered before (a checkpoint or partial film): their sums and the
-    /// stats they had.
-    pub fn resume(&mut self, sums: PassSums, stats: RenderStats) {
+    /// stats they had. The last of them becomes the last pass (whose diagnostic layers a
+    /// finished render adds).
+    pub fn resume(&mut self, sums: PassSums, stats: RenderStats) -> Result<()> {
         self.progress.passes = sums.passes();
         if let Some(p) = &stats.progressive {
             self.progress.pass_seconds.clone_from(&p.pass_seconds);
             self.progress.final_radii = p.final_radii;
         }
+        let last = sums.done.last();
         self.sums = sums;
         self.stats = RenderStats { progressive: None, ..stats };
+        self.last = last.map(|i| self.pass_job(i)).transpose()?;
+        Ok(())
     }
 
     /// The radii of pass `i`.
