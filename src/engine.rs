@@ -62,9 +62,10 @@ pub fn render(
     render_planned(scene, rays, &Job::new(scene, settings)?, engine, budget, progress)
 }
 
-/// Refuses what `job` cannot render with `engine`: a map the plan needs left empty, more memory
-/// than the machine has (before any of it is allocated), diagnostics from the path tracer.
-pub fn check_planned(job: &Job, engine: Engine) -> Result<()> {
+/// Refuses what `job` cannot render with `engine` (progressively or not): a map the plan needs
+/// left empty, more memory than the machine has (before any of it is allocated), diagnostics
+/// from the path tracer.
+pub fn check_planned(job: &Job, engine: Engine, progressive: bool) -> Result<()> {
     let settings = &job.settings;
     if engine != Engine::Path {
         job.plan.check(settings)?;
@@ -77,7 +78,8 @@ pub fn check_planned(job: &Job, engine: Engine) -> Result<()> {
             u64::from(settings.photons) * u64::from(job.plan.global_map.on)
                 + u64::from(settings.caustic_photons) * u64::from(job.plan.caustic_map.on)
         };
-        crate::memory::check(settings.width, settings.height, photons, available, total)?;
+        let per_pixel = crate::memory::bytes_per_pixel(progressive);
+        crate::memory::check(settings.width, settings.height, per_pixel, photons, available, total)?;
     }
     if engine == Engine::Path && settings.diagnostics {
         return Err(Error::setting(
@@ -100,7 +102,7 @@ pub fn render_planned(
     budget: Option<Budget>,
     progress: &dyn Progress,
 ) -> Result<(Film, RenderStats)> {
-    check_planned(job, engine)?;
+    check_planned(job, engine, is_progressive(&job.settings, budget))?;
     let settings = &job.settings;
     if !is_progressive(settings, budget) {
         let (mut film, mut stats) = render_job(scene, rays, job, engine, progress);

@@ -13,14 +13,25 @@ use crate::files::bytes;
 pub const BYTES_PER_PIXEL: u64 = 160;
 /// Bytes per stored photon (measured 81).
 pub const BYTES_PER_PHOTON: u64 = 96;
+/// Bytes per pixel a progressive render adds (measured 390 at 800², peak resident set of
+/// `--passes 2` against one pass, BENCHMARKS.md "Divided renders"): its passes' exact sums
+/// (`crate::exact`, 20 values of 16 bytes), the pass's film beside them and the mean's.
+pub const PROGRESSIVE_BYTES_PER_PIXEL: u64 = 400;
+
+/// Bytes per pixel of a render, progressive or not.
+#[must_use]
+pub fn bytes_per_pixel(progressive: bool) -> u64 {
+    BYTES_PER_PIXEL + if progressive { PROGRESSIVE_BYTES_PER_PIXEL } else { 0 }
+}
+
 /// Bytes of everything else (measured 12 MiB; the scene itself is already loaded).
 pub const BASE_BYTES: u64 = 16 << 20;
 
-/// A render's estimated peak memory, in bytes: a `width × height` image and `photons` stored
-/// in all its maps together.
+/// A render's estimated peak memory, in bytes: a `width × height` image at `per_pixel` bytes a
+/// pixel ([`bytes_per_pixel`]) and `photons` stored in all its maps together.
 #[must_use]
-pub fn estimate(width: u32, height: u32, photons: u64) -> u64 {
-    BASE_BYTES + u64::from(width) * u64::from(height) * BYTES_PER_PIXEL + photons * BYTES_PER_PHOTON
+pub fn estimate(width: u32, height: u32, per_pixel: u64, photons: u64) -> u64 {
+    BASE_BYTES + u64::from(width) * u64::from(height) * per_pixel + photons * BYTES_PER_PHOTON
 }
 
 /// The machine's memory available to a new allocation and in all (Linux `/proc/meminfo`'s
@@ -38,16 +49,16 @@ pub fn machine() -> Option<(u64, u64)> {
 
 /// Refuses a render whose estimate exceeds `available` bytes (of `total`), saying what it would
 /// need, what the machine has, and what to lower.
-pub fn check(width: u32, height: u32, photons: u64, available: u64, total: u64) -> Result<()> {
-    let need = estimate(width, height, photons);
+pub fn check(width: u32, height: u32, per_pixel: u64, photons: u64, available: u64, total: u64) -> Result<()> {
+    let need = estimate(width, height, per_pixel, photons);
     if need <= available {
         return Ok(());
     }
     let pixels = u64::from(width) * u64::from(height);
     Err(Error::setting(
-        if pixels * BYTES_PER_PIXEL >= photons * BYTES_PER_PHOTON { "width" } else { "photons" },
+        if pixels * per_pixel >= photons * BYTES_PER_PHOTON { "width" } else { "photons" },
         format!(
-            "this render needs about {} ({width}×{height} pixels at ~{BYTES_PER_PIXEL} B, {photons} photons at \
+            "this render needs about {} ({width}×{height} pixels at ~{per_pixel} B, {photons} photons at \
              ~{BYTES_PER_PHOTON} B), but the machine has {} available of {}; lower the image size or \
              the photon counts (README, \"Limits\")",
             bytes(need),
@@ -63,13 +74,13 @@ mod tests {
 
     #[test]
     fn a_huge_image_is_refused_with_the_estimate_and_the_machine() {
-        let e = check(16384, 16384, 200_000, 20 << 30, 24 << 30).unwrap_err().to_string();
+        let e = check(16384, 16384, BYTES_PER_PIXEL, 200_000, 20 << 30, 24 << 30).unwrap_err().to_string();
         assert!(
             e.starts_with("setting `width`") && e.contains("40.0 GiB") && e.contains("20.0 GiB available of 24.0 GiB"),
             "{e}"
         );
-        check(320, 320, 300_000, 1 << 30, 1 << 30).unwrap();
-        let e = check(320, 320, 200_000_000, 8 << 30, 8 << 30).unwrap_err().to_string();
+        check(320, 320, BYTES_PER_PIXEL, 300_000, 1 << 30, 1 << 30).unwrap();
+        let e = check(320, 320, BYTES_PER_PIXEL, 200_000_000, 8 << 30, 8 << 30).unwrap_err().to_string();
         assert!(e.starts_with("setting `photons`") && e.contains("200000000 photons"), "{e}");
     }
 

@@ -287,7 +287,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     };
     let settings = &job.settings;
     let (film, mut stats, signal) = if progressive {
-        photonwave::engine::check_planned(&job, args.engine)?;
+        photonwave::engine::check_planned(&job, args.engine, true)?;
         let lights: Vec<String> = args.light.iter().map(|l| format!("{l:?}")).collect();
         let identity = Identity::new(
             &loaded.inputs,
