@@ -44,13 +44,12 @@ struct Part {
 pub fn merge(parts: impl IntoIterator<Item = Result<Partial>>) -> Result<Merged> {
     let mut parts = parts.into_iter();
     let first = parts.next().ok_or_else(|| Error::setting("PART", "give at least one partial film to merge"))??;
-    let (identity, alpha, spp) = (first.identity.clone(), first.sums.alpha(), first.spp);
-    let first_path = first.path.clone();
-    let mut sums = first.sums.sums.clone();
+    let Partial { path: first_path, identity, sums: first_sums, spp, stats, diagnostics } = first;
+    let alpha = first_sums.alpha();
+    let PassSums { mut sums, done, .. } = first_sums;
     // The diagnostic layers of the film holding the last pass, as in an undivided render.
-    let mut last: (Option<u32>, Option<crate::film::EstimateLayers>, usize) =
-        (first.sums.done.last(), first.diagnostics.clone(), 0);
-    let mut kept = vec![Part { path: first.path, done: first.sums.done, stats: first.stats, spp }];
+    let mut last: (Option<u32>, Option<crate::film::EstimateLayers>, usize) = (done.last(), diagnostics, 0);
+    let mut kept = vec![Part { path: first_path.clone(), done, stats, spp }];
     for p in parts {
         let p = p?;
         let (a, b) = (first_path.display().to_string(), p.path.display().to_string());

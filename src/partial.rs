@@ -214,7 +214,6 @@ pub fn read(path: &Path) -> Result<Partial> {
     use exr::prelude::{AttributeValue, FlatSamples, Text};
     let bad = |m: String| Error::parse(path, 0, m);
     let image = crate::film::decode_exr(path)?;
-    let layers = crate::film::rgb_layers(path, &image)?;
     let layer = image.layer_data.first().ok_or_else(|| bad("EXR has no layer".into()))?;
     let text = match layer.attributes.other.get(&Text::new_or_panic(ATTRIBUTE)) {
         Some(AttributeValue::Text(t)) => t.to_string(),
@@ -238,8 +237,8 @@ pub fn read(path: &Path) -> Result<Partial> {
     let Some(alpha) = alpha.filter(|a| *a > 0.0 && *a < 1.0) else {
         return Err(bad("its settings have no valid `alpha` (in (0, 1)): damaged".into()));
     };
-    let (w, h) = (layers.width, layers.height);
-    let channel = |k: usize, word: usize| -> Option<&Vec<u32>> {
+    let (w, h) = (layer.size.0 as u32, layer.size.1 as u32);
+    let channel = |k: usize, word: usize| -> Option<&[u32]> {
         let name = format!("sum.{}.w{word}", NAMES[k]);
         match layer.channel_data.list.iter().find(|c| c.name.eq(name.as_str())).map(|c| &c.sample_data) {
             Some(FlatSamples::U32(v)) if v.len() == w as usize * h as usize => Some(v),
@@ -252,15 +251,18 @@ pub fn read(path: &Path) -> Result<Partial> {
         .flat_map(|(k, name)| (0..4).map(move |word| (k, word, name)))
         .find(|&(k, word, _)| channel(k, word).is_none())
         .map(|(_, word, name)| format!("sum.{name}.w{word}"));
-    let words = |k: usize, word: usize| channel(k, word).cloned().unwrap_or_default();
+    let words = |k: usize, word: usize| channel(k, word).unwrap_or_default();
     if let Some(name) = missing {
         return Err(bad(format!(
             "partial film without its u32 channel `{name}`: damaged, or not written by photonwave"
         )));
     }
     let sums = ExactSums::from_words(w, h, &words);
+    // The diagnostic layers hold R = G = B: their R channels.
     let layer_of = |name: &str| {
-        layers.layers.iter().find(|(n, _)| n == name).map(|(_, p)| p.iter().map(|v| v.x).collect::<Vec<f32>>())
+        let name = format!("{name}.R");
+        let c = layer.channel_data.list.iter().find(|c| c.name.eq(name.as_str()))?;
+        Some(c.sample_data.values_as_f32().collect::<Vec<f32>>())
     };
     let diagnostics = match (
         layer_of("radius.caustic"),

@@ -19,11 +19,11 @@ pub const BIAS_EVERY: u32 = 4;
 /// r²ᵢ / r²₁ for pass `i` (1-based): ∏ⱼ₌₁^{i−1} (j + α)/(j + 1).
 #[must_use]
 pub fn radius2_scale(i: u32, alpha: f32) -> f64 {
-    (1..i).map(|j| (f64::from(j) + f64::from(alpha)) / (f64::from(j) + 1.0)).product()
+    RadiusSequence::new(alpha).scale2(i.saturating_sub(1))
 }
 
 /// The radius sequence walked forward: r² of pass index i (0-based) over pass 0's, the product
-/// [`radius2_scale`] takes, multiplied in the same order so that every walk gives the same bits.
+/// ∏ⱼ₌₁^i (j + α)/(j + 1), multiplied in index order so that every walk gives the same bits.
 #[derive(Clone, Copy, Debug)]
 pub struct RadiusSequence {
     alpha: f32,

@@ -223,15 +223,15 @@ pub fn render(s: &Setup, flags: &PassFlags, progress: &dyn Progress, say: Say) -
     interrupt.finish();
     if ended == Ended::Stopped {
         let sig = interrupt.signal().unwrap_or(signal_hook::consts::SIGTERM);
-        write_partial(&guard)?;
+        let (film, mut stats) = (guard.image(), guard.stats_now());
+        stats.times.total_s = t.elapsed().as_secs_f64();
+        partial::write(&stop_path, &identity, &guard.sums, spp, &film, &stats)?;
         say.info(format!(
             "stopped: {} passes written to {} (continue with --resume)\n",
             guard.passes(),
             stop_path.display()
         ));
-        let mut stats = guard.stats_now();
-        stats.times.total_s = t.elapsed().as_secs_f64();
-        return Ok(Rendered { film: guard.image(), stats, signal: Some(sig) });
+        return Ok(Rendered { film, stats, signal: Some(sig) });
     }
     // Every pass is done: with diagnostic layers still to make (a photon pass), save the passes
     // first, so that a signal or a kill meanwhile loses nothing.

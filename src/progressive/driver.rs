@@ -52,9 +52,8 @@ pub fn drive(
     d: Drive,
     progress: &dyn Progress,
 ) -> Result<Ended> {
-    let settings = lock(state).job().settings.clone();
+    let target = f64::from(lock(state).job().settings.target_error);
     let start = d.budget.map_or_else(Instant::now, |b| b.start);
-    let target = f64::from(settings.target_error);
     let mut next = d.set.next_after(lock(state).sums.done.last());
     let to_do = d.set.count().map(|n| n.saturating_sub(lock(state).passes()));
     let (unit, total) = match (d.budget, to_do) {

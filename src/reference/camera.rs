@@ -20,7 +20,7 @@ use crate::stats::{Numerics, RayCounts};
 use crate::transport::camera::render_pixels;
 use crate::transport::direct::direct_light;
 use crate::transport::estimate::{caustic_estimate, indirect_estimate, map_radiance};
-use crate::transport::gather::{chain_lands_near, glossy_ray, trace_gather_rays};
+use crate::transport::gather::{glossy_ray, lands_near, trace_gather_rays};
 use crate::transport::specular::{continue_ray, emission_toward, first_non_specular, ChainEnd};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
@@ -152,17 +152,20 @@ fn gather_hit(
 ) -> Estimated {
     let (y, wo) = (&end.point, -end.dir);
     let bsdf = &ctx.scene.materials[y.material as usize].bsdf;
-    if !chain_lands_near(end, bsdf, ctx.secondary_gather) {
+    if !lands_near(end.t, end.bounces, bsdf, ctx.secondary_gather) {
         return map_radiance(ctx, y, bsdf, wo, scratch).into();
     }
     let direct = direct_light(ctx, y, bsdf, wo, &chain.fork(streams::SECONDARY_LIGHT), rays);
     let caustic = caustic_estimate(ctx, y, bsdf, wo, None, scratch);
-    let mut far = Estimated::default();
-    trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, _| {
-        let e = map_radiance(ctx, &z.point, &ctx.scene.materials[z.point.material as usize].bsdf, -z.dir, scratch);
-        far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias };
-    });
     let kd = bsdf.diffuse();
+    let mut far = Estimated::default();
+    // A black surface sends no gather ray (as in `final_gather` and the wavefront engine).
+    if kd != Vec3::ZERO {
+        trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, _| {
+            let e = map_radiance(ctx, &z.point, &ctx.scene.materials[z.point.material as usize].bsdf, -z.dir, scratch);
+            far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias };
+        });
+    }
     Estimated { radiance: direct + caustic.radiance + kd * far.radiance, bias: caustic.bias + kd * far.bias }
 }
 

@@ -92,10 +92,3 @@ pub fn secondary_gather_distance(scene: &Scene, job: &Job) -> f32 {
 pub fn lands_near(end_t: f32, bounces: u32, bsdf: &Bsdf, distance: f32) -> bool {
     bounces == 0 && end_t < distance && matches!(bsdf, Bsdf::Lambert { .. })
 }
-
-/// [`lands_near`] for a chain's end.
-#[must_use]
-#[inline]
-pub fn chain_lands_near(end: &ChainEnd, bsdf: &Bsdf, distance: f32) -> bool {
-    lands_near(end.t, end.bounces, bsdf, distance)
-}
