@@ -35,7 +35,7 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
     let (caustic_on, global_on) = (ctx.effects.caustic_map.on, ctx.effects.global_map.on);
     let gather_on = ctx.effects.final_gather.on;
     let found = probe_first_surfaces(&ctx, job, rays, [0.0; 4], |pixel, s, sp, d, scratch, counts| {
-        let bsdf = &scene.materials[sp.material as usize].bsdf;
+        let bsdf = &scene.bsdf(sp);
         let caustic = if caustic_on {
             let e = caustic_estimate(&ctx, sp, bsdf, -d, Some(pixel), scratch);
             [e.radius, e.count as f32]
@@ -48,7 +48,7 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
             let (mut sum, mut hits) = ([0.0f64; 2], 0u32);
             let gather = s.fork(streams::gather(0));
             trace_gather_rays(&ctx, sp, -d, settings.gather_rays, &gather, counts, |end, _, _| {
-                let bsdf = &scene.materials[end.point.material as usize].bsdf;
+                let bsdf = &scene.bsdf(&end.point);
                 let e = global_estimate(&ctx, &end.point, bsdf, -end.dir, 0, None, scratch);
                 sum[0] += f64::from(e.radius);
                 sum[1] += f64::from(e.count);

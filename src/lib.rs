@@ -89,6 +89,7 @@ pub mod scene;
 pub mod settings;
 pub mod stats;
 pub mod sweep;
+pub mod texture;
 pub mod transport;
 pub mod wavefront;
 

@@ -7,8 +7,10 @@
 //! whether the ray enters or leaves.
 
 use crate::sampling::{cosine_hemisphere, Frame};
-use glam::Vec3;
+use crate::texture::Texture;
+use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 /// What flows along the path: radiance (camera paths) or power (photons). Refraction scales
 /// radiance by (η_wo / η_wi)², never power.
@@ -46,6 +48,59 @@ pub struct Material {
     pub bsdf: Bsdf,
     /// Emitted radiance from the front (counter-clockwise) face; zero for non-emitters.
     pub emission: Vec3,
+    /// Image textures that replace the constant colours where the surface has them.
+    pub maps: Maps,
+}
+
+/// A material's image textures: each, when present, replaces its constant colour at every
+/// point by the texture's value at the point's texture coordinates.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Maps {
+    /// Diffuse albedo (MTL `map_Kd`): replaces `kd`.
+    pub kd: Option<Arc<Texture>>,
+    /// Specular reflectance (MTL `map_Ks`): replaces `ks` of glossy and mirror materials.
+    pub ks: Option<Arc<Texture>>,
+}
+
+impl Maps {
+    /// True when the material has no texture.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.kd.is_none() && self.ks.is_none()
+    }
+}
+
+impl Material {
+    /// A material without textures.
+    #[must_use]
+    pub fn new(name: impl Into<String>, bsdf: Bsdf, emission: Vec3) -> Material {
+        Material { name: name.into(), bsdf, emission, maps: Maps::default() }
+    }
+
+    /// The scattering at texture coordinates `uv`: the constant BSDF with its textured colours
+    /// replaced. Albedos are kept within energy conservation as the MTL mapping keeps the
+    /// constants: a Lambertian or mirror colour at most 1, a glossy `kd + ks` at most 1 per
+    /// channel (both scaled down together).
+    #[inline]
+    #[must_use]
+    pub fn bsdf_at(&self, uv: Vec2) -> Bsdf {
+        if self.maps.is_empty() {
+            return self.bsdf;
+        }
+        let kd_at = |kd: Vec3| self.maps.kd.as_ref().map_or(kd, |t| t.lookup(uv));
+        let ks_at = |ks: Vec3| self.maps.ks.as_ref().map_or(ks, |t| t.lookup(uv));
+        match self.bsdf {
+            Bsdf::Lambert { kd } => Bsdf::Lambert { kd: kd_at(kd).min(Vec3::ONE) },
+            Bsdf::Glossy { kd, ks, exponent } => {
+                let (kd, ks) = (kd_at(kd), ks_at(ks));
+                let sum = (kd + ks).max_element();
+                let scale = if sum > 1.0 { 1.0 / sum } else { 1.0 };
+                Bsdf::Glossy { kd: kd * scale, ks: ks * scale, exponent }
+            }
+            Bsdf::Mirror { ks } => Bsdf::Mirror { ks: ks_at(ks).min(Vec3::ONE) },
+            b @ Bsdf::Glass { .. } => b,
+        }
+    }
 }
 
 /// A BSDF sample whose pdf came out zero (see [`Bsdf::sample_checked`]).

@@ -92,7 +92,7 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
         rays.camera += 1;
         let Some(hit) = scene.intersect(o, d, f32::INFINITY) else { break };
         let sp = scene.surface(&hit);
-        let mat = &scene.materials[sp.material as usize];
+        let bsdf = scene.bsdf(&sp);
         let wo = -d;
         let e = emission_toward(scene, hit.tri, wo);
         if last_delta && e != Vec3::ZERO {
@@ -101,11 +101,11 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
         if depth == ctx.settings.max_depth {
             break;
         }
-        if !mat.bsdf.is_delta() {
-            let l = beta * direct_light(ctx, &sp, &mat.bsdf, wo, &s.fork(streams::path_light(depth)), rays);
+        if !bsdf.is_delta() {
+            let l = beta * direct_light(ctx, &sp, &bsdf, wo, &s.fork(streams::path_light(depth)), rays);
             terms.add(path_term(Term::Direct, depth, via_specular), l);
         }
-        let Some(bs) = continue_ray(&sp, &mat.bsdf, wo, s, streams::CAMERA_CHAIN_BOUNCE + depth) else { break };
+        let Some(bs) = continue_ray(&sp, &bsdf, wo, s, streams::CAMERA_CHAIN_BOUNCE + depth) else { break };
         beta *= bs.weight;
         last_delta = bs.delta;
         if depth == 0 && bs.delta {

@@ -4,7 +4,7 @@
 mod common;
 
 use common::*;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use photonwave::code_path::CodePath;
 use photonwave::material::{Bsdf, Material, SurfaceFrame};
 use photonwave::photon_map::{Filter, Lookup, Photon, PhotonMap, Reflectance};
@@ -108,7 +108,7 @@ fn closed_cube(half: f32) -> MeshInput {
 #[test]
 fn spot_light_flux_is_conserved_in_a_closed_box() {
     // A spot light's photons carry unequal power (falloff / pdf); their sum estimates Φ.
-    let mat = Material { name: "grey".into(), bsdf: Bsdf::Lambert { kd: Vec3::splat(0.5) }, emission: Vec3::ZERO };
+    let mat = Material::new("grey", Bsdf::Lambert { kd: Vec3::splat(0.5) }, Vec3::ZERO);
     let spot = Light::Spot {
         position: Vec3::ZERO,
         direction: Vec3::new(0.3, -1.0, 0.2).normalize(),
@@ -214,7 +214,7 @@ fn quad_light_irradiance_matches_lamberts_formula() {
         material: vec![0, 0],
         ..Default::default()
     };
-    let light = Material { name: "light".into(), bsdf: Bsdf::Lambert { kd: Vec3::ZERO }, emission: Vec3::splat(le) };
+    let light = Material::new("light", Bsdf::Lambert { kd: Vec3::ZERO }, Vec3::splat(le));
     let scene = Scene::build(vec![mesh], vec![light], vec![], vec![]).unwrap();
     let settings = Settings { light_samples: 256, ..Default::default() };
     let maps = PhotonMaps::default();
@@ -228,6 +228,7 @@ fn quad_light_irradiance_matches_lamberts_formula() {
             frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y },
             material: 0,
             tri: 0,
+            uv: Vec2::ZERO,
         };
         let mut rays = Default::default();
         // E = π·L_reflected for a white Lambertian; each call averages 256 light samples.
@@ -246,7 +247,7 @@ fn quad_light_irradiance_matches_lamberts_formula() {
 #[test]
 fn point_light_irradiance_is_inverse_square_cosine() {
     let mesh = closed_cube(10.0);
-    let mat = Material { name: "grey".into(), bsdf: Bsdf::Lambert { kd: Vec3::splat(0.5) }, emission: Vec3::ZERO };
+    let mat = Material::new("grey", Bsdf::Lambert { kd: Vec3::splat(0.5) }, Vec3::ZERO);
     let light = Light::Point { position: Vec3::new(0.0, 2.0, 0.0), intensity: Vec3::splat(4.0) };
     let scene = Scene::build(vec![mesh], vec![mat], vec![light], vec![]).unwrap();
     let settings = Settings::default();
@@ -254,8 +255,14 @@ fn point_light_irradiance_is_inverse_square_cosine() {
     let job = job(&scene, &settings);
     let ctx = Context::new(&scene, &maps, &job);
     let p = Vec3::new(1.5, 0.0, 0.0);
-    let sp =
-        SurfacePoint { p, p_error: Vec3::ZERO, frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y }, material: 0, tri: 0 };
+    let sp = SurfacePoint {
+        p,
+        p_error: Vec3::ZERO,
+        frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y },
+        material: 0,
+        tri: 0,
+        uv: Vec2::ZERO,
+    };
     let l = direct_light(
         &ctx,
         &sp,
@@ -292,7 +299,7 @@ fn directional_light_irradiance_is_cosine_weighted_by_both_methods() {
             material: vec![0, 0],
             ..Default::default()
         };
-        let mat = Material { name: "white".into(), bsdf: Bsdf::Lambert { kd: Vec3::splat(kd) }, emission: Vec3::ZERO };
+        let mat = Material::new("white", Bsdf::Lambert { kd: Vec3::splat(kd) }, Vec3::ZERO);
         let th = deg.to_radians();
         let light =
             Light::Directional { direction: Vec3::new(th.sin(), -th.cos(), 0.0), irradiance: Vec3::splat(e_perp) };
@@ -325,6 +332,7 @@ fn directional_light_irradiance_is_cosine_weighted_by_both_methods() {
                     frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y },
                     material: 0,
                     tri: 0,
+                    uv: Vec2::ZERO,
                 };
                 let direct = direct_light(
                     &ctx,

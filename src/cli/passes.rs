@@ -183,7 +183,7 @@ pub fn render(s: &Setup, flags: &PassFlags, progress: &dyn Progress, say: Say) -
         state.resume(part.sums, part.stats)?;
     }
     let divided = flags.divided() || flags.partial;
-    if !set.is_whole() {
+    if flags.divided() {
         say.info(format!(
             "rendering {} (a part: {} is a partial film for `photonwave merge`)\n",
             set.describe(),

@@ -59,30 +59,30 @@ pub fn trace_camera_path(
         rays.camera += 1;
         let Some(hit) = scene.intersect(o, d, f32::INFINITY) else { break };
         let sp = scene.surface(&hit);
-        let mat = &scene.materials[sp.material as usize];
+        let bsdf = scene.bsdf(&sp);
         let wo = -d;
         let e = emission_toward(scene, hit.tri, wo);
         if e != Vec3::ZERO {
             terms.add(Term::Emitted.seen(through_specular), beta * e);
         }
-        if mat.bsdf.is_delta() {
+        if bsdf.is_delta() {
             if depth == ctx.settings.max_depth {
                 break;
             }
-            let Some(next) = continue_ray(&sp, &mat.bsdf, wo, s, streams::CAMERA_CHAIN_BOUNCE + depth) else { break };
+            let Some(next) = continue_ray(&sp, &bsdf, wo, s, streams::CAMERA_CHAIN_BOUNCE + depth) else { break };
             beta *= next.weight;
             through_specular = true;
             (o, d) = (next.origin, next.dir);
             continue;
         }
-        let direct = beta * direct_light(ctx, &sp, &mat.bsdf, wo, &s.fork(streams::light(depth)), rays);
-        let caustic = caustic_estimate(ctx, &sp, &mat.bsdf, wo, Some(pixel), scratch);
+        let direct = beta * direct_light(ctx, &sp, &bsdf, wo, &s.fork(streams::light(depth)), rays);
+        let caustic = caustic_estimate(ctx, &sp, &bsdf, wo, Some(pixel), scratch);
         let indirect = if ctx.effects.final_gather.on {
-            final_gather(ctx, &sp, &mat.bsdf, wo, &s.fork(streams::gather(depth)), rays, scratch)
+            final_gather(ctx, &sp, &bsdf, wo, &s.fork(streams::gather(depth)), rays, scratch)
         } else {
-            indirect_estimate(ctx, &sp, &mat.bsdf, wo, Some(pixel), scratch).into()
+            indirect_estimate(ctx, &sp, &bsdf, wo, Some(pixel), scratch).into()
         };
-        let glossy = glossy_reflection(ctx, &sp, &mat.bsdf, wo, &s.fork(streams::glossy(depth)), rays, scratch);
+        let glossy = glossy_reflection(ctx, &sp, &bsdf, wo, &s.fork(streams::glossy(depth)), rays, scratch);
         let (caustic_l, indirect_l, glossy_l) =
             (beta * caustic.radiance, beta * indirect.radiance, beta * glossy.radiance);
         if through_specular {
@@ -151,7 +151,7 @@ fn gather_hit(
     scratch: &mut Vec<(f32, u32)>,
 ) -> Estimated {
     let (y, wo) = (&end.point, -end.dir);
-    let bsdf = &ctx.scene.materials[y.material as usize].bsdf;
+    let bsdf = &ctx.scene.bsdf(y);
     if !lands_near(end.t, end.bounces, bsdf, ctx.secondary_gather) {
         return map_radiance(ctx, y, bsdf, wo, scratch).into();
     }
@@ -162,7 +162,7 @@ fn gather_hit(
     // A black surface sends no gather ray (as in `final_gather` and the wavefront engine).
     if kd != Vec3::ZERO {
         trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, _| {
-            let e = map_radiance(ctx, &z.point, &ctx.scene.materials[z.point.material as usize].bsdf, -z.dir, scratch);
+            let e = map_radiance(ctx, &z.point, &ctx.scene.bsdf(&z.point), -z.dir, scratch);
             far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias };
         });
     }
@@ -188,7 +188,7 @@ pub fn glossy_reflection(
     else {
         return Estimated::default();
     };
-    let b = &ctx.scene.materials[y.material as usize].bsdf;
+    let b = &ctx.scene.bsdf(&y);
     let direct = direct_light(ctx, &y, b, -d, &s.fork(streams::GLOSSY_HIT_LIGHT), rays);
     let caustic = caustic_estimate(ctx, &y, b, -d, None, scratch);
     let rest = indirect_estimate(ctx, &y, b, -d, None, scratch);

@@ -90,7 +90,7 @@ pub fn trace_path(
             break;
         };
         let sp = scene.surface(&hit);
-        let bsdf = scene.materials[sp.material as usize].bsdf;
+        let bsdf = scene.bsdf(&sp);
         if !bsdf.is_delta() && !deposit_photon(domain, &sp, &photon, bounce, out) {
             break;
         }

@@ -249,7 +249,7 @@ impl MaterialEntry {
             Some(e) => colour(&f("emission"), e)?,
             None => Vec3::ZERO,
         };
-        Ok(Material { name: name.to_string(), bsdf, emission })
+        Ok(Material::new(name, bsdf, emission))
     }
 }
 

@@ -70,9 +70,9 @@ pub fn displaced_sphere(rings: u32, segments: u32) -> Result<LoadedScene> {
     room.material.extend([2, 2]);
 
     let materials = vec![
-        Material { name: "sphere".into(), bsdf: Bsdf::Lambert { kd: Vec3::splat(0.7) }, emission: Vec3::ZERO },
-        Material { name: "walls".into(), bsdf: Bsdf::Lambert { kd: Vec3::splat(0.6) }, emission: Vec3::ZERO },
-        Material { name: "light".into(), bsdf: Bsdf::Lambert { kd: Vec3::ZERO }, emission: Vec3::splat(20.0) },
+        Material::new("sphere", Bsdf::Lambert { kd: Vec3::splat(0.7) }, Vec3::ZERO),
+        Material::new("walls", Bsdf::Lambert { kd: Vec3::splat(0.6) }, Vec3::ZERO),
+        Material::new("light", Bsdf::Lambert { kd: Vec3::ZERO }, Vec3::splat(20.0)),
     ];
     let scene = Scene::build(vec![sphere, room], materials, vec![], vec![])?;
     let camera = Camera { eye: Vec3::new(0.5, 0.5, 0.02), target: centre, up: Vec3::Y, fov_deg: 60.0 };

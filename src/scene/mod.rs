@@ -5,6 +5,7 @@ pub mod camera;
 mod checks;
 pub mod file;
 pub mod generated;
+pub mod image;
 pub mod light;
 pub mod mtl;
 pub mod obj;
@@ -19,7 +20,7 @@ use crate::geometry::{in_range, normal_and_area, Bvh, Hit, MAX_COORDINATE};
 use crate::material::{Bsdf, Material, SurfaceFrame};
 use crate::sampling::Distribution1D;
 pub use camera::Camera;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 pub use light::{Light, LightPreset, TriangleGeom};
 
 /// Triangles of one mesh before the scene is assembled.
@@ -34,6 +35,8 @@ pub struct MeshInput {
     pub normals: Vec<Vec3>,
     /// Vertex normals given in the file with zero length (counted, then treated as absent).
     pub zero_normals: u64,
+    /// Texture coordinates (empty, or one per position; (0, 0) where a vertex has none).
+    pub texcoords: Vec<Vec2>,
     /// Triangles as vertex indices.
     pub triangles: Vec<[u32; 3]>,
     /// Material of each triangle (index into the scene's material table).
@@ -53,6 +56,8 @@ pub struct SurfacePoint {
     pub material: u32,
     /// Triangle index.
     pub tri: u32,
+    /// Texture coordinates ((0, 0) in a scene without textures).
+    pub uv: Vec2,
 }
 
 /// An assembled, validated scene.
@@ -65,6 +70,8 @@ pub struct Scene {
     pub p2: Vec<Vec3>,
     /// Vertex normals per triangle (the geometric normal where the mesh has none).
     pub vn: Vec<[Vec3; 3]>,
+    /// Texture coordinates per triangle; empty when no material has a texture.
+    pub uv: Vec<[Vec2; 3]>,
     /// Unit geometric normals.
     pub ng: Vec<Vec3>,
     /// Triangle areas.
@@ -117,6 +124,9 @@ impl Scene {
         mut warnings: Vec<String>,
     ) -> Result<Scene> {
         let (mut p0, mut p1, mut p2, mut vn, mut mat) = (vec![], vec![], vec![], vec![], vec![]);
+        let textured = materials.iter().any(|m| !m.maps.is_empty());
+        let mut uv: Vec<[Vec2; 3]> = vec![];
+        let mut untextured_uses: Vec<String> = vec![];
         let mut dropped = 0usize;
         let zero_normals = meshes.iter().map(|m| m.zero_normals).sum();
         // Emissive area per material, to refuse lights whose every triangle is degenerate.
@@ -159,8 +169,24 @@ impl Scene {
                     tri.map(|i| m.normals[i as usize].try_normalize().unwrap_or(gn))
                 });
                 mat.push(material);
+                if textured {
+                    if m.texcoords.is_empty() {
+                        let name = &materials[material as usize];
+                        if !name.maps.is_empty() && !untextured_uses.iter().any(|u| u.starts_with(&m.source)) {
+                            untextured_uses.push(format!(
+                                "{}: material `{}` has a texture but the mesh has no texture coordinates (`vt`); it \
+                                 reads the texture at (0, 0) everywhere",
+                                m.source, name.name
+                            ));
+                        }
+                        uv.push([Vec2::ZERO; 3]);
+                    } else {
+                        uv.push(tri.map(|i| m.texcoords[i as usize]));
+                    }
+                }
             }
         }
+        warnings.extend(untextured_uses);
         for (i, seen) in emitter_seen.iter().enumerate() {
             if *seen && emitter_area[i] <= 0.0 {
                 return Err(Error::scene(format!(
@@ -204,6 +230,7 @@ impl Scene {
         let (p0, p1, p2) = (pick(&p0), pick(&p1), pick(&p2));
         let vn: Vec<[Vec3; 3]> = order.iter().map(|&i| vn[i as usize]).collect();
         let material: Vec<u32> = order.iter().map(|&i| mat[i as usize]).collect();
+        let uv: Vec<[Vec2; 3]> = if textured { order.iter().map(|&i| uv[i as usize]).collect() } else { vec![] };
         let (ng, area): (Vec<Vec3>, Vec<f32>) = (0..p0.len()).map(|i| normal_and_area(p0[i], p1[i], p2[i])).unzip();
 
         let mut lights: Vec<Light> = (0..p0.len())
@@ -228,6 +255,7 @@ impl Scene {
             p1,
             p2,
             vn,
+            uv,
             ng,
             area,
             material,
@@ -326,13 +354,26 @@ impl Scene {
         let p = a * b[0] + bb * b[1] + c * b[2];
         let n = self.vn[i];
         let ns = (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).try_normalize().unwrap_or(self.ng[i]);
+        let uv = match self.uv.get(i) {
+            Some(t) => t[0] * b[0] + t[1] * b[1] + t[2] * b[2],
+            None => Vec2::ZERO,
+        };
         SurfacePoint {
             p,
             p_error: barycentric_error(b, a, bb, c),
             frame: SurfaceFrame { ng: self.ng[i], ns },
             material: self.material[i],
             tri: hit.tri,
+            uv,
         }
+    }
+
+    /// The scattering at a surface point: its material's BSDF with any textures read at the
+    /// point ([`Material::bsdf_at`]). Both engines, the photons and the path tracer read it here.
+    #[inline]
+    #[must_use]
+    pub fn bsdf(&self, sp: &SurfacePoint) -> Bsdf {
+        self.materials[sp.material as usize].bsdf_at(sp.uv)
     }
 
     /// Geometry of triangle `i` for area lights.

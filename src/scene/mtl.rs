@@ -10,9 +10,10 @@
 //! | otherwise (`illum` 0, 1, 10, or 2 without `Ks`) | Lambertian `Kd` (0.8 grey if absent) |
 //!
 //! Colours take three numbers, one (grey), or `xyz X [Y Z]` (CIE XYZ, converted to linear sRGB).
-//! Statements the spec defines but photonwave does not simulate (texture maps with their
-//! options, `d`/`Tr` transparency, a coloured `Tf`, `sharpness`, `Km`, the PBR keys, spectral
-//! colours) are read, checked where they hold numbers, and reported in one warning per
+//! `map_Kd` and `map_Ks` name textures that replace `Kd` and `Ks` ([`MapStatement`]; read by
+//! [`super::obj`]). Statements the spec defines but photonwave does not simulate (the other
+//! texture maps, texture options, `d`/`Tr` transparency, a coloured `Tf`, `sharpness`, `Km`, the
+//! PBR keys, spectral colours) are read, checked where they hold numbers, and reported in one warning per
 //! material (`Ka` is read and not reported: ambient light has no place in global illumination). Anything else is
 //! an error naming the file and line.
 
@@ -41,8 +42,29 @@ pub struct MtlMaterial {
     pub ni: Option<f32>,
     /// `illum`.
     pub illum: Option<u8>,
-    /// Statements read but not simulated, in order of first appearance (`map_Kd`, `d`, …).
+    /// The texture maps simulated (`map_Kd`, `map_Ks`), in file order.
+    pub maps: Vec<MapStatement>,
+    /// Statements read but not simulated, in order of first appearance (`map_Ke`, `d`, …).
     pub ignored: Vec<String>,
+}
+
+/// A texture statement photonwave simulates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapStatement {
+    /// Its keyword (`map_Kd` or `map_Ks`).
+    pub key: String,
+    /// The image file as written (relative to the MTL file's folder).
+    pub file: String,
+    /// Its line.
+    pub line: usize,
+}
+
+impl MtlMaterial {
+    /// The file of the texture statement `key` (the last one given), if any.
+    #[must_use]
+    pub fn map(&self, key: &str) -> Option<&MapStatement> {
+        self.maps.iter().rev().find(|m| m.key == key)
+    }
 }
 
 /// A colour statement's value: `r g b`, `r` (grey), or `xyz X [Y Z]`. `None` for `spectral`.
@@ -199,10 +221,17 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
                 ignore(m, kw);
             }
             _ if kw.starts_with("map_") || matches!(kw, "bump" | "disp" | "decal" | "refl" | "norm") => {
-                if texture_file(&words).is_none() {
+                let Some(file) = texture_file(&words) else {
                     return Err(Error::parse(path, line, format!("`{kw}` names no image file")));
+                };
+                if matches!(kw, "map_Kd" | "map_Ks") {
+                    if words.first().is_some_and(|w| w.starts_with('-')) {
+                        ignore(m, &format!("{kw} options"));
+                    }
+                    m.maps.push(MapStatement { key: kw.to_string(), file, line });
+                } else {
+                    ignore(m, kw);
                 }
-                ignore(m, kw);
             }
             other => return Err(Error::parse(path, line, format!("unknown MTL statement `{other}`"))),
         }
@@ -210,8 +239,9 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
     for m in &out {
         if !m.ignored.is_empty() {
             warnings.push(format!(
-                "{}:{}: material `{}`: {} not simulated yet (texture maps, transparency and the PBR keys are \
-                 ignored); it renders with its constant colours",
+                "{}:{}: material `{}`: {} not simulated yet (of the texture maps only `map_Kd` and `map_Ks` \
+                 are, without options; transparency and the PBR keys are ignored); it renders with its constant \
+                 colours there",
                 path.display(),
                 m.line,
                 m.name,
@@ -226,14 +256,17 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
 #[must_use]
 pub fn material_from_mtl(m: &MtlMaterial, warnings: &mut Vec<String>) -> Material {
     let kd = m.kd.unwrap_or(Vec3::splat(0.8));
-    let ks = m.ks.unwrap_or(Vec3::ZERO);
+    // A `map_Ks` gives a specular colour even without `Ks`; its texels replace `ks` (and are kept
+    // within kd + ks ≤ 1 where they are read, `Material::bsdf_at`).
+    let ks_map = m.map("map_Ks").is_some();
+    let ks = m.ks.unwrap_or(if ks_map { Vec3::ONE } else { Vec3::ZERO });
     let emission = m.ke.unwrap_or(Vec3::ZERO);
     let bsdf = match m.illum.unwrap_or(2) {
         3 | 5 | 8 => Bsdf::Mirror { ks: m.ks.unwrap_or(Vec3::ONE).min(Vec3::ONE) },
         4 | 6 | 7 | 9 => Bsdf::Glass { ior: m.ni.unwrap_or(1.5) },
         2 if ks.max_element() > 0.0 => {
             let sum = (kd + ks).max_element();
-            let scale = if sum > 1.0 {
+            let scale = if sum > 1.0 && !ks_map && m.map("map_Kd").is_none() {
                 warnings.push(format!("material `{}`: Kd + Ks = {sum:.3} > 1, scaled down to conserve energy", m.name));
                 1.0 / sum
             } else {
@@ -248,7 +281,7 @@ pub fn material_from_mtl(m: &MtlMaterial, warnings: &mut Vec<String>) -> Materia
             Bsdf::Lambert { kd: kd.min(Vec3::ONE) }
         }
     };
-    Material { name: m.name.clone(), bsdf, emission }
+    Material::new(m.name.clone(), bsdf, emission)
 }
 
 #[cfg(test)]
@@ -277,10 +310,14 @@ mod tests {
                     d 0.5\nd -halo 1\nmap_Ks spec.png\nnewmtl b\nd 1\nTr 0\n";
         let (m, w) = parse(text);
         let m = m.unwrap();
-        assert_eq!(m[0].ignored, ["sharpness", "Km", "map_Kd", "bump", "d", "map_Ks"]);
+        assert_eq!(m[0].ignored, ["sharpness", "Km", "map_Kd options", "bump", "d"]);
+        assert_eq!(
+            m[0].maps.iter().map(|s| (s.key.as_str(), s.file.as_str(), s.line)).collect::<Vec<_>>(),
+            [("map_Kd", "tex.png", 5), ("map_Ks", "spec.png", 9)]
+        );
         assert!(m[1].ignored.is_empty(), "opaque `d 1` and `Tr 0` change nothing");
         assert_eq!(w.len(), 1, "{w:?}");
-        assert!(w[0].starts_with("m.mtl:1: material `a`") && w[0].contains("`map_Kd`"), "{w:?}");
+        assert!(w[0].starts_with("m.mtl:1: material `a`") && w[0].contains("`map_Kd options`"), "{w:?}");
     }
 
     #[test]

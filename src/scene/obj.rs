@@ -6,16 +6,19 @@
 //! whole when such a file exists). Materials are kept per MTL file: two files may each define
 //! `floor`, and each mesh gets its own file's.
 
+use super::image::load_texture;
 use super::mtl::{material_from_mtl, parse_mtl, MtlMaterial};
 use super::validate::{check_obj, MtlLib};
 use super::MeshInput;
 use crate::error::{Error, Result};
 use crate::files::{read_text, MAX_MATERIAL_FILE, MAX_MESH_FILE};
 use crate::geometry::{in_range, MAX_COORDINATE};
-use crate::material::{Bsdf, Material};
-use glam::Vec3;
+use crate::material::{Bsdf, Maps, Material};
+use crate::texture::{Encoding, Texture};
+use glam::{Vec2, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Materials of all loaded files, kept apart per MTL file.
 #[derive(Default, Debug)]
@@ -24,6 +27,8 @@ pub struct MaterialTable {
     pub materials: Vec<Material>,
     /// (MTL file, name) → index.
     by_key: HashMap<(PathBuf, String), u32>,
+    /// Textures read so far, by file and encoding (a file named twice is read once).
+    textures: HashMap<(PathBuf, Encoding), Arc<Texture>>,
 }
 
 impl MaterialTable {
@@ -65,13 +70,36 @@ impl MaterialTable {
         n
     }
 
+    /// The textures the MTL material `m` of the file `mtl_path` names, read (or taken from those
+    /// read before); each file read is added to `inputs`. An image that cannot be read is an
+    /// error naming it and the MTL statement.
+    pub fn load_maps(&mut self, mtl_path: &Path, m: &MtlMaterial, inputs: &mut Vec<PathBuf>) -> Result<Maps> {
+        let dir = mtl_path.parent().unwrap_or(Path::new("."));
+        let mut load = |key: &str| -> Result<Option<Arc<Texture>>> {
+            let Some(st) = m.map(key) else { return Ok(None) };
+            let path = dir.join(&st.file);
+            let cache_key = (path.clone(), Encoding::Srgb);
+            if let Some(t) = self.textures.get(&cache_key) {
+                return Ok(Some(t.clone()));
+            }
+            let what = format!("a `{key}` texture");
+            let texture = load_texture(&path, Encoding::Srgb, &what).map_err(|e| {
+                named_by_statement(
+                    e,
+                    &format!("`{key}` of material `{}` at {}:{}", m.name, mtl_path.display(), st.line),
+                )
+            })?;
+            inputs.push(path);
+            let texture = Arc::new(texture);
+            self.textures.insert(cache_key, texture.clone());
+            Ok(Some(texture))
+        };
+        Ok(Maps { kd: load("map_Kd")?, ks: load("map_Ks")? })
+    }
+
     /// Index of the grey Lambertian used for faces without a material.
     pub fn default_material(&mut self) -> u32 {
-        let grey = Material {
-            name: DEFAULT_MATERIAL.into(),
-            bsdf: Bsdf::Lambert { kd: Vec3::splat(0.8) },
-            emission: Vec3::ZERO,
-        };
+        let grey = Material::new(DEFAULT_MATERIAL, Bsdf::Lambert { kd: Vec3::splat(0.8) }, Vec3::ZERO);
         match self.by_key.get(&(PathBuf::new(), DEFAULT_MATERIAL.to_string())) {
             Some(&i) => i,
             None => self.insert(Path::new(""), grey, &mut Vec::new()),
@@ -89,6 +117,17 @@ fn mtllib_files(dir: &Path, lib: &MtlLib) -> Vec<PathBuf> {
         vec![PathBuf::from(&lib.names)]
     } else {
         lib.names.split_whitespace().map(PathBuf::from).collect()
+    }
+}
+
+/// `e` with "(named by STATEMENT)" added, for an image file that cannot be read.
+fn named_by_statement(e: Error, statement: &str) -> Error {
+    match e {
+        Error::Io { path, message } => Error::Io { path, message: format!("{message} (named by {statement})") },
+        Error::Parse { path, line, message } => {
+            Error::Parse { path, line, message: format!("{message} (named by {statement})") }
+        }
+        other => other,
     }
 }
 
@@ -169,18 +208,32 @@ pub fn load_obj(
         }
     })
     .map_err(|e| Error::parse(path, 0, format!("OBJ: {e}")))?;
-    let ids: Vec<u32> =
-        mtl.iter().map(|(file, m)| table.insert(file, material_from_mtl(m, warnings), warnings)).collect();
+    let mut ids = Vec::with_capacity(mtl.len());
+    for (file, m) in &mtl {
+        let mut material = material_from_mtl(m, warnings);
+        material.maps = table.load_maps(file, m, inputs)?;
+        ids.push(table.insert(file, material, warnings));
+    }
 
     let (scale, translate) = transform;
     let mut mesh = MeshInput { source: path.display().to_string(), ..Default::default() };
     let mut any_normals = false;
+    let mut any_texcoords = false;
     let mut missing_material = false;
     for model in &models {
         let m = &model.mesh;
         let base = mesh.positions.len() as u32;
         let has_normals = !m.normals.is_empty() && m.normals.len() == m.positions.len();
         any_normals |= has_normals;
+        let has_texcoords = !m.texcoords.is_empty() && m.texcoords.len() / 2 == m.positions.len() / 3;
+        any_texcoords |= has_texcoords;
+        mesh.texcoords.extend((0..m.positions.len() / 3).map(|k| {
+            if has_texcoords {
+                Vec2::new(m.texcoords[2 * k], m.texcoords[2 * k + 1])
+            } else {
+                Vec2::ZERO
+            }
+        }));
         for (k, p) in m.positions.chunks_exact(3).enumerate() {
             mesh.positions.push(Vec3::new(p[0], p[1], p[2]) * scale + translate);
             mesh.normals.push(if has_normals {
@@ -209,6 +262,9 @@ pub fn load_obj(
     }
     if !any_normals {
         mesh.normals.clear();
+    }
+    if !any_texcoords {
+        mesh.texcoords.clear();
     }
     if mesh.positions.iter().any(|p| !in_range(*p)) {
         return Err(out_of_range(path, &text, transform));

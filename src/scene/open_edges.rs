@@ -135,7 +135,7 @@ mod tests {
     fn scene(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Scene {
         let material = vec![0; triangles.len()];
         let mesh = MeshInput { source: "test".into(), positions, triangles, material, ..Default::default() };
-        let grey = Material { name: "grey".into(), bsdf: Bsdf::Lambert { kd: Vec3::splat(0.5) }, emission: Vec3::ZERO };
+        let grey = Material::new("grey", Bsdf::Lambert { kd: Vec3::splat(0.5) }, Vec3::ZERO);
         let light = Light::Point { position: Vec3::new(0.0, 1.0, 0.0), intensity: Vec3::ONE };
         Scene::build(vec![mesh], vec![grey], vec![light], vec![]).unwrap()
     }

@@ -70,7 +70,7 @@ pub fn first_non_specular(
         rays.gather += 1;
         let hit = scene.intersect(o, d, f32::INFINITY)?;
         let sp = scene.surface(&hit);
-        let bsdf = &scene.materials[sp.material as usize].bsdf;
+        let bsdf = &scene.bsdf(&sp);
         if !bsdf.is_delta() {
             return Some(ChainEnd { point: sp, dir: d, beta, t: hit.t, bounces: depth });
         }

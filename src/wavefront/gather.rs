@@ -40,7 +40,7 @@ fn estimate_at_diffuse_hits(
         r.filter_map(|j| {
             let i = lanes[j] as usize;
             let sp = ctx.scene.surface(&w.paths.hits.get(i)?);
-            let bsdf = &ctx.scene.materials[sp.material as usize].bsdf;
+            let bsdf = &ctx.scene.bsdf(&sp);
             let kind = w.paths.kind[i];
             let pixel =
                 (kind == PathKind::Camera).then(|| ((w.first_sample + u64::from(w.paths.sample[i])) / spp) as usize);

@@ -29,7 +29,7 @@ fn scatter_lanes(shared: &Shared, work: &PhotonWork, lanes: &[u32], next: &mut P
         r.filter_map(|j| {
             let i = lanes[j] as usize;
             let sp = scene.surface(&q.hits.get(i)?);
-            let bsdf = scene.materials[sp.material as usize].bsdf;
+            let bsdf = scene.bsdf(&sp);
             let photon = PhotonRay {
                 origin: q.rays.origin(i),
                 dir: q.rays.direction(i),
@@ -102,7 +102,7 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
                 let i = lanes[j] as usize;
                 let Some(hit) = w.paths.hits.get(i) else { continue };
                 let sp = ctx.scene.surface(&hit);
-                let bsdf = &ctx.scene.materials[sp.material as usize].bsdf;
+                let bsdf = &ctx.scene.bsdf(&sp);
                 let s = Sampler::from_key(w.paths.key[i]);
                 let (stream, term) = match w.paths.kind[i] {
                     PathKind::Camera => {
@@ -158,7 +158,7 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
                 let i = lanes[j] as usize;
                 let Some(hit) = w.hits.get(i) else { continue };
                 let sp = scene.surface(&hit);
-                let kd = scene.materials[sp.material as usize].bsdf.diffuse();
+                let kd = scene.bsdf(&sp).diffuse();
                 if kd == glam::Vec3::ZERO {
                     continue;
                 }
@@ -208,7 +208,7 @@ pub fn spawn_glossy_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
         }
         let Some(hit) = w.paths.hits.get(i) else { continue };
         let sp = scene.surface(&hit);
-        let bsdf = &scene.materials[sp.material as usize].bsdf;
+        let bsdf = &scene.bsdf(&sp);
         // Only glossy materials have the lobe (glossy_ray says so too, after the stream's fork).
         if !matches!(bsdf, Bsdf::Glossy { .. }) {
             continue;
@@ -254,7 +254,7 @@ fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32]) -> PathQ
                     return None;
                 }
                 let sp = scene.surface(&w.paths.hits.get(i)?);
-                let bsdf = &scene.materials[sp.material as usize].bsdf;
+                let bsdf = &scene.bsdf(&sp);
                 let s = Sampler::from_key(w.paths.key[i]);
                 let bounce = u32::from(w.paths.base[i]) + w.paths.depth[i];
                 let next = continue_ray(&sp, bsdf, -w.paths.rays.direction(i), &s, bounce)?;
