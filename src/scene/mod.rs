@@ -354,9 +354,11 @@ impl Scene {
         let p = a * b[0] + bb * b[1] + c * b[2];
         let n = self.vn[i];
         let ns = (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).try_normalize().unwrap_or(self.ng[i]);
-        let uv = match self.uv.get(i) {
-            Some(t) => t[0] * b[0] + t[1] * b[1] + t[2] * b[2],
-            None => Vec2::ZERO,
+        let uv = if self.uv.is_empty() {
+            Vec2::ZERO
+        } else {
+            let t = self.uv[i];
+            t[0] * b[0] + t[1] * b[1] + t[2] * b[2]
         };
         SurfacePoint {
             p,
@@ -373,7 +375,12 @@ impl Scene {
     #[inline]
     #[must_use]
     pub fn bsdf(&self, sp: &SurfacePoint) -> Bsdf {
-        self.materials[sp.material as usize].bsdf_at(sp.uv)
+        let m = &self.materials[sp.material as usize];
+        if self.uv.is_empty() {
+            m.bsdf
+        } else {
+            m.bsdf_at(sp.uv)
+        }
     }
 
     /// Geometry of triangle `i` for area lights.
