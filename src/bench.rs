@@ -144,7 +144,7 @@ fn light_point(scene: &Scene, u: [f32; 3]) -> Option<Vec3> {
             Some(t.p[0] * (1.0 - b1 - b2) + t.p[1] * b1 + t.p[2] * b2)
         }
         Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
-        Light::Directional { .. } => None,
+        Light::Directional { .. } | Light::Sun { .. } | Light::Environment => None,
     }
 }
 

@@ -90,7 +90,13 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
     let mut last_delta = true; // previous vertex was the camera or a delta bounce
     for depth in 0..=ctx.settings.max_depth {
         rays.camera += 1;
-        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else { break };
+        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else {
+            // The environment and the sun, counted where light sampling does not (as emitters).
+            if last_delta && scene.has_background() {
+                terms.add(path_term(Term::Emitted, depth, via_specular), beta * scene.background(d));
+            }
+            break;
+        };
         let sp = scene.surface(&hit);
         let bsdf = scene.bsdf(&sp);
         let wo = -d;

@@ -127,6 +127,16 @@ impl Distribution1D {
         let i = self.cdf.partition_point(|&c| c <= target);
         i.min(self.cdf.len() - 1)
     }
+    /// [`Distribution1D::sample`], and where `u` fell within the item's share of [0, 1),
+    /// rescaled to [0, 1): a second uniform number for free (continuous sampling inside a bin).
+    #[must_use]
+    pub fn sample_remapped(&self, u: f32) -> (usize, f32) {
+        let i = self.sample(u);
+        let lo = if i == 0 { 0.0 } else { self.cdf[i - 1] };
+        let width = self.cdf[i] - lo;
+        let r = if width > 0.0 { (u as f64 * self.total - lo) / width } else { 0.5 };
+        (i, (r as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0))
+    }
 }
 
 #[cfg(test)]

@@ -57,7 +57,13 @@ pub fn trace_camera_path(
     let mut through_specular = false;
     for depth in 0..=ctx.settings.max_depth {
         rays.camera += 1;
-        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else { break };
+        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else {
+            // Leaving the scene: the environment and the sun, seen directly or through mirrors.
+            if scene.has_background() {
+                terms.add(Term::Emitted.seen(through_specular), beta * scene.background(d));
+            }
+            break;
+        };
         let sp = scene.surface(&hit);
         let bsdf = scene.bsdf(&sp);
         let wo = -d;

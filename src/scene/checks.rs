@@ -86,7 +86,7 @@ impl Scene {
     /// one of the closed pieces (connected by shared edges) by the parity of a ray's crossings of
     /// that piece — per piece, so that a light inside a glass ball inside a room counts.
     pub(super) fn find_enclosure(&self, uses: &super::open_edges::EdgeUses) -> bool {
-        if self.p0.is_empty() || self.lights.iter().any(|l| matches!(l, Light::Directional { .. })) {
+        if self.p0.is_empty() || self.lights.iter().any(Light::is_distant) {
             return false;
         }
         let n = self.p0.len();
@@ -121,7 +121,7 @@ impl Scene {
                 let lift = c.abs().max_element().max(diagonal) * 1e-5;
                 self.inside(c + self.ng[i] * lift, &piece)
             }
-            Light::Directional { .. } => false,
+            Light::Directional { .. } | Light::Sun { .. } | Light::Environment => false,
         })
     }
 

@@ -17,6 +17,18 @@
 //! position = [0, 1.5, 0]
 //! intensity = [5, 5, 5]         # W/sr
 //!
+//! [[light]]
+//! type = "sun"                  # a distant disk: soft shadows
+//! direction = [0.3, -1, -0.2]   # of travel
+//! irradiance = [800, 780, 740]  # W/m² on a perpendicular plane
+//! angle = 0.27                  # angular radius, degrees
+//!
+//! [environment]                 # radiance from every direction at infinity
+//! radiance = [0.4, 0.5, 0.7]    # a constant, or
+//! # map = "sky.exr"             # a lat-long (2:1) linear image, +y up
+//! scale = 1.0
+//! rotation = 0                  # degrees about +y
+//!
 //! [materials.sphere]            # replaces the MTL material `sphere`
 //! type = "glass"                # lambert | glossy | mirror | glass
 //! ior = 1.5
@@ -27,6 +39,8 @@
 //! ```
 
 use super::camera::Camera;
+use super::environment::Environment;
+use super::image::load_texture;
 use super::light::Light;
 use super::obj::{load_obj, MaterialTable};
 use super::{bounds_of, MeshInput, Scene};
@@ -34,6 +48,7 @@ use crate::error::{Error, Result};
 use crate::files::{read_text, MAX_SCENE_FILE};
 use crate::material::{Bsdf, Material};
 use crate::settings::Settings;
+use crate::texture::Encoding;
 use glam::Vec3;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -49,8 +64,28 @@ struct SceneFile {
     light: Vec<LightEntry>,
     #[serde(default)]
     materials: BTreeMap<String, MaterialEntry>,
+    environment: Option<EnvironmentEntry>,
     #[serde(default)]
     render: Option<Settings>,
+}
+
+/// `[environment]`: a constant `radiance`, or a lat-long `map` (linear HDR, EXR or any image
+/// format textures take), times `scale`, turned `rotation` degrees about +y.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct EnvironmentEntry {
+    #[serde(default)]
+    radiance: Option<[f32; 3]>,
+    #[serde(default)]
+    map: Option<PathBuf>,
+    #[serde(default = "one")]
+    scale: f32,
+    #[serde(default)]
+    rotation: f32,
+}
+
+fn sun_angle() -> f32 {
+    0.27
 }
 
 #[derive(Deserialize, Debug)]
@@ -99,6 +134,13 @@ enum LightEntry {
     Directional {
         direction: [f32; 3],
         irradiance: [f32; 3],
+    },
+    Sun {
+        direction: [f32; 3],
+        irradiance: [f32; 3],
+        /// Angular radius, degrees (the real sun's: 0.27).
+        #[serde(default = "sun_angle")]
+        angle: f32,
     },
 }
 
@@ -215,7 +257,55 @@ impl LightEntry {
                     .ok_or_else(|| Error::setting(f("direction"), "must not be zero"))?,
                 irradiance: colour(&f("irradiance"), irradiance)?,
             },
+            LightEntry::Sun { direction, irradiance, angle } => {
+                if !(angle > 0.0 && angle <= 45.0) {
+                    return Err(Error::setting(
+                        f("angle"),
+                        "the sun's angular radius must be in (0, 45] degrees (the real sun's is 0.27)",
+                    ));
+                }
+                let half = (angle * 0.5).to_radians().sin();
+                Light::Sun {
+                    direction: finite3(&f("direction"), direction)?
+                        .try_normalize()
+                        .ok_or_else(|| Error::setting(f("direction"), "must not be zero"))?,
+                    irradiance: colour(&f("irradiance"), irradiance)?,
+                    one_minus_cos: 2.0 * half * half,
+                }
+            }
         })
+    }
+}
+
+impl EnvironmentEntry {
+    /// The environment this entry describes; a map is read relative to `dir` and added to
+    /// `inputs`.
+    fn to_environment(&self, dir: &Path, inputs: &mut Vec<PathBuf>) -> Result<Environment> {
+        if !(self.scale >= 0.0 && self.scale.is_finite()) {
+            return Err(Error::setting("environment.scale", "must be a finite number ≥ 0"));
+        }
+        if !self.rotation.is_finite() {
+            return Err(Error::setting("environment.rotation", "must be a finite number of degrees"));
+        }
+        match (&self.radiance, &self.map) {
+            (Some(_), Some(_)) => {
+                Err(Error::setting("environment", "give `radiance` (a constant) or `map` (a lat-long image), not both"))
+            }
+            (None, None) => Err(Error::setting("environment", "needs `radiance = [r, g, b]` or `map = \"sky.exr\"`")),
+            (Some(l), None) => Ok(Environment::constant(colour("environment.radiance", *l)? * self.scale)),
+            (None, Some(file)) => {
+                let path = dir.join(file);
+                let map = load_texture(&path, Encoding::Linear, "an environment map").map_err(|e| match e {
+                    Error::Io { path, message } => {
+                        Error::Io { path, message: format!("{message} (named by `environment.map`)") }
+                    }
+                    other => other,
+                })?;
+                inputs.push(path);
+                Environment::from_map(map, self.scale, self.rotation.to_radians())
+                    .map_err(|e| Error::setting("environment.map", e))
+            }
+        }
     }
 }
 
@@ -279,7 +369,7 @@ pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
         let line = e.span().map_or(0, |s| text[..s.start.min(text.len())].lines().count().max(1));
         Error::parse(path, line, e.message().to_string())
     })?;
-    if file.mesh.is_empty() && file.light.is_empty() {
+    if file.mesh.is_empty() && file.light.is_empty() && file.environment.is_none() {
         return Err(Error::parse(path, 0, "the scene file names no [[mesh]] and no [[light]]"));
     }
     let dir = path.parent().unwrap_or(Path::new("."));
@@ -310,7 +400,8 @@ pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
     }
     let settings = file.render.unwrap_or_default();
     settings.validate()?;
-    let scene = Scene::build(meshes, table.materials, lights, warnings)?;
+    let environment = file.environment.as_ref().map(|e| e.to_environment(dir, &mut inputs)).transpose()?;
+    let scene = Scene::build_lit(meshes, table.materials, lights, environment, warnings)?;
     Ok(LoadedScene { scene, camera, settings, inputs })
 }
 

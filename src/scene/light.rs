@@ -20,6 +20,13 @@ pub enum Light {
     Spot { position: Vec3, direction: Vec3, intensity: Vec3, cos_inner: f32, cos_outer: f32 },
     /// Distant light travelling along `direction` with irradiance `irradiance` on a perpendicular plane.
     Directional { direction: Vec3, irradiance: Vec3 },
+    /// A sun: a distant disk of uniform radiance seen under angular radius θ, its centre's light
+    /// travelling along `direction`, putting `irradiance` on a perpendicular plane.
+    /// `one_minus_cos` = 1 − cos θ (kept apart for precision: 4.4e-6 for the real sun's 0.27°).
+    Sun { direction: Vec3, irradiance: Vec3, one_minus_cos: f32 },
+    /// The scene's environment ([`super::environment::Environment`]): sampled by the scene, which
+    /// holds its map.
+    Environment,
 }
 
 /// A photon leaving a light: origin, direction and power before division by the photon count.
@@ -72,10 +79,26 @@ pub fn spot_falloff(cos_theta: f32, cos_inner: f32, cos_outer: f32) -> f32 {
 }
 
 impl Light {
-    /// True for lights that cannot be hit by rays (point, spot, directional).
+    /// True for lights of one direction at each point (point, spot, directional): sampled once
+    /// per shading point. Area lights, the sun and the environment are sampled `light_samples`
+    /// times.
     #[must_use]
     pub fn is_delta(&self) -> bool {
-        !matches!(self, Light::Area { .. })
+        !matches!(self, Light::Area { .. } | Light::Sun { .. } | Light::Environment)
+    }
+
+    /// True for lights at infinity (directional, sun, environment): they light the whole scene
+    /// and photons from them can leave it.
+    #[must_use]
+    pub fn is_distant(&self) -> bool {
+        matches!(self, Light::Directional { .. } | Light::Sun { .. } | Light::Environment)
+    }
+
+    /// The sun's radiance: E / (π sin² θ), so that its disk puts `irradiance` on a perpendicular
+    /// plane (∫ L cos dω over the disk = L·π sin² θ).
+    #[must_use]
+    pub fn sun_radiance(irradiance: Vec3, one_minus_cos: f32) -> Vec3 {
+        irradiance / (PI * one_minus_cos * (2.0 - one_minus_cos))
     }
 
     /// Emitted power (W) per channel. `scene_radius` bounds the scene (directional lights).
@@ -87,7 +110,11 @@ impl Light {
             Light::Spot { intensity, cos_inner, cos_outer, .. } => {
                 intensity * 2.0 * PI * ((1.0 - cos_inner) + 0.5 * (cos_inner - cos_outer))
             }
-            Light::Directional { irradiance, .. } => irradiance * PI * scene_radius * scene_radius,
+            Light::Directional { irradiance, .. } | Light::Sun { irradiance, .. } => {
+                irradiance * PI * scene_radius * scene_radius
+            }
+            // Computed by the scene, which holds the map (`Scene::light_power_of`).
+            Light::Environment => Vec3::ZERO,
         }
     }
 
@@ -131,6 +158,20 @@ impl Light {
                 let origin = centre + (f.s * dx + f.t * dy) * radius - direction * (2.0 * radius);
                 Emission { origin, direction, power: irradiance * PI * radius * radius, normal: None }
             }
+            Light::Sun { direction, irradiance, one_minus_cos } => {
+                // Directions ∝ L·cos about the axis: uniform on the disk of radius sin θ.
+                let (centre, radius) = scene;
+                let sin_max = (one_minus_cos * (2.0 - one_minus_cos)).sqrt();
+                let (x, y) = concentric_disk([u[2], u[3]]);
+                let (x, y) = (x * sin_max, y * sin_max);
+                let f = Frame::new(direction);
+                let dir = f.to_world(Vec3::new(x, y, (1.0 - x * x - y * y).max(0.0).sqrt()));
+                let (dx, dy) = concentric_disk([u[0], u[1]]);
+                let origin = centre + (f.s * dx + f.t * dy) * radius - dir * (2.0 * radius);
+                Emission { origin, direction: dir, power: irradiance * PI * radius * radius, normal: None }
+            }
+            // Sampled by the scene (`Scene::sample_emission`); never reached.
+            Light::Environment => Emission { origin: Vec3::ZERO, direction: Vec3::Y, power: Vec3::ZERO, normal: None },
         }
     }
 
@@ -184,6 +225,29 @@ impl Light {
             Light::Directional { direction, irradiance } => {
                 Some(Incident { wi: -direction, value: irradiance, distance: f32::INFINITY, point: None })
             }
+            Light::Sun { direction, irradiance, one_minus_cos } => {
+                // Uniform in the cone: pdf 1/(2π(1 − cos θ)).
+                let cos = 1.0 - u[0] * one_minus_cos;
+                let sin = (u[0] * one_minus_cos * (2.0 - u[0] * one_minus_cos)).max(0.0).sqrt();
+                let phi = 2.0 * PI * u[1];
+                let wi = Frame::new(-direction).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos));
+                let value = Self::sun_radiance(irradiance, one_minus_cos) * (2.0 * PI * one_minus_cos);
+                Some(Incident { wi, value, distance: f32::INFINITY, point: None })
+            }
+            // Sampled by the scene (`Scene::sample_incident`).
+            Light::Environment => None,
+        }
+    }
+
+    /// Radiance this light sends along a ray that leaves the scene in direction `d` (the sun
+    /// when `d` points into its disk; the environment is the scene's).
+    #[must_use]
+    pub fn radiance_at_infinity(&self, d: Vec3) -> Vec3 {
+        match *self {
+            Light::Sun { direction, irradiance, one_minus_cos } if 1.0 + d.dot(direction) <= one_minus_cos => {
+                Self::sun_radiance(irradiance, one_minus_cos)
+            }
+            _ => Vec3::ZERO,
         }
     }
 }

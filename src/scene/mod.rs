@@ -3,6 +3,7 @@
 
 pub mod camera;
 mod checks;
+pub mod environment;
 pub mod file;
 pub mod generated;
 pub mod image;
@@ -20,6 +21,7 @@ use crate::geometry::{in_range, normal_and_area, Bvh, Hit, MAX_COORDINATE};
 use crate::material::{Bsdf, Material, SurfaceFrame};
 use crate::sampling::Distribution1D;
 pub use camera::Camera;
+pub use environment::Environment;
 use glam::{Vec2, Vec3};
 pub use light::{Light, LightPreset, TriangleGeom};
 
@@ -80,8 +82,11 @@ pub struct Scene {
     pub material: Vec<u32>,
     /// Material table.
     pub materials: Vec<Material>,
-    /// Lights (area lights first, one per emissive triangle).
+    /// Lights (area lights first, one per emissive triangle; then the scene file's, and
+    /// [`Light::Environment`] last when there is an environment).
     pub lights: Vec<Light>,
+    /// The environment: radiance at infinity (a constant or a lat-long map).
+    pub environment: Option<Environment>,
     /// Lights by power (photon emission).
     pub light_power: Distribution1D,
     /// Indices of area lights in `lights`, and their distribution by power (direct lighting).
@@ -121,8 +126,22 @@ impl Scene {
         meshes: Vec<MeshInput>,
         materials: Vec<Material>,
         extra_lights: Vec<Light>,
+        warnings: Vec<String>,
+    ) -> Result<Scene> {
+        Self::build_lit(meshes, materials, extra_lights, None, warnings)
+    }
+
+    /// [`Scene::build`] with an environment light.
+    pub fn build_lit(
+        meshes: Vec<MeshInput>,
+        materials: Vec<Material>,
+        mut extra_lights: Vec<Light>,
+        environment: Option<Environment>,
         mut warnings: Vec<String>,
     ) -> Result<Scene> {
+        if environment.is_some() {
+            extra_lights.push(Light::Environment);
+        }
         let (mut p0, mut p1, mut p2, mut vn, mut mat) = (vec![], vec![], vec![], vec![], vec![]);
         let textured = materials.iter().any(|m| !m.maps.is_empty());
         let mut uv: Vec<[Vec2; 3]> = vec![];
@@ -199,7 +218,7 @@ impl Scene {
             warnings.push(format!("{dropped} degenerate (zero-area) triangles were skipped"));
         }
         if p0.is_empty() {
-            let directional = extra_lights.iter().any(|l| matches!(l, Light::Directional { .. }));
+            let directional = extra_lights.iter().any(Light::is_distant);
             let why = if dropped > 0 {
                 format!(" (all {dropped} of its triangles have zero area)")
             } else if directional {
@@ -261,6 +280,7 @@ impl Scene {
             material,
             materials,
             lights,
+            environment,
             light_power: Distribution1D::default(),
             area_lights: vec![],
             area_power: None,
@@ -283,18 +303,8 @@ impl Scene {
             scene.kinds.1 |= matches!(m.bsdf, Bsdf::Glass { .. });
             scene.kinds.2 |= !m.bsdf.is_delta();
         }
-        let radius = scene.radius();
-        let powers: Vec<f64> = scene
-            .lights
-            .iter()
-            .map(|l| {
-                let tri = match l {
-                    Light::Area { tri, .. } => Some(scene.triangle(*tri)),
-                    _ => None,
-                };
-                l.power(tri.as_ref(), radius).element_sum() as f64 / 3.0
-            })
-            .collect();
+        let powers: Vec<f64> =
+            scene.lights.iter().map(|l| scene.light_power_of(l).element_sum() as f64 / 3.0).collect();
         if let Some(i) = powers.iter().position(|p| !p.is_finite()) {
             let what = match &scene.lights[i] {
                 Light::Area { tri, .. } => {
@@ -427,7 +437,80 @@ impl Scene {
     /// Total emitted power per channel.
     #[must_use]
     pub fn total_power(&self) -> Vec3 {
-        self.lights.iter().map(|l| l.power(self.light_triangle(l).as_ref(), self.radius())).sum()
+        self.lights.iter().map(|l| self.light_power_of(l)).sum()
+    }
+
+    /// The power light `l` emits into the scene (W per channel).
+    #[must_use]
+    pub fn light_power_of(&self, l: &Light) -> Vec3 {
+        match (l, &self.environment) {
+            (Light::Environment, Some(env)) => env.power(self.radius()),
+            _ => l.power(self.light_triangle(l).as_ref(), self.radius()),
+        }
+    }
+
+    /// Samples light `l` arriving at `p`, a surface point with unit normal `n` (on the side light
+    /// is wanted from), with two uniform numbers ([`Light::sample_incident`]). The environment is
+    /// sampled half by its map ([`Environment::sample`]) and half cosine-weighted about `n`, with
+    /// the pdf of the mixture (the balance heuristic of the two): a face that does not see a
+    /// bright sun in the map still gets half of its samples where its own sky is.
+    #[must_use]
+    pub fn sample_incident(&self, l: &Light, p: Vec3, n: Vec3, u: [f32; 2]) -> Option<light::Incident> {
+        match (l, &self.environment) {
+            (Light::Environment, Some(env)) => {
+                let wi = if u[0] < 0.5 {
+                    let local = crate::sampling::cosine_hemisphere([(2.0 * u[0]).min(1.0), u[1]]);
+                    crate::sampling::Frame::new(n).to_world(local)
+                } else {
+                    env.sample([(2.0 * u[0] - 1.0).min(1.0 - f32::EPSILON / 2.0), u[1]])?.0
+                };
+                let pdf = 0.5 * wi.dot(n).max(0.0) * std::f32::consts::FRAC_1_PI + 0.5 * env.pdf(wi);
+                (pdf > 0.0 && wi.is_finite()).then(|| light::Incident {
+                    wi,
+                    value: env.radiance(wi) / pdf,
+                    distance: f32::INFINITY,
+                    point: None,
+                })
+            }
+            _ => l.sample_incident(self.light_triangle(l).as_ref(), p, u),
+        }
+    }
+
+    /// Samples a photon leaving light `l` with four uniform numbers ([`Light::sample_emission`];
+    /// the environment's from a disk of the scene's radius across a direction picked by the
+    /// map's importance: power L·π r²/pdf).
+    #[must_use]
+    pub fn sample_emission(&self, l: &Light, u: [f32; 4]) -> light::Emission {
+        let (centre, radius) = (self.centre(), self.radius());
+        match (l, &self.environment) {
+            (Light::Environment, Some(env)) => {
+                let Some((wi, pdf, radiance)) = env.sample([u[0], u[1]]) else {
+                    return light::Emission { origin: centre, direction: Vec3::Y, power: Vec3::ZERO, normal: None };
+                };
+                let (dx, dy) = crate::sampling::concentric_disk([u[2], u[3]]);
+                let f = crate::sampling::Frame::new(wi);
+                let origin = centre + (f.s * dx + f.t * dy) * radius + wi * (2.0 * radius);
+                let power = radiance * (std::f32::consts::PI * radius * radius) / pdf;
+                light::Emission { origin, direction: -wi, power, normal: None }
+            }
+            _ => l.sample_emission(self.light_triangle(l).as_ref(), (centre, radius), u),
+        }
+    }
+
+    /// Radiance reaching a ray that leaves the scene in direction `d`: the environment's and
+    /// the sun's. Zero in a scene lit by neither.
+    #[must_use]
+    pub fn background(&self, d: Vec3) -> Vec3 {
+        let d = d.normalize_or(Vec3::Y);
+        let env = self.environment.as_ref().map_or(Vec3::ZERO, |e| e.radiance(d));
+        self.lights.iter().filter(|l| matches!(l, Light::Sun { .. })).map(|l| l.radiance_at_infinity(d)).sum::<Vec3>()
+            + env
+    }
+
+    /// Whether any ray leaving the scene sees light ([`Scene::background`]).
+    #[must_use]
+    pub fn has_background(&self) -> bool {
+        self.environment.is_some() || self.lights.iter().any(|l| matches!(l, Light::Sun { .. }))
     }
 
     /// Number of triangles.

@@ -41,8 +41,7 @@ pub fn direct_light_rays(
     let (_, ns) = sp.frame.oriented(wo);
     let mut add = |light_index: u32, u: [f32; 2], weight: f32| {
         let light = &scene.lights[light_index as usize];
-        let tri = scene.light_triangle(light);
-        let Some(inc) = light.sample_incident(tri.as_ref(), sp.p, u) else { return };
+        let Some(inc) = scene.sample_incident(light, sp.p, ns, u) else { return };
         let f = bsdf.eval(&sp.frame, wo, inc.wi);
         let cos = inc.wi.dot(ns).abs();
         if f == Vec3::ZERO || cos == 0.0 {

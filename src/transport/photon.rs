@@ -120,11 +120,7 @@ pub fn start_photon(scene: &Scene, seed: u64, domain: Domain, index: u64) -> Opt
     let pmf = scene.light_power.pmf(li) as f32;
     let light = &scene.lights[li];
     let tri = scene.light_triangle(light);
-    let em = light.sample_emission(
-        tri.as_ref(),
-        (scene.centre(), scene.radius()),
-        [s.get(0, 1), s.get(0, 2), s.get(0, 3), s.get(0, 4)],
-    );
+    let em = scene.sample_emission(light, [s.get(0, 1), s.get(0, 2), s.get(0, 3), s.get(0, 4)]);
     let power = em.power / pmf;
     if !power.is_finite() || !em.direction.is_finite() {
         return None;

@@ -64,7 +64,8 @@ pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
 }
 
 /// Camera rays (not gather or glossy rays, whose emission is the direct term's) add the
-/// radiance of emitters whose front face they hit.
+/// radiance of emitters whose front face they hit, and of the environment and the sun when they
+/// leave the scene.
 pub fn deposit_emission(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let scene = &*shared.scene;
@@ -74,8 +75,12 @@ pub fn deposit_emission(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut s
         if w.paths.kind[i] != PathKind::Camera {
             continue;
         }
-        let Some(hit) = w.paths.hits.get(i) else { continue };
-        let emission = emission_toward(scene, hit.tri, -w.paths.rays.direction(i));
+        let emission = match w.paths.hits.get(i) {
+            Some(hit) => emission_toward(scene, hit.tri, -w.paths.rays.direction(i)),
+            // Leaving the scene: the environment and the sun.
+            None if scene.has_background() => scene.background(w.paths.rays.direction(i)),
+            None => continue,
+        };
         if emission == Vec3::ZERO {
             continue;
         }
