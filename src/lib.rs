@@ -72,6 +72,7 @@ pub mod job;
 pub mod material;
 pub mod memory;
 pub mod merge;
+pub mod microfacet;
 pub mod parallel;
 pub mod partial;
 pub mod pass_set;

@@ -6,6 +6,7 @@
 //! the frame is flipped to the side of `wo`. The dielectric uses the unflipped normal to know
 //! whether the ray enters or leaves.
 
+use crate::microfacet;
 use crate::sampling::{cosine_hemisphere, Frame};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3};
@@ -37,7 +38,19 @@ pub enum Bsdf {
     /// Smooth clear dielectric with index of refraction `ior` (relative to the outside, the side
     /// the geometric normal points to), exact Fresnel.
     Glass { ior: f32 },
+    /// Rough conductor ([`crate::microfacet`]): GGX of width `alpha` (roughness²), Schlick's
+    /// Fresnel from the normal-incidence reflectance `ks`.
+    RoughConductor { ks: Vec3, alpha: f32 },
+    /// Rough (frosted) clear dielectric: GGX of width `alpha`, exact Fresnel, reflection and
+    /// refraction through the microfacets; `ior` as for [`Bsdf::Glass`].
+    RoughDielectric { ior: f32, alpha: f32 },
 }
+
+/// The GGX α below which a rough conductor acts as a mirror for photons (roughness 0.3): its
+/// photons pass on as specular, so its caustics go into the caustic map, instead of being
+/// stored on it. Rough dielectrics always pass photons on (a photon stored on frosted glass
+/// could never light what lies behind it). The effects plan says which surfaces are which.
+pub const PHOTON_SPECULAR_ALPHA: f32 = 0.09;
 
 /// A named material: scattering plus emitted radiance from the front face.
 #[derive(Clone, Debug, PartialEq)]
@@ -98,7 +111,8 @@ impl Material {
                 Bsdf::Glossy { kd: kd * scale, ks: ks * scale, exponent }
             }
             Bsdf::Mirror { ks } => Bsdf::Mirror { ks: ks_at(ks).min(Vec3::ONE) },
-            b @ Bsdf::Glass { .. } => b,
+            Bsdf::RoughConductor { ks, alpha } => Bsdf::RoughConductor { ks: ks_at(ks).min(Vec3::ONE), alpha },
+            b @ (Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. }) => b,
         }
     }
 }
@@ -181,6 +195,25 @@ impl Bsdf {
         matches!(self, Bsdf::Mirror { .. } | Bsdf::Glass { .. })
     }
 
+    /// True for surfaces photons pass on as specular (neither stored there nor ending a caustic
+    /// path): delta materials, rough dielectrics, rough conductors below
+    /// [`PHOTON_SPECULAR_ALPHA`].
+    #[must_use]
+    pub fn photon_specular(&self) -> bool {
+        match *self {
+            Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. } => true,
+            Bsdf::RoughConductor { alpha, .. } => alpha < PHOTON_SPECULAR_ALPHA,
+            _ => false,
+        }
+    }
+
+    /// True for materials with a lobe that camera paths follow with one traced ray (the glossy
+    /// reflection): Phong glossy and the rough materials.
+    #[must_use]
+    pub fn has_glossy_lobe(&self) -> bool {
+        matches!(self, Bsdf::Glossy { .. } | Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. })
+    }
+
     /// The Lambertian albedo (zero for delta materials).
     #[must_use]
     pub fn diffuse(&self) -> Vec3 {
@@ -193,6 +226,9 @@ impl Bsdf {
     /// f(wo, wi) for the non-delta part; zero unless wo and wi lie on the same geometric side.
     #[must_use]
     pub fn eval(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Vec3 {
+        if let Some(f) = self.eval_rough(frame, wo, wi) {
+            return f;
+        }
         let (ng, ns) = frame.oriented(wo);
         if wi.dot(ng) <= 0.0 {
             return Vec3::ZERO;
@@ -207,6 +243,9 @@ impl Bsdf {
     /// The glossy lobe alone (zero for other materials).
     #[must_use]
     pub fn eval_glossy(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Vec3 {
+        if let Some(f) = self.eval_rough(frame, wo, wi) {
+            return f;
+        }
         match *self {
             Bsdf::Glossy { ks, exponent, .. } => {
                 let (ng, ns) = frame.oriented(wo);
@@ -268,20 +307,121 @@ impl Bsdf {
                 (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: ks, delta: true })
             }
             Bsdf::Glass { ior } => sample_glass(frame, wo, ior, u[0], transport),
+            Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } => {
+                self.sample_rough(frame, wo, u, transport == Transport::Radiance)
+            }
         })
     }
 
-    /// Samples the glossy lobe alone: weight `ks·(n+2)/(n+1)·cos θi`. `None` for other materials.
+    /// Samples the glossy lobe alone (radiance): for Phong, weight `ks·(n+2)/(n+1)·cos θi`; for
+    /// the rough materials, the whole BSDF. `None` for other materials.
     #[must_use]
-    pub fn sample_glossy(&self, frame: &SurfaceFrame, wo: Vec3, u: [f32; 2]) -> Option<BsdfSample> {
+    pub fn sample_glossy(&self, frame: &SurfaceFrame, wo: Vec3, u: [f32; 3]) -> Option<BsdfSample> {
+        if let Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } = self {
+            return self.sample_rough(frame, wo, u, true);
+        }
         let Bsdf::Glossy { ks, exponent, .. } = *self else { return None };
         let (ng, ns) = frame.oriented(wo);
-        let wi = sample_phong(reflect(wo, ns), exponent, u);
+        let wi = sample_phong(reflect(wo, ns), exponent, [u[0], u[1]]);
         let cos = wi.dot(ns);
         if wi.dot(ng) <= 0.0 || cos <= 0.0 {
             return None;
         }
         Some(BsdfSample { wi, weight: ks * ((exponent + 2.0) / (exponent + 1.0) * cos), delta: false })
+    }
+
+    /// The local frame of a rough material at `wo`: the geometric and shading normals on the
+    /// side of `wo`, and η(other side)/η(wo's side) (1 for a conductor).
+    fn rough_frame(&self, frame: &SurfaceFrame, wo: Vec3) -> (Vec3, Frame, f32) {
+        match *self {
+            Bsdf::RoughDielectric { ior, .. } => {
+                let entering = wo.dot(frame.ng) > 0.0;
+                let eta = if entering { ior } else { 1.0 / ior };
+                let ng = if entering { frame.ng } else { -frame.ng };
+                let ns = if entering { frame.ns } else { -frame.ns };
+                let ns = if ns.dot(ng) > 0.0 && ns.is_finite() { ns } else { ng };
+                (ng, Frame::new(ns), eta)
+            }
+            _ => {
+                let (ng, ns) = frame.oriented(wo);
+                (ng, Frame::new(ns), 1.0)
+            }
+        }
+    }
+
+    /// f(wo, wi) of a rough material (radiance); `None` for the others.
+    fn eval_rough(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Option<Vec3> {
+        let (ng, f, eta) = match self {
+            Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } => self.rough_frame(frame, wo),
+            _ => return None,
+        };
+        let (lo, li) = (f.to_local(wo), f.to_local(wi));
+        Some(match *self {
+            Bsdf::RoughConductor { ks, alpha } if wi.dot(ng) > 0.0 => microfacet::conductor_eval(lo, li, ks, alpha),
+            // Reflection stays on wo's geometric side, refraction crosses it.
+            Bsdf::RoughDielectric { alpha, .. } if (wi.dot(ng) > 0.0) == (li.z > 0.0) => {
+                Vec3::splat(microfacet::dielectric_eval(lo, li, eta, alpha))
+            }
+            _ => Vec3::ZERO,
+        })
+    }
+
+    /// The pdf per steradian with which [`Bsdf::sample`] picks `wi` (non-delta materials; 0 for
+    /// delta ones, whose directions are not in a density).
+    #[must_use]
+    pub fn pdf(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> f32 {
+        match *self {
+            Bsdf::Lambert { .. } => {
+                let (ng, ns) = frame.oriented(wo);
+                if wi.dot(ng) > 0.0 {
+                    wi.dot(ns).max(0.0) / PI
+                } else {
+                    0.0
+                }
+            }
+            Bsdf::Glossy { kd, ks, exponent } => {
+                let (ng, ns) = frame.oriented(wo);
+                if wi.dot(ng) <= 0.0 {
+                    return 0.0;
+                }
+                let p = glossy_diffuse_probability(kd, ks);
+                p * wi.dot(ns).max(0.0) / PI + (1.0 - p) * phong_pdf(reflect(wo, ns), wi, exponent)
+            }
+            Bsdf::RoughConductor { alpha, .. } => {
+                let (ng, f, _) = self.rough_frame(frame, wo);
+                if wi.dot(ng) <= 0.0 {
+                    return 0.0;
+                }
+                microfacet::conductor_pdf(f.to_local(wo), f.to_local(wi), alpha)
+            }
+            Bsdf::RoughDielectric { alpha, .. } => {
+                let (ng, f, eta) = self.rough_frame(frame, wo);
+                let li = f.to_local(wi);
+                if (wi.dot(ng) > 0.0) != (li.z > 0.0) {
+                    return 0.0;
+                }
+                microfacet::dielectric_pdf(f.to_local(wo), li, eta, alpha)
+            }
+            Bsdf::Mirror { .. } | Bsdf::Glass { .. } => 0.0,
+        }
+    }
+
+    /// Samples a rough material; `radiance` picks the transport (refraction scales radiance by
+    /// 1/η², not power). `None` for the others, or when the sample leaves through the wrong side
+    /// of the geometric surface.
+    fn sample_rough(&self, frame: &SurfaceFrame, wo: Vec3, u: [f32; 3], radiance: bool) -> Option<BsdfSample> {
+        let (ng, f, eta) = self.rough_frame(frame, wo);
+        let lo = f.to_local(wo);
+        if lo.z <= 0.0 {
+            return None;
+        }
+        let s = match *self {
+            Bsdf::RoughConductor { ks, alpha } => microfacet::conductor_sample(lo, ks, alpha, [u[0], u[1]])?,
+            Bsdf::RoughDielectric { alpha, .. } => microfacet::dielectric_sample(lo, eta, alpha, u, radiance)?,
+            _ => return None,
+        };
+        let wi = f.to_world(s.wi);
+        ((wi.dot(ng) > 0.0) == (s.wi.z > 0.0)).then_some(BsdfSample { wi, weight: s.weight, delta: false })
     }
 }
 

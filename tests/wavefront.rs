@@ -48,12 +48,15 @@ fn wavefront_matches_reference_per_pixel_on_every_bundled_scene() {
     // channel, about 8 f32 ulps (measured: at most 9e-8).
     let glossy = glossy_spheres();
     let lights = delta_lights();
+    let (smooth_rough, rough) = (rough_spheres(0.2), rough_spheres(0.6));
     let scenes = [
         "cornell-box.toml",
         "cornell-spheres.toml",
         "furnace.toml",
         glossy.to_str().unwrap(),
         lights.to_str().unwrap(),
+        smooth_rough.to_str().unwrap(),
+        rough.to_str().unwrap(),
     ];
     for scene in scenes {
         // The secondary gather at its default (many gather rays landing near: in one-pass
@@ -101,6 +104,22 @@ fn glossy_spheres() -> std::path::PathBuf {
         obj.to_str().unwrap()
     );
     let path = dir.join("glossy-spheres.toml");
+    std::fs::write(&path, toml).unwrap();
+    path
+}
+
+/// The bundled spheres with a rough metal sphere of roughness `r` (below 0.3 photons pass it on
+/// as specular, above they are stored on it) and a frosted glass sphere (photons always pass).
+fn rough_spheres(r: f32) -> std::path::PathBuf {
+    let dir = scratch_dir(&format!("rough-spheres-{r}"));
+    let obj = bundled("cornell-spheres.obj");
+    let toml = format!(
+        "[[mesh]]\nfile = {:?}\n[camera]\neye = [0.0, 0.273, 1.0796]\ntarget = [0.0, 0.273, 0.0]\nfov = 39.3\n\
+         [materials.mirror]\ntype = \"rough_conductor\"\nks = [0.95, 0.7, 0.4]\nroughness = {r}\n\
+         [materials.glass]\ntype = \"rough_dielectric\"\nior = 1.5\nroughness = 0.25\n",
+        obj.to_str().unwrap()
+    );
+    let path = dir.join("rough-spheres.toml");
     std::fs::write(&path, toml).unwrap();
     path
 }

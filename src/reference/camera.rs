@@ -190,7 +190,7 @@ pub fn glossy_reflection(
 ) -> Estimated {
     let Some(ray) = glossy_ray(sp, bsdf, wo, s) else { return Estimated::default() };
     let Some(ChainEnd { point: y, dir: d, beta, .. }) =
-        first_non_specular(ctx, ray.origin, ray.dir, s, streams::GLOSSY_CHAIN_BOUNCE, rays)
+        first_non_specular(ctx, ray.origin, ray.dir, s, streams::GLOSSY_CHAIN_BOUNCE, true, rays)
     else {
         return Estimated::default();
     };

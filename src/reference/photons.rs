@@ -91,7 +91,7 @@ pub fn trace_path(
         };
         let sp = scene.surface(&hit);
         let bsdf = scene.bsdf(&sp);
-        if !bsdf.is_delta() && !deposit_photon(domain, &sp, &photon, bounce, out) {
+        if !bsdf.is_delta() && !deposit_photon(domain, &sp, &bsdf, &photon, bounce, out) {
             break;
         }
         match scatter_photon(&s, &sp, &bsdf, &photon, bounce) {

@@ -30,7 +30,7 @@
 //! rotation = 0                  # degrees about +y
 //!
 //! [materials.sphere]            # replaces the MTL material `sphere`
-//! type = "glass"                # lambert | glossy | mirror | glass
+//! type = "glass"                # lambert | glossy | mirror | glass | rough_conductor | rough_dielectric
 //! ior = 1.5
 //! outside_ior = 1.0             # glass only: the medium the normal points into (nested dielectrics)
 //!
@@ -165,6 +165,24 @@ enum MaterialEntry {
         #[serde(default)]
         emission: Option<[f32; 3]>,
     },
+    #[serde(rename = "rough_conductor")]
+    RoughConductor {
+        #[serde(default = "ones")]
+        ks: [f32; 3],
+        roughness: f32,
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+    #[serde(rename = "rough_dielectric")]
+    RoughDielectric {
+        #[serde(default = "ior_default")]
+        ior: f32,
+        #[serde(default = "one")]
+        outside_ior: f32,
+        roughness: f32,
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
     Glass {
         #[serde(default = "ior_default")]
         ior: f32,
@@ -211,6 +229,18 @@ fn colour(field: &str, v: [f32; 3]) -> Result<Vec3> {
         Err(Error::setting(field, "must not be negative"))
     } else {
         Ok(v)
+    }
+}
+
+/// GGX α of a `roughness` in (0, 1] (α = roughness²; 0 is the smooth `mirror` or `glass`).
+fn roughness_alpha(field: &str, roughness: f32) -> Result<f32> {
+    if roughness > 0.0 && roughness <= 1.0 {
+        Ok(crate::microfacet::alpha_of(roughness))
+    } else {
+        Err(Error::setting(
+            field,
+            format!("must be in (0, 1], found {roughness} (a smooth surface is `mirror` or `glass`)"),
+        ))
     }
 }
 
@@ -325,6 +355,17 @@ impl MaterialEntry {
                 (Bsdf::Glossy { kd, ks, exponent }, emission)
             }
             MaterialEntry::Mirror { ks, emission } => (Bsdf::Mirror { ks: albedo(&f("ks"), ks)? }, emission),
+            MaterialEntry::RoughConductor { ks, roughness, emission } => {
+                let alpha = roughness_alpha(&f("roughness"), roughness)?;
+                (Bsdf::RoughConductor { ks: albedo(&f("ks"), ks)?, alpha }, emission)
+            }
+            MaterialEntry::RoughDielectric { ior, outside_ior, roughness, emission } => {
+                let alpha = roughness_alpha(&f("roughness"), roughness)?;
+                if !(ior > 0.0 && ior.is_finite() && outside_ior > 0.0 && outside_ior.is_finite()) {
+                    return Err(Error::setting(f("ior"), "`ior` and `outside_ior` must be positive numbers"));
+                }
+                (Bsdf::RoughDielectric { ior: ior / outside_ior, alpha }, emission)
+            }
             MaterialEntry::Glass { ior, outside_ior, emission } => {
                 if !(ior > 0.0 && ior.is_finite()) {
                     return Err(Error::setting(f("ior"), "must be a positive number"));

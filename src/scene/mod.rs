@@ -299,7 +299,7 @@ impl Scene {
             used[m as usize] = true;
         }
         for (m, _) in scene.materials.iter().zip(&used).filter(|(_, u)| **u) {
-            scene.kinds.0 |= m.bsdf.is_delta();
+            scene.kinds.0 |= m.bsdf.photon_specular();
             scene.kinds.1 |= matches!(m.bsdf, Bsdf::Glass { .. });
             scene.kinds.2 |= !m.bsdf.is_delta();
         }
@@ -519,7 +519,8 @@ impl Scene {
         self.p0.len()
     }
 
-    /// True if any triangle has a delta (mirror or glass) material.
+    /// True if any triangle has a material photons pass on as specular (mirror, glass, frosted
+    /// glass, a smooth rough metal: [`Bsdf::photon_specular`]): caustics are possible.
     #[must_use]
     pub fn has_delta_surfaces(&self) -> bool {
         self.kinds.0

@@ -4,8 +4,9 @@
 //! | MTL | material |
 //! |---|---|
 //! | `Ke` ≠ 0 | area emitter with radiance `Ke` from the front (counter-clockwise) face, plus the scattering below |
-//! | `illum` 3, 5 or 8 | perfect mirror, reflectance `Ks` (1 if absent) |
-//! | `illum` 4, 6, 7 or 9 | smooth clear dielectric, IOR `Ni` (1.5 if absent), exact Fresnel |
+//! | `illum` 3, 5 or 8 | perfect mirror, reflectance `Ks` (1 if absent); with `Pr` > 0 a GGX rough conductor of α = `Pr`² |
+//! | `illum` 4, 6, 7 or 9 | smooth clear dielectric, IOR `Ni` (1.5 if absent), exact Fresnel; with `Pr` > 0 rough (frosted) |
+//! | `Pm` ≥ 0.5 (PBR metal) | mirror of colour `Kd`; with `Pr` > 0 a rough conductor |
 //! | `illum` 2 with `Ks` > 0 | Lambertian `Kd` + normalised Phong lobe `Ks`, exponent `Ns`; scaled so Kd + Ks ≤ 1 |
 //! | otherwise (`illum` 0, 1, 10, or 2 without `Ks`) | Lambertian `Kd` (0.8 grey if absent) |
 //!
@@ -20,6 +21,7 @@
 use super::validate::number;
 use crate::error::{Error, Result};
 use crate::material::{Bsdf, Material};
+use crate::microfacet::alpha_of;
 use glam::Vec3;
 use std::path::Path;
 
@@ -42,6 +44,10 @@ pub struct MtlMaterial {
     pub ni: Option<f32>,
     /// `illum`.
     pub illum: Option<u8>,
+    /// `Pr` (PBR roughness, 0–1).
+    pub pr: Option<f32>,
+    /// `Pm` (PBR metallic, 0–1).
+    pub pm: Option<f32>,
     /// The texture maps simulated (`map_Kd`, `map_Ks`), in file order.
     pub maps: Vec<MapStatement>,
     /// Statements read but not simulated, in order of first appearance (`map_Ke`, `d`, …).
@@ -212,7 +218,19 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
                     ignore(m, kw);
                 }
             }
-            "sharpness" | "Pr" | "Pm" | "Ps" | "Pc" | "Pcr" | "aniso" | "anisor" => {
+            "Pr" | "Pm" => {
+                let v = one(kw)?;
+                if !(0.0..=1.0).contains(&v) {
+                    let what = if kw == "Pr" { "roughness" } else { "metallic" };
+                    return Err(Error::parse(path, line, format!("`{kw}` ({what}) must be in [0, 1], found {v}")));
+                }
+                if kw == "Pr" {
+                    m.pr = Some(v);
+                } else {
+                    m.pm = Some(v);
+                }
+            }
+            "sharpness" | "Ps" | "Pc" | "Pcr" | "aniso" | "anisor" => {
                 one(kw)?;
                 ignore(m, kw);
             }
@@ -234,6 +252,13 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
                 }
             }
             other => return Err(Error::parse(path, line, format!("unknown MTL statement `{other}`"))),
+        }
+    }
+    for m in &mut out {
+        let rough_kind = matches!(m.illum, Some(3..=9)) || m.pm.is_some_and(|p| p >= 0.5);
+        if m.pr.is_some_and(|r| r > 0.0) && !rough_kind && !m.ignored.iter().any(|s| s == "Pr") {
+            // A rough dielectric coat over a diffuse base (rough plastic) is not built yet.
+            m.ignored.push("Pr on a non-metal".into());
         }
     }
     for m in &out {
@@ -261,10 +286,17 @@ pub fn material_from_mtl(m: &MtlMaterial, warnings: &mut Vec<String>) -> Materia
     let ks_map = m.map("map_Ks").is_some();
     let ks = m.ks.unwrap_or(if ks_map { Vec3::ONE } else { Vec3::ZERO });
     let emission = m.ke.unwrap_or(Vec3::ZERO);
-    let bsdf = match m.illum.unwrap_or(2) {
-        3 | 5 | 8 => Bsdf::Mirror { ks: m.ks.unwrap_or(Vec3::ONE).min(Vec3::ONE) },
-        4 | 6 | 7 | 9 => Bsdf::Glass { ior: m.ni.unwrap_or(1.5) },
-        2 if ks.max_element() > 0.0 => {
+    let rough = m.pr.filter(|&r| r > 0.0).map(alpha_of);
+    let metal = m.pm.is_some_and(|p| p >= 0.5);
+    let bsdf = match (m.illum.unwrap_or(2), rough) {
+        (3 | 5 | 8, None) => Bsdf::Mirror { ks: m.ks.unwrap_or(Vec3::ONE).min(Vec3::ONE) },
+        (3 | 5 | 8, Some(alpha)) => Bsdf::RoughConductor { ks: m.ks.unwrap_or(Vec3::ONE).min(Vec3::ONE), alpha },
+        (4 | 6 | 7 | 9, None) => Bsdf::Glass { ior: m.ni.unwrap_or(1.5) },
+        (4 | 6 | 7 | 9, Some(alpha)) => Bsdf::RoughDielectric { ior: m.ni.unwrap_or(1.5), alpha },
+        // The PBR extension's metals take their colour from `Kd` (the base colour).
+        (_, None) if metal => Bsdf::Mirror { ks: kd.min(Vec3::ONE) },
+        (_, Some(alpha)) if metal => Bsdf::RoughConductor { ks: kd.min(Vec3::ONE), alpha },
+        (2, _) if ks.max_element() > 0.0 => {
             let sum = (kd + ks).max_element();
             let scale = if sum > 1.0 && !ks_map && m.map("map_Kd").is_none() {
                 warnings.push(format!("material `{}`: Kd + Ks = {sum:.3} > 1, scaled down to conserve energy", m.name));
@@ -318,6 +350,25 @@ mod tests {
         assert!(m[1].ignored.is_empty(), "opaque `d 1` and `Tr 0` change nothing");
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].starts_with("m.mtl:1: material `a`") && w[0].contains("`map_Kd options`"), "{w:?}");
+    }
+
+    #[test]
+    fn pbr_roughness_and_metallic_make_rough_materials() {
+        let text = "newmtl metal\nKd 0.9 0.6 0.3\nPm 1\nPr 0.4\nnewmtl frosted\nillum 7\nNi 1.4\nPr 0.5\n\
+                    newmtl chrome\nKd 0.8 0.8 0.8\nPm 1\nPr 0\nnewmtl plastic\nKd 0.5 0.5 0.5\nPr 0.3\n";
+        let (m, w) = parse(text);
+        let m = m.unwrap();
+        let mut w2 = Vec::new();
+        let b: Vec<Bsdf> = m.iter().map(|x| material_from_mtl(x, &mut w2).bsdf).collect();
+        assert_eq!(b[0], Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.6, 0.3), alpha: alpha_of(0.4) });
+        assert_eq!(b[1], Bsdf::RoughDielectric { ior: 1.4, alpha: alpha_of(0.5) });
+        assert_eq!(b[2], Bsdf::Mirror { ks: Vec3::splat(0.8) });
+        assert_eq!(b[3], Bsdf::Lambert { kd: Vec3::splat(0.5) });
+        assert!(w.iter().any(|w| w.contains("`plastic`") && w.contains("Pr on a non-metal")), "{w:?}");
+        for bad in ["Pr 1.5", "Pr -0.1", "Pm 2"] {
+            let e = parse(&format!("newmtl a\n{bad}\n")).0.unwrap_err().to_string();
+            assert!(e.starts_with("m.mtl:2:") && e.contains("must be in [0, 1]"), "{bad}: {e}");
+        }
     }
 
     #[test]

@@ -55,7 +55,7 @@ pub fn trace_gather_rays(
 ) {
     gather_rays(sp, wo, n, s, |g, o, wi| {
         let chain = s.fork(streams::gather_ray(g));
-        if let Some(end) = first_non_specular(ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, rays) {
+        if let Some(end) = first_non_specular(ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, true, rays) {
             read(&end, &chain, rays);
         }
     });
@@ -66,7 +66,7 @@ pub fn trace_gather_rays(
 #[must_use]
 #[inline]
 pub fn glossy_ray(sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler) -> Option<Bounce> {
-    let bs = bsdf.sample_glossy(&sp.frame, wo, [s.get(0, 0), s.get(0, 1)])?;
+    let bs = bsdf.sample_glossy(&sp.frame, wo, [s.get(0, 0), s.get(0, 1), s.get(0, 2)])?;
     Some(Bounce {
         origin: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi),
         dir: bs.wi,

@@ -137,15 +137,20 @@ pub fn start_photon(scene: &Scene, seed: u64, domain: Domain, index: u64) -> Opt
 }
 
 /// At a non-specular hit: stores the photon where its map wants it; returns whether the path
-/// goes on. The caustic pass keeps only paths whose first hit is specular and ends each at its
+/// goes on. A surface that passes photons on as specular ([`Bsdf::photon_specular`]) stores none. The caustic pass keeps only paths whose first hit is specular and ends each at its
 /// first non-specular hit.
 pub fn deposit_photon(
     domain: Domain,
     sp: &SurfacePoint,
+    bsdf: &Bsdf,
     photon: &PhotonRay,
     bounce: u32,
     out: &mut Vec<Photon>,
 ) -> bool {
+    // Smooth rough surfaces and frosted glass pass photons on as specular: nothing stored.
+    if bsdf.photon_specular() {
+        return true;
+    }
     let caustic = domain == Domain::CausticPhoton;
     if caustic && bounce == 0 {
         return false;
@@ -206,7 +211,7 @@ pub fn scatter_photon(s: &Sampler, sp: &SurfacePoint, bsdf: &Bsdf, photon: &Phot
         origin: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi),
         dir: bs.wi,
         power,
-        specular_only: photon.specular_only && bs.delta,
+        specular_only: photon.specular_only && (bs.delta || bsdf.photon_specular()),
     })
 }
 

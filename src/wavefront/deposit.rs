@@ -49,7 +49,7 @@ pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
                     specular_only: queue.specular_only[i],
                 };
                 out.clear();
-                if deposit_photon(domain, &sp, &photon, queue.bounce[i], &mut out) {
+                if deposit_photon(domain, &sp, &scene.bsdf(&sp), &photon, queue.bounce[i], &mut out) {
                     part.survivors.push(lane);
                 }
                 part.deposits.extend(out.drain(..).map(|p| (queue.path[i], queue.bounce[i], p)));

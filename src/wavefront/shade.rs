@@ -8,7 +8,6 @@
 use super::queues::{PathKind, PathQueue, PhotonLane, PhotonQueue, Segment, ShadowLane, ShadowQueue};
 use super::{par_columns, par_lanes, CameraWork, Maps, PhotonWork, Shared, StageStats, CHUNK};
 use crate::film::{PixelMean, Term};
-use crate::material::Bsdf;
 use crate::rng::{Domain, Sampler};
 use crate::stats::Numerics;
 use crate::transport::direct::{direct_light_rays, ShadowRay};
@@ -210,7 +209,7 @@ pub fn spawn_glossy_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
         let sp = scene.surface(&hit);
         let bsdf = &scene.bsdf(&sp);
         // Only glossy materials have the lobe (glossy_ray says so too, after the stream's fork).
-        if !matches!(bsdf, Bsdf::Glossy { .. }) {
+        if !bsdf.has_glossy_lobe() {
             continue;
         }
         let gls = Sampler::from_key(w.paths.key[i]).fork(streams::glossy(w.paths.depth[i]));
