@@ -516,3 +516,210 @@ target = [0.0, -0.1, 0.0]
 fov = 50''', f'{boundary}')
 
 nested("hard")
+
+# ---- real-looking scenes (issue 17): textures, rough materials, sun and sky ------------------
+
+import struct, zlib
+
+def write_png(path, w, h, pixel):
+    """An 8-bit RGB PNG whose texel (x, y) (row y from the top) is pixel(x, y) -> (r, g, b)."""
+    raw = b"".join(b"\x00" + bytes(c for x in range(w) for c in pixel(x, y)) for y in range(h))
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff)
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+
+def wood(x, y):
+    """Planks along u: a warm brown with rings and a darker seam every 64 texels."""
+    ring = 0.5 + 0.5 * math.sin(0.21 * y + 3.0 * math.sin(0.031 * x + 0.05 * y))
+    seam = 0.55 if y % 64 in (0, 1) else 1.0
+    k = (0.78 + 0.22 * ring) * seam
+    return (int(150 * k), int(96 * k), int(54 * k))
+
+def tiles(x, y):
+    """Terracotta and cream tiles, 64 texels a side, with grey grout."""
+    if x % 64 < 3 or y % 64 < 3:
+        return (120, 118, 112)
+    return (176, 92, 60) if (x // 64 + y // 64) % 2 else (222, 208, 180)
+
+def box_faces(o, name, material, lo, hi, inward=False):
+    """The six faces of an axis-aligned box, facing out (or in)."""
+    c = tuple((lo[i] + hi[i]) / 2 for i in range(3))
+    for axis in range(3):
+        for v in (lo[axis], hi[axis]):
+            u, w = (axis + 1) % 3, (axis + 2) % 3
+            pts = []
+            for a, b in [(lo[u], lo[w]), (hi[u], lo[w]), (hi[u], hi[w]), (lo[u], hi[w])]:
+                p = [0.0, 0.0, 0.0]; p[axis], p[u], p[w] = v, a, b
+                pts.append(tuple(p))
+            facing = [0.0, 0.0, 0.0]; facing[axis] = (v - c[axis]) * (-1 if inward else 1)
+            o.quad(f"{name}_{'xyz'[axis]}{'-' if v == lo[axis] else '+'}", material, pts, tuple(facing))
+
+def textured_quad(o, name, material, pts, uvs, facing):
+    """A quad with texture coordinates (one `vt` per corner)."""
+    n = cross(sub(pts[1], pts[0]), sub(pts[2], pts[0]))
+    if dot(n, facing) < 0:
+        pts, uvs = pts[::-1], uvs[::-1]
+    o.lines += [f"o {name}", f"usemtl {material}"]
+    o.lines += ["v %.6f %.6f %.6f" % p for p in pts]
+    o.lines += ["vt %.6f %.6f" % t for t in uvs]
+    base_t = sum(1 for l in o.lines if l.startswith("vt ")) - 4
+    o.lines.append("f " + " ".join(f"{o.nv + 1 + i}/{base_t + 1 + i}" for i in range(4)))
+    o.nv += 4
+
+def cylinder(o, name, material, centre, radius, y0, y1, inward=False, seg=96):
+    """The side of a vertical cylinder, facing out (or toward its axis)."""
+    cx, cz = centre
+    for s in range(seg):
+        a0, a1 = 2 * math.pi * s / seg, 2 * math.pi * (s + 1) / seg
+        p = [(cx + radius * math.cos(a), y, cz + radius * math.sin(a)) for a, y in [(a0, y0), (a1, y0), (a1, y1), (a0, y1)]]
+        out = (math.cos(a0 + math.pi / seg), 0.0, math.sin(a0 + math.pi / seg))
+        o.quad(f"{name}{s}", material, p, tuple(-c for c in out) if inward else out)
+
+def annulus(o, name, material, centre, r0, r1, y, up, seg=96):
+    """A flat ring (a disk when r0 = 0) at height y facing up or down."""
+    cx, cz = centre
+    for s in range(seg):
+        a0, a1 = 2 * math.pi * s / seg, 2 * math.pi * (s + 1) / seg
+        if r0 == 0:
+            p = [(cx, y, cz), (cx + r1 * math.cos(a0), y, cz + r1 * math.sin(a0)), (cx + r1 * math.cos(a1), y, cz + r1 * math.sin(a1))]
+        else:
+            p = [(cx + r0 * math.cos(a0), y, cz + r0 * math.sin(a0)), (cx + r1 * math.cos(a0), y, cz + r1 * math.sin(a0)),
+                 (cx + r1 * math.cos(a1), y, cz + r1 * math.sin(a1)), (cx + r0 * math.cos(a1), y, cz + r0 * math.sin(a1))]
+        o.quad(f"{name}{s}", material, p, (0, 1 if up else -1, 0))
+
+def real_scenes():
+    raw = lambda p: p
+    # A small glass ball in a large room: 8 x 3 x 6 m, a 0.5 m ceiling light, a 10 cm ball.
+    o = Obj("glass-in-room.mtl", convert=raw)
+    box_faces(o, "room", "wall", (-4, 0, -3), (4, 3, 3), inward=True)
+    o.quad("light", "light", [(-0.25, 2.999, -0.25), (0.25, 2.999, -0.25), (0.25, 2.999, 0.25), (-0.25, 2.999, 0.25)], (0, -1, 0))
+    o.sphere("ball", "glass", (0.5, 0.1, 0.5), 0.1)
+    o.write("glass-in-room.obj")
+    mtl("glass-in-room.mtl", [("wall", "illum 1\nKd 0.7 0.7 0.7"), ("light", "illum 1\nKd 0 0 0\nKe 40 36 30"),
+                              ("glass", "illum 7\nNi 1.5")])
+    with open("glass-in-room.toml", "w") as f:
+        f.write('''# A 10 cm glass ball in an 8 x 3 x 6 m room under a 0.5 m ceiling light, written by
+# scenes/generate.py: caustic photons emitted blindly almost never reach the ball; aimed ones do.
+[[mesh]]
+file = "glass-in-room.obj"
+
+[camera]
+eye = [0.5, 0.9, 1.6]
+target = [0.5, 0.05, 0.45]
+fov = 35
+''')
+
+    # A glass of water and a gold ring on a wooden table, under a sky and a low sun.
+    o = Obj("table.mtl", convert=raw)
+    textured_quad(o, "table", "wood", [(-0.4, -0.0005, -0.4), (0.4, -0.0005, -0.4), (0.4, -0.0005, 0.4), (-0.4, -0.0005, 0.4)],
+                  [(0, 1), (1, 1), (1, 0), (0, 0)], (0, 1, 0))
+    g, ro, ri, h, bottom, level = (0.09, -0.06), 0.035, 0.031, 0.11, 0.008, 0.075
+    cylinder(o, "glass_out", "glass", g, ro, 0.0, h)
+    annulus(o, "glass_base", "glass", g, 0.0, ro, 0.0, up=False)
+    annulus(o, "glass_rim", "glass", g, ri, ro, h, up=True)
+    cylinder(o, "glass_in_air", "glass_inside", g, ri, level, h, inward=True)
+    cylinder(o, "glass_in_water", "water_on_glass", g, ri, bottom, level, inward=True)
+    annulus(o, "glass_floor", "water_on_glass", g, 0.0, ri, bottom, up=True)
+    annulus(o, "water_surface", "water", g, 0.0, ri, level, up=True)
+    r, (rx, rz), rh, rt = 0.032, (-0.08, 0.05), 0.012, 0.0025
+    cylinder(o, "ring_out", "gold", (rx, rz), r + rt, 0.0, rh)
+    cylinder(o, "ring_in", "gold", (rx, rz), r, 0.0, rh, inward=True)
+    annulus(o, "ring_top", "gold", (rx, rz), r, r + rt, rh, up=True)
+    annulus(o, "ring_bottom", "gold", (rx, rz), r, r + rt, 0.0, up=False)
+    o.write("table.obj")
+    write_png("wood.png", 256, 256, wood)
+    mtl("table.mtl", [("wood", "illum 1\nKd 1 1 1\nmap_Kd wood.png"), ("glass", "illum 7\nNi 1.5"),
+                      ("glass_inside", "illum 7\nNi 1.5"), ("water", "illum 7\nNi 1.33"),
+                      ("water_on_glass", "illum 7\nNi 1.33"), ("gold", "illum 3\nKs 1.0 0.78 0.34")])
+    with open("table.toml", "w") as f:
+        f.write('''# A glass of water and a gold ring on a wooden table (map_Kd wood.png) under a blue sky and a
+# low sun, written by scenes/generate.py: the ring's cardioid, the glass's caustic, soft shadows.
+[[mesh]]
+file = "table.obj"
+
+[camera]
+eye = [0.0, 0.22, 0.36]
+target = [0.0, 0.03, 0.0]
+fov = 38
+
+[[light]]
+type = "sun"
+direction = [0.45, -0.45, -0.77]
+irradiance = [2.9, 2.75, 2.5]
+angle = 0.27
+
+[environment]
+radiance = [0.2, 0.26, 0.38]
+
+# The glass's inner wall below the water and its floor: one face between glass (inside, the
+# side the normal points away from) and water.
+[materials.water_on_glass]
+type = "glass"
+ior = 1.5
+outside_ior = 1.33
+''')
+
+    # A room lit only through a glass window pane: sun and sky outside.
+    o = Obj("window.mtl", convert=raw)
+    W, H, D = 2.0, 2.6, 2.0
+    textured_quad(o, "floor", "tiles", [(-W, 0, -D), (W, 0, -D), (W, 0, D), (-W, 0, D)],
+                  [(0, 4), (4, 4), (4, 0), (0, 0)], (0, 1, 0))
+    o.quad("ceiling", "wall", [(-W, H, -D), (W, H, -D), (W, H, D), (-W, H, D)], (0, -1, 0))
+    o.quad("left", "wall", [(-W, 0, -D), (-W, H, -D), (-W, H, D), (-W, 0, D)], (1, 0, 0))
+    o.quad("right", "wall", [(W, 0, -D), (W, H, -D), (W, H, D), (W, 0, D)], (-1, 0, 0))
+    o.quad("front", "wall", [(-W, 0, D), (W, 0, D), (W, H, D), (-W, H, D)], (0, 0, -1))
+    x0, x1, y0, y1 = -0.7, 0.7, 0.9, 2.0
+    for name, pts in [("back_low", [(-W, 0), (W, 0), (W, y0), (-W, y0)]), ("back_high", [(-W, y1), (W, y1), (W, H), (-W, H)]),
+                      ("back_left", [(-W, y0), (x0, y0), (x0, y1), (-W, y1)]), ("back_right", [(x1, y0), (W, y0), (W, y1), (x1, y1)])]:
+        o.quad(name, "wall", [(x, y, -D) for x, y in pts], (0, 0, 1))
+    box_faces(o, "pane", "glass", (x0, y0, -D - 0.006), (x1, y1, -D + 0.006))
+    o.write("window.obj")
+    write_png("tiles.png", 256, 256, tiles)
+    mtl("window.mtl", [("wall", "illum 1\nKd 0.75 0.73 0.7"), ("tiles", "illum 1\nKd 1 1 1\nmap_Kd tiles.png"),
+                       ("glass", "illum 7\nNi 1.5")])
+    with open("window.toml", "w") as f:
+        f.write('''# A closed room whose only opening is a glass window pane, written by scenes/generate.py: sun
+# and sky reach the tiled floor (map_Kd tiles.png) only through glass, a path tracer's worst case.
+[[mesh]]
+file = "window.obj"
+
+[camera]
+eye = [1.5, 1.5, 1.9]
+target = [-0.2, 0.6, -1.0]
+fov = 60
+
+[[light]]
+type = "sun"
+direction = [0.25, -0.55, 0.8]
+irradiance = [5.0, 4.8, 4.4]
+
+[environment]
+radiance = [0.8, 1.0, 1.4]
+''')
+
+    with open("cornell-rough.toml", "w") as f:
+        f.write('''# The Cornell spheres with a brushed-gold metal sphere (roughness 0.35: its photons are stored)
+# and a frosted glass sphere (roughness 0.3: photons pass it as specular), written by
+# scenes/generate.py.
+[[mesh]]
+file = "cornell-spheres.obj"
+
+[camera]
+eye = [0.0, 0.273, 1.0796]
+target = [0.0, 0.273, 0.0]
+fov = 39.3
+
+[materials.mirror]
+type = "rough_conductor"
+ks = [1.0, 0.78, 0.34]
+roughness = 0.35
+
+[materials.glass]
+type = "rough_dielectric"
+ior = 1.5
+roughness = 0.3
+''')
+
+real_scenes()

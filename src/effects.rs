@@ -17,11 +17,21 @@ impl Effects {
         let glass = scene.has_glass();
         let forced = |name: &str| settings.force.iter().any(|f| f == name);
         let caustic_map = match (delta, diffuse) {
-            (true, true) => Part::new(
-                true,
-                "mirror or glass surfaces (or frosted glass, or metal with roughness below 0.3, which pass photons \
-                 on as specular) can focus light onto diffuse surfaces",
-            ),
+            (true, true) => {
+                let aimed = match scene.caustic_targets.len() {
+                    n if settings.aim_caustics && n > 0 => {
+                        format!("; its photons are aimed at {n} specular object{}", if n == 1 { "" } else { "s" })
+                    }
+                    _ => String::new(),
+                };
+                Part::new(
+                    true,
+                    format!(
+                        "mirror or glass surfaces (or frosted glass, or metal with roughness below 0.3, which pass \
+                         photons on as specular) can focus light onto diffuse surfaces{aimed}"
+                    ),
+                )
+            }
             _ if forced("caustic_map") => Part::new(true, "forced on by the `force` setting"),
             (false, _) => Part::new(false, "no mirror or glass in the scene"),
             (true, false) => Part::new(false, "no diffuse surface to receive caustics"),

@@ -20,10 +20,14 @@
 //! - [`code_path`]: the SIMD kernels or their scalar twins, for traversal and photon lookups;
 //!
 //! **Data** — records and their own methods:
-//! - [`material`]: BSDFs (Lambert, glossy Phong, mirror, glass) and Fresnel;
+//! - [`texture`]: image textures, bilinear lookups, sRGB decoding;
+//! - [`optics`]: reflection, refraction and Fresnel at a smooth interface;
+//! - [`microfacet`]: GGX rough conductors and dielectrics (eval, pdf, visible-normal sampling);
+//! - [`material`]: BSDFs (Lambert, glossy Phong, mirror, glass, the rough ones) and their textures;
 //! - [`photon_map`]: the 20-byte photon, the kd-tree, k-NN and fixed-radius density estimates;
 //! - [`settings`]: the user's knobs, their layering and validation;
-//! - [`scene`]: OBJ/MTL and TOML loading, lights, the camera;
+//! - [`scene`]: OBJ/MTL and TOML loading, image files, lights (area, point, spot, directional,
+//!   sun, environment), caustic targets, the camera;
 //! - [`plan`] and [`effects`]: the effects plan — which terms and machinery a scene needs, and why;
 //! - [`stats`]: plain records of what a render did (rays, times, maps, numerics);
 //! - [`film`]: the five [`film::Term`]s per pixel, EXR and PNG output;
@@ -34,7 +38,7 @@
 //!
 //! **Physics** — written once:
 //! - [`transport`]: every vertex both engines and the path tracer share — camera samples,
-//!   photon emission, deposit and scattering, direct light, gather and glossy rays, the
+//!   photon emission (caustic photons aimed at specular objects), deposit and scattering, direct light, gather and glossy rays, the
 //!   specular continuation, density estimates, the random-stream layout;
 //!
 //! **Engines** — loops over the transport core:
@@ -73,6 +77,7 @@ pub mod material;
 pub mod memory;
 pub mod merge;
 pub mod microfacet;
+pub mod optics;
 pub mod parallel;
 pub mod partial;
 pub mod pass_set;

@@ -9,7 +9,7 @@
 //! surface is a little darker than a real one (at α = 1 a white conductor keeps about 80 % of
 //! its light at normal incidence; the tests measure it).
 
-use crate::material::fresnel_dielectric;
+use crate::optics::{fresnel_dielectric, refract};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -198,7 +198,7 @@ pub fn dielectric_sample(wo: Vec3, eta: f32, alpha: f32, u: [f32; 3], radiance: 
         }
         return Some(LocalSample { wi, weight: Vec3::splat(g2(wo, wi, alpha) / g1(wo, alpha)) });
     }
-    let wi = crate::material::refract(wo, m, eta)?;
+    let wi = refract(wo, m, eta)?;
     if wi.z >= 0.0 {
         return None;
     }

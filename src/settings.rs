@@ -140,6 +140,11 @@ pub struct Settings {
     /// `photons.global` to the EXR (`crate::diagnostics`): where the estimates are starved or
     /// blurred. Costs one pass's photon tracing again. Off by default.
     pub diagnostics: bool,
+    /// Caustic photons are emitted only toward the bounding spheres of the objects that make
+    /// caustics (mirrors, glass, frosted glass, smooth rough metal), their power divided by the
+    /// aimed pdf (`transport::aim`): the same caustic map in expectation from far fewer emitted
+    /// paths. `false` emits them as the global photons are, for comparison.
+    pub aim_caustics: bool,
 }
 
 impl Default for Settings {
@@ -172,6 +177,7 @@ impl Default for Settings {
             visibility: false,
             boundary_correction: true,
             diagnostics: false,
+            aim_caustics: true,
         }
     }
 }
@@ -241,6 +247,8 @@ pub struct Overrides {
     pub visibility: bool,
     /// `--no-boundary-correction`.
     pub no_boundary_correction: bool,
+    /// `--no-aim-caustics`.
+    pub no_aim_caustics: bool,
     /// `--diagnostics` (turns them on; the scene file may too).
     pub diagnostics: bool,
     /// `--force`, added to the scene file's.
@@ -284,6 +292,9 @@ impl Overrides {
         s.diagnostics |= self.diagnostics;
         if self.no_boundary_correction {
             s.boundary_correction = false;
+        }
+        if self.no_aim_caustics {
+            s.aim_caustics = false;
         }
         let given = PerPass {
             spp: self.spp.is_some(),

@@ -240,7 +240,11 @@ impl RenderStats {
         let over = self.progressive.as_ref().map_or(String::new(), |p| format!(" in all {} passes", p.passes));
         let map = |name: &str, m: &MapStats| {
             if m.built {
-                format!("  {name:<8} map: {} photons stored from {} emitted paths{over}\n", m.stored, m.emitted)
+                let per = if m.emitted > 0 { m.stored as f64 / m.emitted as f64 } else { 0.0 };
+                format!(
+                    "  {name:<8} map: {} photons stored from {} emitted paths{over} ({per:.3} per path)\n",
+                    m.stored, m.emitted
+                )
             } else {
                 format!("  {name:<8} map: not built — {}\n", m.reason)
             }

@@ -21,13 +21,13 @@ const GOLDEN: &[(&str, &str, u32, u64)] = &[
     ("cornell-box.toml", "wavefront", 1, 0x1dea3d005dd55068),
     ("cornell-box.toml", "reference", 1, 0x639845c897ccbb69),
     ("cornell-box.toml", "path", 1, 0xd3159bbc928efad9),
-    ("cornell-spheres.toml", "wavefront", 1, 0xab7cc38beda27241),
-    ("cornell-spheres.toml", "reference", 1, 0x097fd32560bbeed9),
-    ("cornell-spheres.toml", "wavefront", 3, 0xad49c1f67ebdc338),
-    ("cornell-spheres.toml", "reference", 3, 0xe80171f19efc2b6a),
-    ("hard/furnace-materials.toml", "wavefront", 1, 0x1cf768ef8f207d03),
-    ("hard/furnace-materials.toml", "reference", 1, 0x955056ae583b84cf),
-    ("hard/nested.toml", "wavefront", 2, 0x46cd5f5de20fcd71),
+    ("cornell-spheres.toml", "wavefront", 1, 0x4efa6111b3f00857),
+    ("cornell-spheres.toml", "reference", 1, 0xcf28f091ff0e045d),
+    ("cornell-spheres.toml", "wavefront", 3, 0x160d3adca67771c7),
+    ("cornell-spheres.toml", "reference", 3, 0x951152e606799b1f),
+    ("hard/furnace-materials.toml", "wavefront", 1, 0x7c9f828ee156795c),
+    ("hard/furnace-materials.toml", "reference", 1, 0x6315b918a5bd669e),
+    ("hard/nested.toml", "wavefront", 2, 0x4344acbc2a84072c),
 ];
 
 /// FNV-1a over the bits of every term of every pixel, in film order.

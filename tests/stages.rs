@@ -119,13 +119,15 @@ fn emit_photons_starts_a_batch_like_the_reference() {
     let q = &w.resource::<PhotonWork>().queue;
     assert_eq!(q.len(), photonwave::transport::photon::BATCH);
     for k in [0usize, 777, 16_383] {
-        let p = photonwave::transport::photon::start_photon(
+        let photonwave::transport::photon::Start::Photon(p) = photonwave::transport::photon::start_photon(
             &shared.scene,
             shared.job.pass.seed,
             Domain::GlobalPhoton,
             q.path[k],
-        )
-        .unwrap();
+            true,
+        ) else {
+            panic!("path {k} starts no photon")
+        };
         assert_eq!((q.rays.origin(k), q.rays.direction(k), q.power[k]), (p.origin, p.dir, p.power));
         assert_eq!(q.path[k], 5 * 16_384 + k as u64);
     }

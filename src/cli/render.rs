@@ -79,6 +79,10 @@ pub struct RenderArgs {
     /// surface (edges and corners then come out darker; for comparison) [on].
     #[arg(long)]
     pub no_boundary_correction: bool,
+    /// Emit caustic photons in every direction, as global photons are, instead of aiming them at
+    /// the mirrors, glass and smooth rough metal that make caustics (for comparison) [aimed].
+    #[arg(long)]
+    pub no_aim_caustics: bool,
     /// Add diagnostic EXR layers: per pixel, the radius and photon count of the caustic and the
     /// global density estimates (`radius.caustic`, `photons.caustic`, `radius.global`,
     /// `photons.global`), probed at one camera sample of the last pass; costs one pass's photon
@@ -190,6 +194,7 @@ fn overrides(args: &RenderArgs) -> Overrides {
         code_path: args.code_path,
         gather_rays: args.gather_rays,
         no_final_gather: args.no_final_gather,
+        no_aim_caustics: args.no_aim_caustics,
         secondary_gather: args.secondary_gather,
         visibility: args.visibility,
         no_boundary_correction: args.no_boundary_correction,

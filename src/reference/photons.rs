@@ -9,7 +9,7 @@ use crate::progress::Progress;
 use crate::rng::{Domain, Sampler};
 use crate::scene::Scene;
 use crate::stats::Numerics;
-use crate::transport::photon::{deposit_photon, scatter_photon, start_photon, Scattered, Tally, BATCH};
+use crate::transport::photon::{deposit_photon, scatter_photon, start_photon, Scattered, Start, Tally, BATCH};
 
 /// Paths per work chunk inside a batch.
 const CHUNK: usize = 1024;
@@ -78,9 +78,13 @@ pub fn trace_path(
     rays: &mut u64,
     numerics: &mut Numerics,
 ) {
-    let Some(mut photon) = start_photon(scene, job.pass.seed, domain, index) else {
-        numerics.photon_emission += 1;
-        return;
+    let mut photon = match start_photon(scene, job.pass.seed, domain, index, job.settings.aim_caustics) {
+        Start::Photon(p) => p,
+        Start::Dark => return,
+        Start::NonFinite => {
+            numerics.photon_emission += 1;
+            return;
+        }
     };
     let s = Sampler::new(job.pass.seed, domain, index);
     for bounce in 0..job.settings.max_depth {

@@ -11,6 +11,7 @@ pub mod light;
 pub mod mtl;
 pub mod obj;
 pub mod open_edges;
+pub mod targets;
 pub mod validate;
 
 use crate::error::{Error, Result};
@@ -109,6 +110,9 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// Edges bordering one triangle, listed per triangle of their flat region.
     pub open_edges: open_edges::OpenEdges,
+    /// Bounding spheres of the objects photons pass on as specular: where caustic photons are
+    /// aimed.
+    pub caustic_targets: Vec<targets::Target>,
     bvh: Bvh,
     /// (any delta, any glass, any non-delta) material on a triangle, computed once.
     kinds: (bool, bool, bool),
@@ -293,6 +297,7 @@ impl Scene {
             bvh,
             kinds: (false, false, false),
             open_edges: open_edges::OpenEdges::default(),
+            caustic_targets: Vec::new(),
         };
         let mut used = vec![false; scene.materials.len()];
         for &m in &scene.material {
@@ -328,6 +333,7 @@ impl Scene {
         let edges = scene.edge_uses();
         scene.encloses_lights = scene.find_enclosure(&edges);
         scene.open_edges = scene.find_open_edges(scene.diagonal().max(f32::MIN_POSITIVE), &edges);
+        scene.caustic_targets = scene.find_caustic_targets(&edges);
         Ok(scene)
     }
 

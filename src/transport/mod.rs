@@ -16,6 +16,7 @@
 //! ([`specular::first_non_specular`]). The loops over paths, bounces and queues belong to the
 //! engines.
 
+pub mod aim;
 pub mod camera;
 pub mod direct;
 pub mod estimate;

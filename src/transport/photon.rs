@@ -111,19 +111,40 @@ pub struct PhotonRay {
     pub specular_only: bool,
 }
 
-/// Starts photon path `index` of `domain` with the random streams of `seed`: picks a light by power and samples its emission.
-/// `None` if the emission is not finite.
+/// How a photon path starts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Start {
+    /// A photon leaves the light.
+    Photon(PhotonRay),
+    /// The sample carries no light: an aimed caustic photon behind its area light or outside
+    /// its spot's cone. The path counts as emitted and stores nothing.
+    Dark,
+    /// The emission is not finite (dropped and counted).
+    NonFinite,
+}
+
+/// Starts photon path `index` of `domain` with the random streams of `seed`: picks a light by
+/// power and samples its emission; with `aim` the caustic pass aims at the scene's specular
+/// objects ([`super::aim`]).
 #[must_use]
-pub fn start_photon(scene: &Scene, seed: u64, domain: Domain, index: u64) -> Option<PhotonRay> {
+pub fn start_photon(scene: &Scene, seed: u64, domain: Domain, index: u64, aim: bool) -> Start {
     let s = Sampler::new(seed, domain, index);
     let li = scene.light_power.sample(s.get(0, 0));
     let pmf = scene.light_power.pmf(li) as f32;
     let light = &scene.lights[li];
     let tri = scene.light_triangle(light);
-    let em = scene.sample_emission(light, [s.get(0, 1), s.get(0, 2), s.get(0, 3), s.get(0, 4)]);
+    let u = [s.get(0, 1), s.get(0, 2), s.get(0, 3), s.get(0, 4)];
+    let em = if aim && domain == Domain::CausticPhoton && !scene.caustic_targets.is_empty() {
+        match super::aim::aimed_emission(scene, light, [u[0], u[1], u[2], u[3], s.get(0, 5)]) {
+            Some(em) => em,
+            None => return Start::Dark,
+        }
+    } else {
+        scene.sample_emission(light, u)
+    };
     let power = em.power / pmf;
     if !power.is_finite() || !em.direction.is_finite() {
-        return None;
+        return Start::NonFinite;
     }
     let origin = match (em.normal, tri) {
         (Some(n), Some(t)) => {
@@ -133,7 +154,7 @@ pub fn start_photon(scene: &Scene, seed: u64, domain: Domain, index: u64) -> Opt
         }
         _ => em.origin,
     };
-    Some(PhotonRay { origin, dir: em.direction, power, specular_only: true })
+    Start::Photon(PhotonRay { origin, dir: em.direction, power, specular_only: true })
 }
 
 /// At a non-specular hit: stores the photon where its map wants it; returns whether the path

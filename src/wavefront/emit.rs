@@ -6,7 +6,7 @@ use super::{par_columns, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
 use crate::film::{Term, Terms};
 use crate::rng::Domain;
 use crate::transport::camera::camera_sample;
-use crate::transport::photon::{start_photon, BATCH};
+use crate::transport::photon::{start_photon, Start, BATCH};
 use crate::transport::streams;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -30,8 +30,8 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
         |r, part: &mut (PhotonQueue, u64)| {
             for i in r {
                 let path = first + i as u64;
-                match start_photon(scene, seed, domain, path) {
-                    Some(p) => part.0.push(PhotonLane {
+                match start_photon(scene, seed, domain, path, shared.job.settings.aim_caustics) {
+                    Start::Photon(p) => part.0.push(PhotonLane {
                         origin: p.origin,
                         dir: p.dir,
                         path,
@@ -39,7 +39,8 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
                         power: p.power,
                         specular_only: true,
                     }),
-                    None => part.1 += 1,
+                    Start::Dark => {}
+                    Start::NonFinite => part.1 += 1,
                 }
             }
         },
