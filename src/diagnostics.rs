@@ -47,7 +47,7 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
         } else if gather_on {
             let (mut sum, mut hits) = ([0.0f64; 2], 0u32);
             let gather = s.fork(streams::gather(0));
-            trace_gather_rays(&ctx, sp, -d, settings.gather_rays, &gather, counts, |end, _, _| {
+            trace_gather_rays(&ctx, sp, -d, settings.gather_rays, &gather, counts, |end, _, _, _| {
                 let bsdf = &scene.bsdf(&end.point);
                 let e = global_estimate(&ctx, &end.point, bsdf, -end.dir, 0, None, scratch);
                 sum[0] += f64::from(e.radius);

@@ -45,6 +45,9 @@ pub enum Bsdf {
     /// Rough (frosted) clear dielectric: GGX of width `alpha`, exact Fresnel, reflection and
     /// refraction through the microfacets; `ior` as for [`Bsdf::Glass`].
     RoughDielectric { ior: f32, alpha: f32 },
+    /// Rough plastic: a GGX dielectric coat (index `ior`, width `alpha`) over a Lambertian base
+    /// `kd` ([`microfacet::plastic_eval`]).
+    RoughPlastic { kd: Vec3, ior: f32, alpha: f32 },
 }
 
 /// The GGX α below which a rough conductor acts as a mirror for photons (roughness 0.3): its
@@ -113,6 +116,7 @@ impl Material {
             }
             Bsdf::Mirror { ks } => Bsdf::Mirror { ks: ks_at(ks).min(Vec3::ONE) },
             Bsdf::RoughConductor { ks, alpha } => Bsdf::RoughConductor { ks: ks_at(ks).min(Vec3::ONE), alpha },
+            Bsdf::RoughPlastic { kd, ior, alpha } => Bsdf::RoughPlastic { kd: kd_at(kd).min(Vec3::ONE), ior, alpha },
             b @ (Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. }) => b,
         }
     }
@@ -177,14 +181,42 @@ impl Bsdf {
     /// reflection): Phong glossy and the rough materials.
     #[must_use]
     pub fn has_glossy_lobe(&self) -> bool {
-        matches!(self, Bsdf::Glossy { .. } | Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. })
+        matches!(
+            self,
+            Bsdf::Glossy { .. }
+                | Bsdf::RoughConductor { .. }
+                | Bsdf::RoughDielectric { .. }
+                | Bsdf::RoughPlastic { .. }
+        )
+    }
+
+    /// Whether a final-gather ray's weight depends on its direction ([`Bsdf::gather_weight`]):
+    /// only for the rough plastic, whose base is seen through its coat.
+    #[must_use]
+    pub fn gather_varies(&self) -> bool {
+        matches!(self, Bsdf::RoughPlastic { .. })
+    }
+
+    /// The weight of a cosine-sampled final-gather ray `wi` from the diffuse part: `kd` for
+    /// Lambertian and glossy materials (the 1/π and the cosine cancel), the base's
+    /// kd·(1 − F(wo))·(1 − F(wi)) for the rough plastic.
+    #[must_use]
+    pub fn gather_weight(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Vec3 {
+        match *self {
+            Bsdf::RoughPlastic { kd, ior, .. } => {
+                let (_, ns) = frame.oriented(wo);
+                let f = Frame::new(ns);
+                microfacet::plastic_base(f.to_local(wo), f.to_local(wi), kd, ior)
+            }
+            _ => self.diffuse(),
+        }
     }
 
     /// The Lambertian albedo (zero for delta materials).
     #[must_use]
     pub fn diffuse(&self) -> Vec3 {
         match *self {
-            Bsdf::Lambert { kd } | Bsdf::Glossy { kd, .. } => kd,
+            Bsdf::Lambert { kd } | Bsdf::Glossy { kd, .. } | Bsdf::RoughPlastic { kd, .. } => kd,
             _ => Vec3::ZERO,
         }
     }
@@ -273,18 +305,29 @@ impl Bsdf {
                 (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: ks, delta: true })
             }
             Bsdf::Glass { ior } => sample_glass(frame, wo, ior, u[0], transport),
-            Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } => {
+            Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } | Bsdf::RoughPlastic { .. } => {
                 self.sample_rough(frame, wo, u, transport == Transport::Radiance)
             }
         })
     }
 
     /// Samples the glossy lobe alone (radiance): for Phong, weight `ks·(n+2)/(n+1)·cos θi`; for
-    /// the rough materials, the whole BSDF. `None` for other materials.
+    /// the rough conductor and dielectric, the whole BSDF; for the rough plastic, its coat (its
+    /// base is the final gather's). `None` for other materials.
     #[must_use]
     pub fn sample_glossy(&self, frame: &SurfaceFrame, wo: Vec3, u: [f32; 3]) -> Option<BsdfSample> {
         if let Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } = self {
             return self.sample_rough(frame, wo, u, true);
+        }
+        if let Bsdf::RoughPlastic { ior, alpha, .. } = *self {
+            let (ng, f, _) = self.rough_frame(frame, wo);
+            let lo = f.to_local(wo);
+            if lo.z <= 0.0 {
+                return None;
+            }
+            let s = microfacet::plastic_coat_sample(lo, ior, alpha, [u[0], u[1]])?;
+            let wi = f.to_world(s.wi);
+            return (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: s.weight, delta: false });
         }
         let Bsdf::Glossy { ks, exponent, .. } = *self else { return None };
         let (ng, ns) = frame.oriented(wo);
@@ -318,12 +361,17 @@ impl Bsdf {
     /// f(wo, wi) of a rough material (radiance); `None` for the others.
     fn eval_rough(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Option<Vec3> {
         let (ng, f, eta) = match self {
-            Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } => self.rough_frame(frame, wo),
+            Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } | Bsdf::RoughPlastic { .. } => {
+                self.rough_frame(frame, wo)
+            }
             _ => return None,
         };
         let (lo, li) = (f.to_local(wo), f.to_local(wi));
         Some(match *self {
             Bsdf::RoughConductor { ks, alpha } if wi.dot(ng) > 0.0 => microfacet::conductor_eval(lo, li, ks, alpha),
+            Bsdf::RoughPlastic { kd, ior, alpha } if wi.dot(ng) > 0.0 => {
+                microfacet::plastic_eval(lo, li, kd, ior, alpha)
+            }
             // Reflection stays on wo's geometric side, refraction crosses it.
             Bsdf::RoughDielectric { alpha, .. } if (wi.dot(ng) > 0.0) == (li.z > 0.0) => {
                 Vec3::splat(microfacet::dielectric_eval(lo, li, eta, alpha))
@@ -360,6 +408,13 @@ impl Bsdf {
                 }
                 microfacet::conductor_pdf(f.to_local(wo), f.to_local(wi), alpha)
             }
+            Bsdf::RoughPlastic { kd, ior, alpha } => {
+                let (ng, f, _) = self.rough_frame(frame, wo);
+                if wi.dot(ng) <= 0.0 {
+                    return 0.0;
+                }
+                microfacet::plastic_pdf(f.to_local(wo), f.to_local(wi), kd, ior, alpha)
+            }
             Bsdf::RoughDielectric { alpha, .. } => {
                 let (ng, f, eta) = self.rough_frame(frame, wo);
                 let li = f.to_local(wi);
@@ -384,6 +439,7 @@ impl Bsdf {
         let s = match *self {
             Bsdf::RoughConductor { ks, alpha } => microfacet::conductor_sample(lo, ks, alpha, [u[0], u[1]])?,
             Bsdf::RoughDielectric { alpha, .. } => microfacet::dielectric_sample(lo, eta, alpha, u, radiance)?,
+            Bsdf::RoughPlastic { kd, ior, alpha } => microfacet::plastic_sample(lo, kd, ior, alpha, u)?,
             _ => return None,
         };
         let wi = f.to_world(s.wi);

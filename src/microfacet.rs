@@ -1,7 +1,8 @@
 //! Rough surfaces: the GGX (Trowbridge–Reitz) microfacet distribution with Smith's
 //! height-correlated masking–shadowing, sampled by its distribution of visible normals (Heitz
-//! 2018), for a rough conductor (Schlick's Fresnel from a reflectance colour) and a rough
-//! dielectric (Walter et al. 2007: reflection and refraction through the microfacets).
+//! 2018), for a rough conductor (Schlick's Fresnel from a reflectance colour), a rough
+//! dielectric (Walter et al. 2007: reflection and refraction through the microfacets) and a
+//! rough plastic (a dielectric coat over a Lambertian base).
 //!
 //! Every function works in a local frame whose z axis is the shading normal on the side of
 //! `wo`; directions are unit vectors pointing away from the surface. Single scattering only:
@@ -204,4 +205,83 @@ pub fn dielectric_sample(wo: Vec3, eta: f32, alpha: f32, u: [f32; 3], radiance: 
     }
     let scale = if radiance { 1.0 / (eta * eta) } else { 1.0 };
     Some(LocalSample { wi, weight: Vec3::splat(g2(wo, -wi, alpha) / g1(wo, alpha) * scale) })
+}
+
+/// Rough plastic: a GGX dielectric coat of relative index `eta` over a Lambertian base `kd`.
+/// f = F(wo·m)·D·G2/(4·wo.z·wi.z) + kd/π·(1 − F(wo.z))·(1 − F(wi.z)): the coat reflects by its
+/// microfacets; light that enters it (1 − F on the way in and out) meets the base. Reciprocal;
+/// it never gains energy (the coat's light and the base's share of what the coat lets through
+/// sum to at most 1; the tests measure it). Light bouncing between the base and the coat's
+/// underside is not followed, so a plastic is slightly darker than a real one.
+#[must_use]
+pub fn plastic_eval(wo: Vec3, wi: Vec3, kd: Vec3, eta: f32, alpha: f32) -> Vec3 {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let m = (wo + wi).normalize();
+    let coat = fresnel_dielectric(wo.dot(m), eta) * d(m, alpha) * g2(wo, wi, alpha) / (4.0 * wo.z * wi.z);
+    Vec3::splat(coat) + plastic_base(wo, wi, kd, eta) / PI
+}
+
+/// The base's share times π: kd·(1 − F(wo.z))·(1 − F(wi.z)) (the weight of a cosine-sampled
+/// direction through the base alone).
+#[must_use]
+pub fn plastic_base(wo: Vec3, wi: Vec3, kd: Vec3, eta: f32) -> Vec3 {
+    kd * ((1.0 - fresnel_dielectric(wo.z, eta)) * (1.0 - fresnel_dielectric(wi.z, eta)))
+}
+
+/// Probability of sampling the plastic's coat rather than its base from `wo`: F(wo.z) against
+/// (1 − F(wo.z))·mean(kd).
+fn plastic_coat_probability(wo: Vec3, kd: Vec3, eta: f32) -> f32 {
+    let f = fresnel_dielectric(wo.z, eta);
+    let base = (1.0 - f) * kd.element_sum() / 3.0;
+    if f + base > 0.0 {
+        f / (f + base)
+    } else {
+        1.0
+    }
+}
+
+/// The pdf of [`plastic_sample`].
+#[must_use]
+pub fn plastic_pdf(wo: Vec3, wi: Vec3, kd: Vec3, eta: f32, alpha: f32) -> f32 {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return 0.0;
+    }
+    let p = plastic_coat_probability(wo, kd, eta);
+    let m = (wo + wi).normalize();
+    p * visible_d(wo, m, alpha) / (4.0 * wo.dot(m)) + (1.0 - p) * wi.z / PI
+}
+
+/// Samples the rough plastic: its coat (a visible normal, reflection about it) or its base
+/// (cosine-weighted), chosen by [`plastic_coat_probability`]; weight f·cos/pdf of the mixture.
+#[must_use]
+pub fn plastic_sample(wo: Vec3, kd: Vec3, eta: f32, alpha: f32, u: [f32; 3]) -> Option<LocalSample> {
+    let p = plastic_coat_probability(wo, kd, eta);
+    let wi = if u[2] < p {
+        let m = sample_visible_normal(wo, alpha, [u[0], u[1]]);
+        2.0 * wo.dot(m) * m - wo
+    } else {
+        crate::sampling::cosine_hemisphere([u[0], u[1]])
+    };
+    if wi.z <= 0.0 {
+        return None;
+    }
+    let pdf = plastic_pdf(wo, wi, kd, eta, alpha);
+    if !(pdf > 0.0) {
+        return None;
+    }
+    Some(LocalSample { wi, weight: plastic_eval(wo, wi, kd, eta, alpha) * (wi.z / pdf) })
+}
+
+/// Samples the plastic's coat alone (its glossy lobe): weight F(wo·m)·G2/G1(wo).
+#[must_use]
+pub fn plastic_coat_sample(wo: Vec3, eta: f32, alpha: f32, u: [f32; 2]) -> Option<LocalSample> {
+    let m = sample_visible_normal(wo, alpha, u);
+    let wi = 2.0 * wo.dot(m) * m - wo;
+    if wi.z <= 0.0 {
+        return None;
+    }
+    let f = fresnel_dielectric(wo.dot(m), eta);
+    Some(LocalSample { wi, weight: Vec3::splat(f * g2(wo, wi, alpha) / g1(wo, alpha)) })
 }

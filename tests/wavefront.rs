@@ -109,14 +109,16 @@ fn glossy_spheres() -> std::path::PathBuf {
 }
 
 /// The bundled spheres with a rough metal sphere of roughness `r` (below 0.3 photons pass it on
-/// as specular, above they are stored on it) and a frosted glass sphere (photons always pass).
+/// as specular, above they are stored on it), a frosted glass sphere (photons always pass) and a
+/// red wall of rough plastic (final-gather rays weighted one by one).
 fn rough_spheres(r: f32) -> std::path::PathBuf {
     let dir = scratch_dir(&format!("rough-spheres-{r}"));
     let obj = bundled("cornell-spheres.obj");
     let toml = format!(
         "[[mesh]]\nfile = {:?}\n[camera]\neye = [0.0, 0.273, 1.0796]\ntarget = [0.0, 0.273, 0.0]\nfov = 39.3\n\
          [materials.mirror]\ntype = \"rough_conductor\"\nks = [0.95, 0.7, 0.4]\nroughness = {r}\n\
-         [materials.glass]\ntype = \"rough_dielectric\"\nior = 1.5\nroughness = 0.25\n",
+         [materials.glass]\ntype = \"rough_dielectric\"\nior = 1.5\nroughness = 0.25\n\
+         [materials.red]\ntype = \"rough_plastic\"\nkd = [0.63, 0.06, 0.05]\nroughness = 0.4\n",
         obj.to_str().unwrap()
     );
     let path = dir.join("rough-spheres.toml");

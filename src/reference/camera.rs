@@ -71,7 +71,10 @@ pub fn trace_camera_path(
         if e != Vec3::ZERO {
             terms.add(Term::Emitted.seen(through_specular), beta * e);
         }
-        if bsdf.is_delta() {
+        // Mirrors and glass, and what photons pass as specular (frosted glass, smooth rough
+        // metal): the path goes on by sampling, so the lights and sky seen through them are
+        // found as emission, as their photons' caustics are found in the caustic map.
+        if bsdf.is_delta() || bsdf.photon_specular() {
             if depth == ctx.settings.max_depth {
                 break;
             }
@@ -138,12 +141,17 @@ pub fn final_gather(
     }
     let n = ctx.settings.gather_rays;
     let (mut sum, mut bias) = (Vec3::ZERO, Vec3::ZERO);
-    trace_gather_rays(ctx, sp, wo, n, s, rays, |end, chain, rays| {
+    // A rough plastic weighs each ray by its base's share seen through the coat; for the others
+    // the weight is kd for every ray, applied once at the end.
+    let varies = bsdf.gather_varies();
+    trace_gather_rays(ctx, sp, wo, n, s, rays, |end, wi, chain, rays| {
         let e = gather_hit(ctx, end, chain, rays, scratch);
-        sum += end.beta * e.radiance;
-        bias += end.beta * e.bias;
+        let w = if varies { bsdf.gather_weight(&sp.frame, wo, wi) * end.beta } else { end.beta };
+        sum += w * e.radiance;
+        bias += w * e.bias;
     });
-    Estimated { radiance: kd * sum / n as f32, bias: kd * bias / n as f32 }
+    let scale = if varies { Vec3::ONE } else { kd };
+    Estimated { radiance: scale * sum / n as f32, bias: scale * bias / n as f32 }
 }
 
 /// Radiance a gather ray (stream `chain`) finds where it ends: the photon maps' there, or, where
@@ -167,7 +175,7 @@ fn gather_hit(
     let mut far = Estimated::default();
     // A black surface sends no gather ray (as in `final_gather` and the wavefront engine).
     if kd != Vec3::ZERO {
-        trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, _| {
+        trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, _, _| {
             let e = map_radiance(ctx, &z.point, &ctx.scene.bsdf(&z.point), -z.dir, scratch);
             far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias };
         });
@@ -190,7 +198,7 @@ pub fn glossy_reflection(
 ) -> Estimated {
     let Some(ray) = glossy_ray(sp, bsdf, wo, s) else { return Estimated::default() };
     let Some(ChainEnd { point: y, dir: d, beta, .. }) =
-        first_non_specular(ctx, ray.origin, ray.dir, s, streams::GLOSSY_CHAIN_BOUNCE, true, rays)
+        first_non_specular(ctx, ray.origin, ray.dir, s, streams::GLOSSY_CHAIN_BOUNCE, rays)
     else {
         return Estimated::default();
     };

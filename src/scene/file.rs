@@ -30,7 +30,7 @@
 //! rotation = 0                  # degrees about +y
 //!
 //! [materials.sphere]            # replaces the MTL material `sphere`
-//! type = "glass"                # lambert | glossy | mirror | glass | rough_conductor | rough_dielectric
+//! type = "glass"                # lambert | glossy | mirror | glass | rough_conductor | rough_dielectric | rough_plastic
 //! ior = 1.5
 //! outside_ior = 1.0             # glass only: the medium the normal points into (nested dielectrics)
 //!
@@ -173,6 +173,15 @@ enum MaterialEntry {
         #[serde(default)]
         emission: Option<[f32; 3]>,
     },
+    #[serde(rename = "rough_plastic")]
+    RoughPlastic {
+        kd: [f32; 3],
+        #[serde(default = "ior_default")]
+        ior: f32,
+        roughness: f32,
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
     #[serde(rename = "rough_dielectric")]
     RoughDielectric {
         #[serde(default = "ior_default")]
@@ -288,10 +297,11 @@ impl LightEntry {
                 irradiance: colour(&f("irradiance"), irradiance)?,
             },
             LightEntry::Sun { direction, irradiance, angle } => {
-                if !(angle > 0.0 && angle <= 45.0) {
+                if !(0.05..=45.0).contains(&angle) {
                     return Err(Error::setting(
                         f("angle"),
-                        "the sun's angular radius must be in (0, 45] degrees (the real sun's is 0.27)",
+                        "the sun's angular radius must be in [0.05, 45] degrees (the real sun's is 0.27; for a \
+                         point-like sun use type = \"directional\")",
                     ));
                 }
                 let half = (angle * 0.5).to_radians().sin();
@@ -329,6 +339,9 @@ impl EnvironmentEntry {
                     Error::Io { path, message } => {
                         Error::Io { path, message: format!("{message} (named by `environment.map`)") }
                     }
+                    Error::Parse { path, line, message } => {
+                        Error::Parse { path, line, message: format!("{message} (named by `environment.map`)") }
+                    }
                     other => other,
                 })?;
                 inputs.push(path);
@@ -358,6 +371,13 @@ impl MaterialEntry {
             MaterialEntry::RoughConductor { ks, roughness, emission } => {
                 let alpha = roughness_alpha(&f("roughness"), roughness)?;
                 (Bsdf::RoughConductor { ks: albedo(&f("ks"), ks)?, alpha }, emission)
+            }
+            MaterialEntry::RoughPlastic { kd, ior, roughness, emission } => {
+                let alpha = roughness_alpha(&f("roughness"), roughness)?;
+                if !(ior > 0.0 && ior.is_finite()) {
+                    return Err(Error::setting(f("ior"), "must be a positive number"));
+                }
+                (Bsdf::RoughPlastic { kd: albedo(&f("kd"), kd)?, ior, alpha }, emission)
             }
             MaterialEntry::RoughDielectric { ior, outside_ior, roughness, emission } => {
                 let alpha = roughness_alpha(&f("roughness"), roughness)?;

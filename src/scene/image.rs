@@ -98,9 +98,13 @@ type Samples = (u32, u32, usize, f32, Vec<u16>);
 
 /// A PNG's samples, palettes expanded.
 fn decode_png(data: &[u8]) -> std::result::Result<Samples, String> {
-    let mut decoder = png::Decoder::new_with_limits(std::io::Cursor::new(data), png::Limits { bytes: 4 << 30 });
+    // At most MAX_TEXELS of 4 channels of 16 bits: 2 GiB.
+    let limits = png::Limits { bytes: (MAX_TEXELS * 8) as usize };
+    let mut decoder = png::Decoder::new_with_limits(std::io::Cursor::new(data), limits);
     decoder.set_transformations(png::Transformations::EXPAND);
     let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
+    let (w, h) = (reader.info().width, reader.info().height);
+    check_size(w, h)?;
     let size = reader.output_buffer_size().ok_or("the image is too large")?;
     let mut buf = vec![0u8; size];
     let info = reader.next_frame(&mut buf).map_err(|e| e.to_string())?;
@@ -125,11 +129,24 @@ fn decode_jpeg(data: &[u8]) -> std::result::Result<Samples, String> {
         .set_max_height(1 << 16)
         .jpeg_set_out_colorspace(ColorSpace::RGB);
     let mut decoder = zune_jpeg::JpegDecoder::new_with_options(std::io::Cursor::new(data), options);
+    decoder.decode_headers().map_err(|e| e.to_string())?;
+    let header = decoder.info().ok_or("no image header")?;
+    check_size(u32::from(header.width), u32::from(header.height))?;
     let pixels = decoder.decode().map_err(|e| e.to_string())?;
     let info = decoder.info().ok_or("no image header")?;
     let channels = decoder.output_colorspace().map_or(3, |c| c.num_components());
     let (w, h) = (u32::from(info.width), u32::from(info.height));
     Ok((w, h, channels, 255.0, pixels.into_iter().map(u16::from).collect()))
+}
+
+/// Refuses an image header of more than [`MAX_TEXELS`] texels before anything is decoded (a
+/// small file can claim a huge image).
+fn check_size(w: u32, h: u32) -> std::result::Result<(), String> {
+    if u64::from(w) * u64::from(h) > MAX_TEXELS {
+        Err(format!("{w}×{h} texels is more than the 2²⁸ accepted"))
+    } else {
+        Ok(())
+    }
 }
 
 /// Samples of 1–4 channels as linear RGB (grey repeated, alpha dropped).

@@ -166,9 +166,13 @@ impl Light {
                 let (x, y) = (x * sin_max, y * sin_max);
                 let f = Frame::new(direction);
                 let dir = f.to_world(Vec3::new(x, y, (1.0 - x * x - y * y).max(0.0).sqrt()));
+                // The disk across each direction (not the axis): every ray through the scene's
+                // bounding sphere crosses it. Power L/(pdf·q) with pdf = L·cos θ/E⊥ about the axis.
+                let g = Frame::new(dir);
                 let (dx, dy) = concentric_disk([u[0], u[1]]);
-                let origin = centre + (f.s * dx + f.t * dy) * radius - dir * (2.0 * radius);
-                Emission { origin, direction: dir, power: irradiance * PI * radius * radius, normal: None }
+                let origin = centre + (g.s * dx + g.t * dy) * radius - dir * (2.0 * radius);
+                let cos = dir.dot(direction);
+                Emission { origin, direction: dir, power: irradiance * (PI * radius * radius / cos), normal: None }
             }
             // Sampled by the scene (`Scene::sample_emission`); never reached.
             Light::Environment => Emission { origin: Vec3::ZERO, direction: Vec3::Y, power: Vec3::ZERO, normal: None },
@@ -244,7 +248,12 @@ impl Light {
     #[must_use]
     pub fn radiance_at_infinity(&self, d: Vec3) -> Vec3 {
         match *self {
-            Light::Sun { direction, irradiance, one_minus_cos } if 1.0 + d.dot(direction) <= one_minus_cos => {
+            // Inside the disk: toward the sun, and sin of the angle to its axis within sin θ (the
+            // cross product resolves angles a dot product near −1 cannot).
+            Light::Sun { direction, irradiance, one_minus_cos }
+                if d.dot(direction) < 0.0
+                    && d.cross(direction).length_squared() <= one_minus_cos * (2.0 - one_minus_cos) =>
+            {
                 Self::sun_radiance(irradiance, one_minus_cos)
             }
             _ => Vec3::ZERO,

@@ -7,6 +7,7 @@
 //! | `illum` 3, 5 or 8 | perfect mirror, reflectance `Ks` (1 if absent); with `Pr` > 0 a GGX rough conductor of α = `Pr`² |
 //! | `illum` 4, 6, 7 or 9 | smooth clear dielectric, IOR `Ni` (1.5 if absent), exact Fresnel; with `Pr` > 0 rough (frosted) |
 //! | `Pm` ≥ 0.5 (PBR metal) | mirror of colour `Kd`; with `Pr` > 0 a rough conductor |
+//! | `Pr` > 0 otherwise | rough plastic: a GGX coat of IOR `Ni` (1.5) over the Lambertian base `Kd` |
 //! | `illum` 2 with `Ks` > 0 | Lambertian `Kd` + normalised Phong lobe `Ks`, exponent `Ns`; scaled so Kd + Ks ≤ 1 |
 //! | otherwise (`illum` 0, 1, 10, or 2 without `Ks`) | Lambertian `Kd` (0.8 grey if absent) |
 //!
@@ -254,13 +255,6 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
             other => return Err(Error::parse(path, line, format!("unknown MTL statement `{other}`"))),
         }
     }
-    for m in &mut out {
-        let rough_kind = matches!(m.illum, Some(3..=9)) || m.pm.is_some_and(|p| p >= 0.5);
-        if m.pr.is_some_and(|r| r > 0.0) && !rough_kind && !m.ignored.iter().any(|s| s == "Pr") {
-            // A rough dielectric coat over a diffuse base (rough plastic) is not built yet.
-            m.ignored.push("Pr on a non-metal".into());
-        }
-    }
     for m in &out {
         if !m.ignored.is_empty() {
             warnings.push(format!(
@@ -296,6 +290,8 @@ pub fn material_from_mtl(m: &MtlMaterial, warnings: &mut Vec<String>) -> Materia
         // The PBR extension's metals take their colour from `Kd` (the base colour).
         (_, None) if metal => Bsdf::Mirror { ks: kd.min(Vec3::ONE) },
         (_, Some(alpha)) if metal => Bsdf::RoughConductor { ks: kd.min(Vec3::ONE), alpha },
+        // A rough non-metal: the PBR extension's dielectric, a coat over the base colour.
+        (_, Some(alpha)) => Bsdf::RoughPlastic { kd: kd.min(Vec3::ONE), ior: m.ni.unwrap_or(1.5), alpha },
         (2, _) if ks.max_element() > 0.0 => {
             let sum = (kd + ks).max_element();
             let scale = if sum > 1.0 && !ks_map && m.map("map_Kd").is_none() {
@@ -363,8 +359,8 @@ mod tests {
         assert_eq!(b[0], Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.6, 0.3), alpha: alpha_of(0.4) });
         assert_eq!(b[1], Bsdf::RoughDielectric { ior: 1.4, alpha: alpha_of(0.5) });
         assert_eq!(b[2], Bsdf::Mirror { ks: Vec3::splat(0.8) });
-        assert_eq!(b[3], Bsdf::Lambert { kd: Vec3::splat(0.5) });
-        assert!(w.iter().any(|w| w.contains("`plastic`") && w.contains("Pr on a non-metal")), "{w:?}");
+        assert_eq!(b[3], Bsdf::RoughPlastic { kd: Vec3::splat(0.5), ior: 1.5, alpha: alpha_of(0.3) });
+        assert!(w.is_empty(), "{w:?}");
         for bad in ["Pr 1.5", "Pr -0.1", "Pm 2"] {
             let e = parse(&format!("newmtl a\n{bad}\n")).0.unwrap_err().to_string();
             assert!(e.starts_with("m.mtl:2:") && e.contains("must be in [0, 1]"), "{bad}: {e}");

@@ -212,6 +212,10 @@ pub fn load_obj(
     for (file, m) in &mtl {
         let mut material = material_from_mtl(m, warnings);
         material.maps = table.load_maps(file, m, inputs)?;
+        // A PBR metal's colour is its `Kd`: so is its texture's.
+        if m.pm.is_some_and(|p| p >= 0.5) && material.maps.ks.is_none() {
+            material.maps.ks = material.maps.kd.take();
+        }
         ids.push(table.insert(file, material, warnings));
     }
 

@@ -23,25 +23,34 @@ use crate::scene::Scene;
 use glam::Vec3;
 use std::f32::consts::PI;
 
-/// A target's cone seen from a point: its axis, 1 − cos of its half-angle (2 for a point
-/// inside: the whole sphere) and its solid angle.
+/// A target's cone seen from a point: its axis, 1 − cos and sin² of its half-angle (1 − cos = 2
+/// for a point inside: the whole sphere) and its solid angle.
 #[derive(Clone, Copy)]
 struct Cone {
     axis: Vec3,
     one_minus_cos: f32,
+    sin2: f32,
     solid_angle: f32,
+}
+
+impl Cone {
+    /// Whether unit `d` lies in the cone (by the sine, which resolves the tiny cones of far
+    /// targets that 1 − d·axis cannot).
+    fn holds(&self, d: Vec3) -> bool {
+        self.one_minus_cos >= 2.0 || (d.dot(self.axis) > 0.0 && d.cross(self.axis).length_squared() <= self.sin2)
+    }
 }
 
 fn cone(x: Vec3, t: &Target) -> Cone {
     let d = t.centre - x;
     let dist2 = d.length_squared();
     if dist2 <= t.radius * t.radius {
-        return Cone { axis: Vec3::Z, one_minus_cos: 2.0, solid_angle: 4.0 * PI };
+        return Cone { axis: Vec3::Z, one_minus_cos: 2.0, sin2: 1.0, solid_angle: 4.0 * PI };
     }
     let sin2 = t.radius * t.radius / dist2;
     // 1 − cos = sin²/(1 + cos), exact for small cones.
     let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).max(0.0).sqrt());
-    Cone { axis: d / dist2.sqrt(), one_minus_cos, solid_angle: 2.0 * PI * one_minus_cos }
+    Cone { axis: d / dist2.sqrt(), one_minus_cos, sin2, solid_angle: 2.0 * PI * one_minus_cos }
 }
 
 /// The solid angle the targets' cones cover from `x`, counted with overlaps (their sum): the
@@ -74,7 +83,7 @@ fn aim_from(x: Vec3, targets: &[Target], u: [f32; 3]) -> Option<(Vec3, f32)> {
         let phi = 2.0 * PI * u[1];
         Frame::new(c.axis).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos))
     };
-    let holding = cones.iter().filter(|k| k.one_minus_cos >= 2.0 || 1.0 - d.dot(k.axis) <= k.one_minus_cos).count();
+    let holding = cones.iter().filter(|k| k.holds(d)).count();
     Some((d, holding.max(1) as f32 / total))
 }
 

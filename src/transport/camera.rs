@@ -58,7 +58,7 @@ pub fn probe_first_surfaces<T: Send + Sync + Clone>(
                 .map(|pixel| {
                     let (s, (fx, fy)) = camera_sample(job, pixel as u64 * u64::from(job.settings.spp));
                     let (o, d) = rays.ray((pixel % w) as f32 + fx, (pixel / w) as f32 + fy);
-                    match first_non_specular(ctx, o, d, &s, CAMERA_CHAIN_BOUNCE, false, &mut counts) {
+                    match first_non_specular(ctx, o, d, &s, CAMERA_CHAIN_BOUNCE, &mut counts) {
                         Some(end) => probe(pixel, &s, &end.point, end.dir, &mut scratch, &mut counts),
                         None => miss.clone(),
                     }

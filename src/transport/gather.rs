@@ -42,8 +42,8 @@ pub fn gather_rays(sp: &SurfacePoint, wo: Vec3, n: u32, s: &Sampler, mut emit: i
 }
 
 /// Traces the final-gather rays of [`gather_rays`] through mirrors and glass, each on its own
-/// stream (forked [`streams::gather_ray`]`(g)` from `s`), and calls `read(end, stream, rays)` at
-/// each one's first non-specular hit, in ray order. Rays that escape or are absorbed read nothing.
+/// stream (forked [`streams::gather_ray`]`(g)` from `s`), and calls `read(end, wi, stream, rays)`
+/// at each one's first non-specular hit (`wi` the ray's first direction), in ray order. Rays that escape or are absorbed read nothing.
 pub fn trace_gather_rays(
     ctx: &Context,
     sp: &SurfacePoint,
@@ -51,12 +51,12 @@ pub fn trace_gather_rays(
     n: u32,
     s: &Sampler,
     rays: &mut RayCounts,
-    mut read: impl FnMut(&ChainEnd, &Sampler, &mut RayCounts),
+    mut read: impl FnMut(&ChainEnd, Vec3, &Sampler, &mut RayCounts),
 ) {
     gather_rays(sp, wo, n, s, |g, o, wi| {
         let chain = s.fork(streams::gather_ray(g));
-        if let Some(end) = first_non_specular(ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, true, rays) {
-            read(&end, &chain, rays);
+        if let Some(end) = first_non_specular(ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, rays) {
+            read(&end, wi, &chain, rays);
         }
     });
 }

@@ -55,16 +55,15 @@ pub struct ChainEnd {
 
 /// Follows a ray through mirrors and glass (at most `max_depth` bounces, sampling each with `s`
 /// at bounce `first_bounce + depth`) to its first non-specular hit. `None` if it escapes or is
-/// absorbed. With `as_photons` it also passes what photons pass ([`Bsdf::photon_specular`]:
-/// frosted glass, smooth rough metal), sampling their BSDF: gather and glossy rays end where
-/// photons are stored, so the maps they read there hold the light that came through.
+/// absorbed. It also passes what photons pass ([`Bsdf::photon_specular`]: frosted glass,
+/// smooth rough metal), sampling their BSDF: every path ends where photons are stored, so the
+/// maps read there hold the light that came through.
 pub fn first_non_specular(
     ctx: &Context,
     mut o: Vec3,
     mut d: Vec3,
     s: &Sampler,
     first_bounce: u32,
-    as_photons: bool,
     rays: &mut RayCounts,
 ) -> Option<ChainEnd> {
     let scene = ctx.scene;
@@ -74,7 +73,7 @@ pub fn first_non_specular(
         let hit = scene.intersect(o, d, f32::INFINITY)?;
         let sp = scene.surface(&hit);
         let bsdf = &scene.bsdf(&sp);
-        if !(bsdf.is_delta() || as_photons && bsdf.photon_specular()) {
+        if !(bsdf.is_delta() || bsdf.photon_specular()) {
             return Some(ChainEnd { point: sp, dir: d, beta, t: hit.t, bounces: depth });
         }
         let next = continue_ray(&sp, bsdf, -d, s, first_bounce + depth)?;

@@ -10,10 +10,11 @@ use crate::transport::gather::{lands_near, secondary_gather_distance};
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
-/// Fills `out` from `hits`, lanes in order. With `kinds` (camera paths), gather and glossy lanes
-/// at surfaces that photons pass on as specular (frosted glass, smooth rough metal) join the
-/// mirror lanes and continue, as `first_non_specular` continues them in the reference.
-pub fn classify(scene: &Scene, hits: &HitColumns, kinds: Option<&[PathKind]>, out: &mut Classified) {
+/// Fills `out` from `hits`, lanes in order. With `paths` (the camera pass), lanes at surfaces
+/// that photons pass on as specular (frosted glass, smooth rough metal) join the mirror lanes
+/// and continue, as the reference's camera and gather paths do; photons at them deposit nothing
+/// and scatter (`deposit_photon`).
+pub fn classify(scene: &Scene, hits: &HitColumns, paths: bool, out: &mut Classified) {
     out.clear();
     for (i, &tri) in hits.tri.iter().enumerate() {
         let list = if tri == HitColumns::MISS {
@@ -23,7 +24,7 @@ pub fn classify(scene: &Scene, hits: &HitColumns, kinds: Option<&[PathKind]>, ou
             match bsdf {
                 Bsdf::Mirror { .. } => &mut out.mirror,
                 Bsdf::Glass { .. } => &mut out.glass,
-                b if b.photon_specular() && kinds.is_some_and(|k| k[i] != PathKind::Camera) => &mut out.mirror,
+                b if paths && b.photon_specular() => &mut out.mirror,
                 _ => &mut out.diffuse,
             }
         };
@@ -35,7 +36,7 @@ pub fn classify(scene: &Scene, hits: &HitColumns, kinds: Option<&[PathKind]>, ou
 pub fn classify_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let w = &mut *work;
-    classify(&shared.scene, &w.queue.hits, None, &mut w.classified);
+    classify(&shared.scene, &w.queue.hits, false, &mut w.classified);
     if shared.scene.encloses_lights {
         w.numerics.photon_escaped += w.classified.escaped.len() as u64;
     }
@@ -46,7 +47,7 @@ pub fn classify_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut s
 pub fn classify_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let w = &mut *work;
-    classify(&shared.scene, &w.paths.hits, Some(&w.paths.kind), &mut w.classified);
+    classify(&shared.scene, &w.paths.hits, true, &mut w.classified);
     stats.record("classify_paths", w.paths.len(), t);
 }
 

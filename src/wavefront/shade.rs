@@ -157,7 +157,8 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
                 let i = lanes[j] as usize;
                 let Some(hit) = w.hits.get(i) else { continue };
                 let sp = scene.surface(&hit);
-                let kd = scene.bsdf(&sp).diffuse();
+                let bsdf = scene.bsdf(&sp);
+                let kd = bsdf.diffuse();
                 if kd == glam::Vec3::ZERO {
                     continue;
                 }
@@ -171,8 +172,15 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
                     ),
                     _ => (s.fork(streams::SECONDARY_GATHER), 1, PathKind::SecondaryGather, w.term[i]),
                 };
+                let wo = -w.rays.direction(i);
                 let weight = w.beta[i] * kd / rays as f32;
-                gather_rays(&sp, -w.rays.direction(i), rays, &gs, |g, origin, dir| {
+                gather_rays(&sp, wo, rays, &gs, |g, origin, dir| {
+                    // A rough plastic weighs each ray by its base's share (as the reference).
+                    let weight = if bsdf.gather_varies() {
+                        w.beta[i] * bsdf.gather_weight(&sp.frame, wo, dir) / rays as f32
+                    } else {
+                        weight
+                    };
                     out.push(Segment {
                         origin,
                         dir,
