@@ -77,13 +77,18 @@ pub struct Maps {
     pub kd: Option<Arc<Texture>>,
     /// Specular reflectance (MTL `map_Ks`): replaces `ks` of glossy and mirror materials.
     pub ks: Option<Arc<Texture>>,
+    /// Roughness (MTL `map_Pr`, a linear data map read from its red channel): replaces the rough
+    /// materials' roughness, within the material's photon class ([`Material::bsdf_at`]).
+    pub roughness: Option<Arc<Texture>>,
+    /// Emitted radiance (MTL `map_Ke`): replaces the emission of an emitter.
+    pub ke: Option<Arc<Texture>>,
 }
 
 impl Maps {
     /// True when the material has no texture.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.kd.is_none() && self.ks.is_none()
+        self.kd.is_none() && self.ks.is_none() && self.roughness.is_none() && self.ke.is_none()
     }
 }
 
@@ -94,10 +99,23 @@ impl Material {
         Material { name: name.into(), bsdf, emission, maps: Maps::default() }
     }
 
+    /// The radiance emitted at texture coordinates `uv` from the front face: the emission
+    /// texture's value there, or the constant emission.
+    #[inline]
+    #[must_use]
+    pub fn emission_at(&self, uv: Vec2) -> Vec3 {
+        match &self.maps.ke {
+            Some(t) if self.emission != Vec3::ZERO => t.lookup(uv),
+            _ => self.emission,
+        }
+    }
+
     /// The scattering at texture coordinates `uv`: the constant BSDF with its textured colours
     /// replaced. Albedos are kept within energy conservation as the MTL mapping keeps the
     /// constants: a Lambertian or mirror colour at most 1, a glossy `kd + ks` at most 1 per
-    /// channel (both scaled down together).
+    /// channel (both scaled down together). A roughness map sets α = roughness² but keeps a rough
+    /// conductor on its constant roughness's side of [`PHOTON_SPECULAR_ALPHA`]: whether photons
+    /// pass a material is decided per material, so both engines route it alike.
     #[inline]
     #[must_use]
     pub fn bsdf_at(&self, uv: Vec2) -> Bsdf {
@@ -106,6 +124,9 @@ impl Material {
         }
         let kd_at = |kd: Vec3| self.maps.kd.as_ref().map_or(kd, |t| t.lookup(uv));
         let ks_at = |ks: Vec3| self.maps.ks.as_ref().map_or(ks, |t| t.lookup(uv));
+        let alpha_at = |alpha: f32| {
+            self.maps.roughness.as_ref().map_or(alpha, |t| microfacet::alpha_of(t.lookup(uv).x.clamp(0.0, 1.0)))
+        };
         match self.bsdf {
             Bsdf::Lambert { kd } => Bsdf::Lambert { kd: kd_at(kd).min(Vec3::ONE) },
             Bsdf::Glossy { kd, ks, exponent } => {
@@ -115,9 +136,21 @@ impl Material {
                 Bsdf::Glossy { kd: kd * scale, ks: ks * scale, exponent }
             }
             Bsdf::Mirror { ks } => Bsdf::Mirror { ks: ks_at(ks).min(Vec3::ONE) },
-            Bsdf::RoughConductor { ks, alpha } => Bsdf::RoughConductor { ks: ks_at(ks).min(Vec3::ONE), alpha },
-            Bsdf::RoughPlastic { kd, ior, alpha } => Bsdf::RoughPlastic { kd: kd_at(kd).min(Vec3::ONE), ior, alpha },
-            b @ (Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. }) => b,
+            Bsdf::RoughConductor { ks, alpha } => {
+                let a = alpha_at(alpha);
+                // The same photon class as the constant roughness.
+                let a = if alpha < PHOTON_SPECULAR_ALPHA {
+                    a.min(PHOTON_SPECULAR_ALPHA * (1.0 - f32::EPSILON))
+                } else {
+                    a.max(PHOTON_SPECULAR_ALPHA)
+                };
+                Bsdf::RoughConductor { ks: ks_at(ks).min(Vec3::ONE), alpha: a }
+            }
+            Bsdf::RoughPlastic { kd, ior, alpha } => {
+                Bsdf::RoughPlastic { kd: kd_at(kd).min(Vec3::ONE), ior, alpha: alpha_at(alpha) }
+            }
+            Bsdf::RoughDielectric { ior, alpha } => Bsdf::RoughDielectric { ior, alpha: alpha_at(alpha) },
+            b @ Bsdf::Glass { .. } => b,
         }
     }
 }
@@ -520,6 +553,34 @@ fn sample_glass(frame: &SurfaceFrame, wo: Vec3, ior: f32, u: f32, transport: Tra
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_roughness_map_sets_alpha_within_the_photon_class() {
+        let grey =
+            |v: f32| Some(Arc::new(Texture::new(std::path::Path::new("r.png"), 1, 1, vec![Vec3::splat(v)]).unwrap()));
+        let rough = |bsdf: Bsdf, v: f32| Material {
+            maps: Maps { roughness: grey(v), ..Maps::default() },
+            ..Material::new("m", bsdf, Vec3::ZERO)
+        };
+        let uv = Vec2::splat(0.5);
+        let Bsdf::RoughPlastic { alpha, .. } =
+            rough(Bsdf::RoughPlastic { kd: Vec3::ONE, ior: 1.5, alpha: 0.5 }, 0.6).bsdf_at(uv)
+        else {
+            panic!()
+        };
+        assert!((alpha - 0.36).abs() < 1e-6);
+        // A conductor whose photons are stored (α ≥ 0.09) stays there, and one whose photons pass stays below.
+        let stored = rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.25 }, 0.1).bsdf_at(uv);
+        assert_eq!(stored, Bsdf::RoughConductor { ks: Vec3::ONE, alpha: PHOTON_SPECULAR_ALPHA });
+        let passed = rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.01 }, 0.9).bsdf_at(uv);
+        assert!(passed.photon_specular(), "{passed:?}");
+        let Bsdf::RoughConductor { alpha, .. } =
+            rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.01 }, 0.2).bsdf_at(uv)
+        else {
+            panic!()
+        };
+        assert!((alpha - 0.04).abs() < 1e-6);
+    }
 
     #[test]
     fn fresnel_known_values() {

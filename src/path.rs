@@ -100,7 +100,7 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
         let sp = scene.surface(&hit);
         let bsdf = scene.bsdf(&sp);
         let wo = -d;
-        let e = emission_toward(scene, hit.tri, wo);
+        let e = emission_toward(scene, &hit, wo);
         if last_delta && e != Vec3::ZERO {
             terms.add(path_term(Term::Emitted, depth, via_specular), beta * e);
         }

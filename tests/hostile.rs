@@ -215,16 +215,16 @@ fn materials_are_kept_apart_per_file() {
     assert_eq!(loaded.inputs.len(), 5, "scene, two OBJ and two MTL files: {:?}", loaded.inputs);
 }
 
-/// Texture statements not simulated (`map_Ke`, `bump`) and transparency are read and said to be ignored, once per material;
+/// Texture statements not simulated (`map_d`, `bump`) and transparency are read and said to be ignored, once per material;
 /// `Ns -5`, `illum 99` and a file that is not UTF-8 are errors with their line.
 #[test]
 fn what_is_not_simulated_is_said() {
     let d = scratch_dir("said");
-    write(&d, "m.mtl", format!("{MTL}map_Ke -s 2 2 2 glow.png\nbump -bm 0.3 wood-bump.png\nd 0.4\nsharpness 60\n"));
+    write(&d, "m.mtl", format!("{MTL}map_d -s 2 2 2 alpha.png\nbump -bm 0.3 wood-bump.png\nd 0.4\nsharpness 60\n"));
     let scene = load_scene(&write(&d, "a.obj", OBJ)).unwrap().scene;
     let w: Vec<_> = scene.warnings.iter().filter(|w| w.contains("not simulated")).collect();
     assert_eq!(w.len(), 1, "{w:?}");
-    assert!(w[0].contains("m.mtl:4: material `white`") && w[0].contains("`map_Ke`, `bump`, `d`, `sharpness`"));
+    assert!(w[0].contains("m.mtl:4: material `white`") && w[0].contains("`map_d`, `bump`, `d`, `sharpness`"));
     for (bad, what) in [("Ns -5", "negative"), ("illum 99", "0–10")] {
         write(&d, "m.mtl", format!("{MTL}{bad}\n"));
         let e = load_scene(&d.join("a.obj")).err().unwrap().to_string();

@@ -223,3 +223,88 @@ fn a_mesh_without_texture_coordinates_is_warned_about() {
         loaded.scene.warnings
     );
 }
+
+/// A closed box of half-size 1 whose ceiling holds a 0.5 × 0.5 light, its MTL `light` material
+/// given by `light_mtl`; texture coordinates span the light once.
+fn lit_box(dir: &Path, name: &str, light_mtl: &str) -> PathBuf {
+    let obj = "mtllib b.mtl\n\
+        v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+        usemtl wall\nf 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n\
+        v -0.25 0.999 -0.25\nv 0.25 0.999 -0.25\nv 0.25 0.999 0.25\nv -0.25 0.999 0.25\n\
+        vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+        usemtl light\nf 9/1 10/2 11/3 12/4\n";
+    std::fs::write(dir.join(format!("{name}.obj")), obj.replace("b.mtl", &format!("{name}.mtl"))).unwrap();
+    std::fs::write(
+        dir.join(format!("{name}.mtl")),
+        format!("newmtl wall\nKd 0.5 0.5 0.5\nnewmtl light\nKd 0 0 0\n{light_mtl}\n"),
+    )
+    .unwrap();
+    let toml =
+        format!("[[mesh]]\nfile = \"{name}.obj\"\n[camera]\neye = [0, -0.6, 0.95]\ntarget = [0, 0.99, 0]\nfov = 50\n");
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, toml).unwrap();
+    path
+}
+
+#[test]
+fn a_one_colour_emission_texture_renders_as_the_constant_emission() {
+    // The same samples and, per sample, the same radiance (the texel, sRGB-decoded, equals the
+    // constant): the images agree to f32 rounding in every term, in both engines.
+    let dir = scratch_dir("textured-light-uniform");
+    write_png(&dir.join("glow.png"), 1, 1, &[255, 200, 120]);
+    let ke = Vec3::new(255.0, 200.0, 120.0).map(|c| srgb_to_linear(c / 255.0));
+    let textured = lit_box(&dir, "textured", "Ke 1 1 1\nmap_Ke glow.png");
+    let constant = lit_box(&dir, "constant", &format!("Ke {} {} {}", ke.x, ke.y, ke.z));
+    let s = Settings { spp: 2, ..settings() };
+    let (a, b) = (reference(&load_scene(&textured).unwrap(), &s), reference(&load_scene(&constant).unwrap(), &s));
+    for (k, (x, y)) in a.pixels.iter().zip(&b.pixels).enumerate() {
+        for (u, v) in x.as_array().into_iter().zip(y.as_array()) {
+            assert!(
+                ((u - v).abs() / v.abs().max(Vec3::splat(1e-3))).max_element() < 1e-4,
+                "pixel {k}: {u} against {v}"
+            );
+        }
+    }
+    let loaded = load_scene(&textured).unwrap();
+    let rays = loaded.camera.unwrap().prepare(s.width, s.height).unwrap();
+    let w = photonwave::wavefront::render(Arc::new(loaded.scene), &rays, &s, &NoProgress).unwrap().0;
+    for (k, (x, y)) in a.pixels.iter().zip(&w.pixels).enumerate() {
+        for (u, v) in x.as_array().into_iter().zip(y.as_array()) {
+            assert!(((u - v).abs() / u.abs().max(Vec3::ONE)).max_element() <= 1e-6, "pixel {k}: {u} against {v}");
+        }
+    }
+}
+
+#[test]
+fn a_textured_light_emits_its_mean_texel_and_shows_its_texture() {
+    // Bilinear lookup with wrap averages, over one period, to the texels' mean, so the light's
+    // power is π·A·mean. In a closed box every photon's first hit lands somewhere: the
+    // first-hit photons' power sums to it (relative spread of the sum ≈ 1/√N for 200 000).
+    let dir = scratch_dir("textured-light-power");
+    let texels: [[u8; 3]; 4] = [[255, 255, 255], [0, 0, 0], [255, 128, 0], [40, 40, 40]];
+    write_png(&dir.join("sign.png"), 4, 1, &texels.concat());
+    let path = lit_box(&dir, "sign", "Ke 1 1 1\nmap_Ke sign.png");
+    let scene = load_scene(&path).unwrap().scene;
+    let mean =
+        texels.iter().map(|t| Vec3::from_array(t.map(|c| srgb_to_linear(f32::from(c) / 255.0)))).sum::<Vec3>() / 4.0;
+    let want = mean * std::f32::consts::PI * 0.25;
+    let s = Settings { photons: 200_000, threads: 2, ..Default::default() };
+    let t = photonwave::reference::photons::trace_photons(
+        &scene,
+        &common::job(&scene, &s),
+        photonwave::rng::Domain::GlobalPhoton,
+        200_000,
+        &NoProgress,
+    );
+    let got = photonwave::transport::photon::first_hit_power(&t.photons);
+    assert!(
+        ((got - want).abs() / want.max(Vec3::splat(1e-6))).max_element() < 0.02,
+        "first-hit power {got} against π·A·mean = {want}"
+    );
+    // The camera sees the texture: the light's emitted pixels span the texels' range.
+    let loaded = load_scene(&path).unwrap();
+    let film = reference(&loaded, &Settings { width: 32, height: 32, spp: 1, ..settings() });
+    let lit: Vec<f32> = film.pixels.iter().map(|p| p.emitted.x).filter(|&e| e > 0.0).collect();
+    let (lo, hi) = lit.iter().fold((f32::MAX, 0f32), |(a, b), &e| (a.min(e), b.max(e)));
+    assert!(lit.len() > 20 && hi > 0.9 && lo < 0.1, "{} emitting pixels, {lo}..{hi}", lit.len());
+}

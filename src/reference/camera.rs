@@ -67,7 +67,7 @@ pub fn trace_camera_path(
         let sp = scene.surface(&hit);
         let bsdf = scene.bsdf(&sp);
         let wo = -d;
-        let e = emission_toward(scene, hit.tri, wo);
+        let e = emission_toward(scene, &hit, wo);
         if e != Vec3::ZERO {
             terms.add(Term::Emitted.seen(through_specular), beta * e);
         }

@@ -118,6 +118,22 @@ pub struct Scene {
     kinds: (bool, bool, bool),
 }
 
+/// The mean of texture `t` over a triangle with texture coordinates `uv` (16 stratified points),
+/// or over the whole texture where that is black (a pick weight must be positive where the
+/// texture lights anything).
+fn textured_mean(t: &crate::texture::Texture, uv: &[Vec2; 3]) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    for k in 0..16 {
+        let (b1, b2) = crate::sampling::uniform_triangle([(k % 4) as f32 / 4.0 + 0.125, (k / 4) as f32 / 4.0 + 0.125]);
+        sum += t.lookup(uv[0] * (1.0 - b1 - b2) + uv[1] * b1 + uv[2] * b2);
+    }
+    if sum == Vec3::ZERO {
+        t.mean()
+    } else {
+        sum / 16.0
+    }
+}
+
 /// The bounding box (lo, hi) of `points`; (+∞, −∞) for none.
 #[must_use]
 pub fn bounds_of<'a>(points: impl Iterator<Item = &'a Vec3>) -> (Vec3, Vec3) {
@@ -258,7 +274,16 @@ impl Scene {
 
         let mut lights: Vec<Light> = (0..p0.len())
             .filter(|&i| materials[material[i] as usize].emission != Vec3::ZERO)
-            .map(|i| Light::Area { tri: i as u32, radiance: materials[material[i] as usize].emission })
+            .map(|i| {
+                let m = &materials[material[i] as usize];
+                // A textured emitter's radiance here only weighs its pick (its power): the
+                // samples read the texture where they land (`Scene::sample_incident`, …).
+                let radiance = match (&m.maps.ke, uv.get(i)) {
+                    (Some(t), Some(tri_uv)) => textured_mean(t, tri_uv),
+                    _ => m.emission,
+                };
+                Light::Area { tri: i as u32, radiance }
+            })
             .collect();
         for l in &extra_lights {
             if let Light::Point { position, .. } | Light::Spot { position, .. } = *l {
@@ -478,6 +503,17 @@ impl Scene {
                     point: None,
                 })
             }
+            (Light::Area { tri, .. }, _) if self.textured_emitter(*tri) => {
+                // The sample's point and geometry as for a constant emitter, its radiance read
+                // from the texture where it lands: L(q)·cos·A/d².
+                let t = self.triangle(*tri);
+                let mut inc = l.sample_incident(Some(&t), p, u)?;
+                let (q, _) = inc.point?;
+                let dist2 = (q - p).length_squared();
+                let cos_l = -inc.wi.dot(t.n);
+                inc.value = self.emitted_at(*tri, self.barycentrics(*tri, q)) * (cos_l * t.area / dist2);
+                Some(inc)
+            }
             _ => l.sample_incident(self.light_triangle(l).as_ref(), p, u),
         }
     }
@@ -499,8 +535,42 @@ impl Scene {
                 let power = radiance * (std::f32::consts::PI * radius * radius) / pdf;
                 light::Emission { origin, direction: -wi, power, normal: None }
             }
+            (Light::Area { tri, .. }, _) if self.textured_emitter(*tri) => {
+                let t = self.triangle(*tri);
+                let mut em = l.sample_emission(Some(&t), (centre, radius), u);
+                em.power = self.emitted_at(*tri, self.barycentrics(*tri, em.origin)) * (std::f32::consts::PI * t.area);
+                em
+            }
             _ => l.sample_emission(self.light_triangle(l).as_ref(), (centre, radius), u),
         }
+    }
+
+    /// Radiance emitted from the front of triangle `tri` at barycentrics `b` (the emission
+    /// texture read there, or the constant emission).
+    #[must_use]
+    pub fn emitted_at(&self, tri: u32, b: [f32; 3]) -> Vec3 {
+        let i = tri as usize;
+        let m = &self.materials[self.material[i] as usize];
+        match self.uv.get(i) {
+            Some(t) if m.maps.ke.is_some() => m.emission_at(t[0] * b[0] + t[1] * b[1] + t[2] * b[2]),
+            _ => m.emission,
+        }
+    }
+
+    /// Whether triangle `tri`'s emission comes from a texture.
+    fn textured_emitter(&self, tri: u32) -> bool {
+        self.materials[self.material[tri as usize] as usize].maps.ke.is_some() && !self.uv.is_empty()
+    }
+
+    /// The barycentrics of point `q` of triangle `tri`.
+    fn barycentrics(&self, tri: u32, q: Vec3) -> [f32; 3] {
+        let i = tri as usize;
+        let (a, b, c) = (self.p0[i], self.p1[i], self.p2[i]);
+        let n = (b - a).cross(c - a);
+        let n2 = n.length_squared().max(f32::MIN_POSITIVE);
+        let b1 = (q - a).cross(c - a).dot(n) / n2;
+        let b2 = (b - a).cross(q - a).dot(n) / n2;
+        [1.0 - b1 - b2, b1, b2]
     }
 
     /// Radiance reaching a ray that leaves the scene in direction `d`: the environment's and

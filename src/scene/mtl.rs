@@ -243,7 +243,7 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
                 let Some(file) = texture_file(&words) else {
                     return Err(Error::parse(path, line, format!("`{kw}` names no image file")));
                 };
-                if matches!(kw, "map_Kd" | "map_Ks") {
+                if matches!(kw, "map_Kd" | "map_Ks" | "map_Pr" | "map_Ke") {
                     if words.first().is_some_and(|w| w.starts_with('-')) {
                         ignore(m, &format!("{kw} options"));
                     }
@@ -255,11 +255,18 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
             other => return Err(Error::parse(path, line, format!("unknown MTL statement `{other}`"))),
         }
     }
+    for m in &mut out {
+        // Without `Pr` > 0 the material is smooth and has no roughness for `map_Pr` to vary.
+        if !m.pr.is_some_and(|r| r > 0.0) && m.map("map_Pr").is_some() {
+            m.maps.retain(|s| s.key != "map_Pr");
+            m.ignored.push("map_Pr without Pr > 0".into());
+        }
+    }
     for m in &out {
         if !m.ignored.is_empty() {
             warnings.push(format!(
-                "{}:{}: material `{}`: {} not simulated yet (of the texture maps only `map_Kd` and `map_Ks` \
-                 are, without options; transparency and the PBR keys are ignored); it renders with its constant \
+                "{}:{}: material `{}`: {} not simulated yet (of the texture maps only `map_Kd`, `map_Ks`, \
+                 `map_Ke` and `map_Pr` are, without options; transparency and the PBR keys are ignored); it renders with its constant \
                  colours there",
                 path.display(),
                 m.line,
@@ -279,7 +286,8 @@ pub fn material_from_mtl(m: &MtlMaterial, warnings: &mut Vec<String>) -> Materia
     // within kd + ks ≤ 1 where they are read, `Material::bsdf_at`).
     let ks_map = m.map("map_Ks").is_some();
     let ks = m.ks.unwrap_or(if ks_map { Vec3::ONE } else { Vec3::ZERO });
-    let emission = m.ke.unwrap_or(Vec3::ZERO);
+    // A `map_Ke` makes an emitter even without `Ke`; its texels replace the emission.
+    let emission = m.ke.unwrap_or(if m.map("map_Ke").is_some() { Vec3::ONE } else { Vec3::ZERO });
     let rough = m.pr.filter(|&r| r > 0.0).map(alpha_of);
     let metal = m.pm.is_some_and(|p| p >= 0.5);
     let bsdf = match (m.illum.unwrap_or(2), rough) {
@@ -350,13 +358,15 @@ mod tests {
 
     #[test]
     fn pbr_roughness_and_metallic_make_rough_materials() {
-        let text = "newmtl metal\nKd 0.9 0.6 0.3\nPm 1\nPr 0.4\nnewmtl frosted\nillum 7\nNi 1.4\nPr 0.5\n\
+        let text =
+            "newmtl metal\nKd 0.9 0.6 0.3\nPm 1\nmap_Pr r.png\nPr 0.4\nnewmtl frosted\nillum 7\nNi 1.4\nPr 0.5\n\
                     newmtl chrome\nKd 0.8 0.8 0.8\nPm 1\nPr 0\nnewmtl plastic\nKd 0.5 0.5 0.5\nPr 0.3\n";
         let (m, w) = parse(text);
         let m = m.unwrap();
         let mut w2 = Vec::new();
         let b: Vec<Bsdf> = m.iter().map(|x| material_from_mtl(x, &mut w2).bsdf).collect();
         assert_eq!(b[0], Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.6, 0.3), alpha: alpha_of(0.4) });
+        assert!(m[0].map("map_Pr").is_some(), "map_Pr before Pr is kept");
         assert_eq!(b[1], Bsdf::RoughDielectric { ior: 1.4, alpha: alpha_of(0.5) });
         assert_eq!(b[2], Bsdf::Mirror { ks: Vec3::splat(0.8) });
         assert_eq!(b[3], Bsdf::RoughPlastic { kd: Vec3::splat(0.5), ior: 1.5, alpha: alpha_of(0.3) });

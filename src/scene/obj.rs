@@ -75,15 +75,15 @@ impl MaterialTable {
     /// error naming it and the MTL statement.
     pub fn load_maps(&mut self, mtl_path: &Path, m: &MtlMaterial, inputs: &mut Vec<PathBuf>) -> Result<Maps> {
         let dir = mtl_path.parent().unwrap_or(Path::new("."));
-        let mut load = |key: &str| -> Result<Option<Arc<Texture>>> {
+        let mut load = |key: &str, encoding: Encoding| -> Result<Option<Arc<Texture>>> {
             let Some(st) = m.map(key) else { return Ok(None) };
             let path = dir.join(&st.file);
-            let cache_key = (path.clone(), Encoding::Srgb);
+            let cache_key = (path.clone(), encoding);
             if let Some(t) = self.textures.get(&cache_key) {
                 return Ok(Some(t.clone()));
             }
             let what = format!("a `{key}` texture");
-            let texture = load_texture(&path, Encoding::Srgb, &what).map_err(|e| {
+            let texture = load_texture(&path, encoding, &what).map_err(|e| {
                 named_by_statement(
                     e,
                     &format!("`{key}` of material `{}` at {}:{}", m.name, mtl_path.display(), st.line),
@@ -94,7 +94,12 @@ impl MaterialTable {
             self.textures.insert(cache_key, texture.clone());
             Ok(Some(texture))
         };
-        Ok(Maps { kd: load("map_Kd")?, ks: load("map_Ks")? })
+        Ok(Maps {
+            kd: load("map_Kd", Encoding::Srgb)?,
+            ks: load("map_Ks", Encoding::Srgb)?,
+            roughness: load("map_Pr", Encoding::Linear)?,
+            ke: load("map_Ke", Encoding::Srgb)?,
+        })
     }
 
     /// Index of the grey Lambertian used for faces without a material.

@@ -128,22 +128,23 @@ pub fn aimed_emission(scene: &Scene, light: &Light, u: [f32; 5]) -> Option<Emiss
             let x = t.p[0] * (1.0 - b1 - b2) + t.p[1] * b1 + t.p[2] * b2;
             if cones_cover(x, targets) >= 2.0 * PI {
                 // The targets fill the emitter's hemisphere or more: cosine sampling is better.
-                return Some(light.sample_emission(
-                    Some(&t),
-                    (scene.centre(), scene.radius()),
-                    [u[0], u[1], u[2], u[3]],
-                ));
+                return Some(scene.sample_emission(light, [u[0], u[1], u[2], u[3]]));
             }
             let (d, pdf) = aim_from(x, targets, [u[2], u[3], u[4]])?;
             let cos = d.dot(t.n);
             if !(cos > 0.0) {
                 return None;
             }
+            let radiance = if scene.materials[scene.material[tri as usize] as usize].maps.ke.is_some() {
+                scene.emitted_at(tri, [1.0 - b1 - b2, b1, b2])
+            } else {
+                radiance
+            };
             Emission { origin: x, direction: d, power: radiance * (cos * t.area / pdf), normal: Some(t.n) }
         }
         Light::Point { position, intensity } => {
             if cones_cover(position, targets) >= 4.0 * PI {
-                return Some(light.sample_emission(None, (scene.centre(), scene.radius()), [u[0], u[1], u[2], u[3]]));
+                return Some(scene.sample_emission(light, [u[0], u[1], u[2], u[3]]));
             }
             let (d, pdf) = aim_from(position, targets, [u[2], u[3], u[4]])?;
             Emission { origin: position, direction: d, power: intensity / pdf, normal: None }
@@ -151,7 +152,7 @@ pub fn aimed_emission(scene: &Scene, light: &Light, u: [f32; 5]) -> Option<Emiss
         Light::Spot { position, direction, intensity, cos_inner, cos_outer } => {
             if cones_cover(position, targets) >= 2.0 * PI * (1.0 - cos_outer) {
                 // The spot's own cone is the narrower: sample it as unaimed photons do.
-                return Some(light.sample_emission(None, (scene.centre(), scene.radius()), [u[0], u[1], u[2], u[3]]));
+                return Some(scene.sample_emission(light, [u[0], u[1], u[2], u[3]]));
             }
             let (d, pdf) = aim_from(position, targets, [u[2], u[3], u[4]])?;
             let fall = spot_falloff(d.dot(direction), cos_inner, cos_outer);

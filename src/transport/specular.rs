@@ -83,13 +83,15 @@ pub fn first_non_specular(
     None
 }
 
-/// Radiance emitted by triangle `tri` toward `wo` (zero from its back face or a non-emitter).
+/// Radiance emitted at `hit` toward `wo` (zero from its back face or a non-emitter; an
+/// emission texture read at the hit's texture coordinates).
 #[inline]
 #[must_use]
-pub fn emission_toward(scene: &Scene, tri: u32, wo: Vec3) -> Vec3 {
-    let e = scene.materials[scene.material[tri as usize] as usize].emission;
-    if e != Vec3::ZERO && wo.dot(scene.ng[tri as usize]) > 0.0 {
-        e
+pub fn emission_toward(scene: &Scene, hit: &crate::geometry::Hit, wo: Vec3) -> Vec3 {
+    let tri = hit.tri as usize;
+    let m = &scene.materials[scene.material[tri] as usize];
+    if m.emission != Vec3::ZERO && wo.dot(scene.ng[tri]) > 0.0 {
+        scene.emitted_at(hit.tri, hit.b)
     } else {
         Vec3::ZERO
     }

@@ -76,7 +76,7 @@ pub fn deposit_emission(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut s
             continue;
         }
         let emission = match w.paths.hits.get(i) {
-            Some(hit) => emission_toward(scene, hit.tri, -w.paths.rays.direction(i)),
+            Some(hit) => emission_toward(scene, &hit, -w.paths.rays.direction(i)),
             // Leaving the scene: the environment and the sun.
             None if scene.has_background() => scene.background(w.paths.rays.direction(i)),
             None => continue,
