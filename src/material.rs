@@ -257,17 +257,25 @@ impl Bsdf {
     /// f(wo, wi) for the non-delta part; zero unless wo and wi lie on the same geometric side.
     #[must_use]
     pub fn eval(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Vec3 {
-        if let Some(f) = self.eval_rough(frame, wo, wi) {
-            return f;
-        }
-        let (ng, ns) = frame.oriented(wo);
-        if wi.dot(ng) <= 0.0 {
-            return Vec3::ZERO;
-        }
         match *self {
-            Bsdf::Lambert { kd } => kd / PI,
-            Bsdf::Glossy { kd, ks, exponent } => kd / PI + ks * phong_lobe(reflect(wo, ns), wi, exponent),
-            _ => Vec3::ZERO,
+            Bsdf::Lambert { kd } => {
+                let (ng, _) = frame.oriented(wo);
+                if wi.dot(ng) <= 0.0 {
+                    Vec3::ZERO
+                } else {
+                    kd / PI
+                }
+            }
+            Bsdf::Glossy { kd, ks, exponent } => {
+                let (ng, ns) = frame.oriented(wo);
+                if wi.dot(ng) <= 0.0 {
+                    Vec3::ZERO
+                } else {
+                    kd / PI + ks * phong_lobe(reflect(wo, ns), wi, exponent)
+                }
+            }
+            Bsdf::Mirror { .. } | Bsdf::Glass { .. } => Vec3::ZERO,
+            _ => self.eval_rough(frame, wo, wi).unwrap_or(Vec3::ZERO),
         }
     }
 

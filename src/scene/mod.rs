@@ -559,7 +559,7 @@ impl Scene {
 
     /// Whether triangle `tri`'s emission comes from a texture.
     fn textured_emitter(&self, tri: u32) -> bool {
-        self.materials[self.material[tri as usize] as usize].maps.ke.is_some() && !self.uv.is_empty()
+        !self.uv.is_empty() && self.materials[self.material[tri as usize] as usize].maps.ke.is_some()
     }
 
     /// The barycentrics of point `q` of triangle `tri`.

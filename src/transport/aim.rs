@@ -135,11 +135,12 @@ pub fn aimed_emission(scene: &Scene, light: &Light, u: [f32; 5]) -> Option<Emiss
             if !(cos > 0.0) {
                 return None;
             }
-            let radiance = if scene.materials[scene.material[tri as usize] as usize].maps.ke.is_some() {
-                scene.emitted_at(tri, [1.0 - b1 - b2, b1, b2])
-            } else {
-                radiance
-            };
+            let radiance =
+                if !scene.uv.is_empty() && scene.materials[scene.material[tri as usize] as usize].maps.ke.is_some() {
+                    scene.emitted_at(tri, [1.0 - b1 - b2, b1, b2])
+                } else {
+                    radiance
+                };
             Emission { origin: x, direction: d, power: radiance * (cos * t.area / pdf), normal: Some(t.n) }
         }
         Light::Point { position, intensity } => {
