@@ -80,15 +80,22 @@ pub struct Maps {
     /// Roughness (MTL `map_Pr`, a linear data map read from its red channel): replaces the rough
     /// materials' roughness, within the material's photon class ([`Material::bsdf_at`]).
     pub roughness: Option<Arc<Texture>>,
-    /// Emitted radiance (MTL `map_Ke`): replaces the emission of an emitter.
+    /// Emitted radiance (MTL `map_Ke`): multiplies the emission of an emitter.
     pub ke: Option<Arc<Texture>>,
+    /// Metalness (MTL `map_Pm`, data, red channel): where it is at least ½ a rough material is a
+    /// rough conductor of the base colour, elsewhere a rough plastic of it ([`Material::bsdf_at`]).
+    pub metallic: Option<Arc<Texture>>,
 }
 
 impl Maps {
     /// True when the material has no texture.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.kd.is_none() && self.ks.is_none() && self.roughness.is_none() && self.ke.is_none()
+        self.kd.is_none()
+            && self.ks.is_none()
+            && self.roughness.is_none()
+            && self.ke.is_none()
+            && self.metallic.is_none()
     }
 }
 
@@ -99,14 +106,15 @@ impl Material {
         Material { name: name.into(), bsdf, emission, maps: Maps::default() }
     }
 
-    /// The radiance emitted at texture coordinates `uv` from the front face: the emission
-    /// texture's value there, or the constant emission.
+    /// The radiance emitted at texture coordinates `uv` from the front face: the constant
+    /// emission times the emission texture's value there (an 8-bit texture holds colours up to 1;
+    /// `Ke` scales them, as the MTL spec multiplies a map by its constant).
     #[inline]
     #[must_use]
     pub fn emission_at(&self, uv: Vec2) -> Vec3 {
         match &self.maps.ke {
-            Some(t) if self.emission != Vec3::ZERO => t.lookup(uv),
-            _ => self.emission,
+            Some(t) => self.emission * t.lookup(uv),
+            None => self.emission,
         }
     }
 
@@ -127,6 +135,22 @@ impl Material {
         let alpha_at = |alpha: f32| {
             self.maps.roughness.as_ref().map_or(alpha, |t| microfacet::alpha_of(t.lookup(uv).x.clamp(0.0, 1.0)))
         };
+        if let Some(m) = &self.maps.metallic {
+            // The PBR extension's metallic workflow, per point: the base colour makes a metal's
+            // reflectance or a plastic's base. Metal parts store photons (α at least
+            // PHOTON_SPECULAR_ALPHA), as plastic does, so the material's photon class is one.
+            let (base, ior, alpha) = match self.bsdf {
+                Bsdf::RoughPlastic { kd, ior, alpha } => (kd_at(kd), ior, alpha_at(alpha)),
+                Bsdf::RoughConductor { ks, alpha } => (ks_at(ks), 1.5, alpha_at(alpha)),
+                other => return other,
+            };
+            let base = base.min(Vec3::ONE);
+            return if m.lookup(uv).x >= 0.5 {
+                Bsdf::RoughConductor { ks: base, alpha: alpha.max(PHOTON_SPECULAR_ALPHA) }
+            } else {
+                Bsdf::RoughPlastic { kd: base, ior, alpha }
+            };
+        }
         match self.bsdf {
             Bsdf::Lambert { kd } => Bsdf::Lambert { kd: kd_at(kd).min(Vec3::ONE) },
             Bsdf::Glossy { kd, ks, exponent } => {
@@ -242,6 +266,35 @@ impl Bsdf {
                 microfacet::plastic_base(f.to_local(wo), f.to_local(wi), kd, ior)
             }
             _ => self.diffuse(),
+        }
+    }
+
+    /// Whether the material has a part its glossy ray does not sample (a Lambertian, a Phong
+    /// material's kd, a rough plastic's base).
+    #[must_use]
+    pub fn has_base(&self) -> bool {
+        matches!(self, Bsdf::Lambert { .. } | Bsdf::Glossy { .. } | Bsdf::RoughPlastic { .. })
+    }
+
+    /// f(wo, wi) of that part alone: kd/π, or the rough plastic's base
+    /// kd/π·(1 − F(θo))(1 − F(θi)); zero for the others.
+    #[must_use]
+    pub fn eval_base(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Vec3 {
+        let (ng, ns) = frame.oriented(wo);
+        if wi.dot(ng) <= 0.0 {
+            return Vec3::ZERO;
+        }
+        match *self {
+            Bsdf::Lambert { kd } | Bsdf::Glossy { kd, .. } => kd / PI,
+            Bsdf::RoughPlastic { kd, ior, .. } => {
+                let f = Frame::new(ns);
+                let (lo, li) = (f.to_local(wo), f.to_local(wi));
+                if lo.z <= 0.0 || li.z <= 0.0 {
+                    return Vec3::ZERO;
+                }
+                microfacet::plastic_base(lo, li, kd, ior) / PI
+            }
+            _ => Vec3::ZERO,
         }
     }
 
@@ -588,6 +641,23 @@ mod tests {
             panic!()
         };
         assert!((alpha - 0.04).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_metallic_map_picks_conductor_or_plastic_per_point() {
+        let two =
+            Some(Arc::new(Texture::new(std::path::Path::new("m.png"), 2, 1, vec![Vec3::ZERO, Vec3::ONE]).unwrap()));
+        let m = Material {
+            maps: Maps { metallic: two, ..Maps::default() },
+            ..Material::new("m", Bsdf::RoughPlastic { kd: Vec3::new(0.9, 0.5, 0.1), ior: 1.4, alpha: 0.04 }, Vec3::ZERO)
+        };
+        assert_eq!(
+            m.bsdf_at(Vec2::new(0.25, 0.5)),
+            Bsdf::RoughPlastic { kd: Vec3::new(0.9, 0.5, 0.1), ior: 1.4, alpha: 0.04 }
+        );
+        let metal = m.bsdf_at(Vec2::new(0.75, 0.5));
+        assert_eq!(metal, Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.5, 0.1), alpha: PHOTON_SPECULAR_ALPHA });
+        assert!(!metal.photon_specular(), "metal parts store photons, as the plastic does");
     }
 
     #[test]

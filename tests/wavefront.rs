@@ -49,6 +49,16 @@ fn wavefront_matches_reference_per_pixel_on_every_bundled_scene() {
     let glossy = glossy_spheres();
     let lights = delta_lights();
     let (smooth_rough, rough) = (rough_spheres(0.2), rough_spheres(0.6));
+    // With a point light too: camera paths passing the frosted and smooth rough spheres take
+    // the point light's direct light there.
+    let lit_rough = {
+        let p = rough_spheres(0.15);
+        let text = std::fs::read_to_string(&p).unwrap()
+            + "[[light]]\ntype = \"point\"\nposition = [0.1, 0.45, 0.3]\nintensity = [0.05, 0.05, 0.05]\n";
+        let q = p.with_file_name("lit-rough.toml");
+        std::fs::write(&q, text).unwrap();
+        q
+    };
     let scenes = [
         "cornell-box.toml",
         "cornell-spheres.toml",
@@ -57,6 +67,7 @@ fn wavefront_matches_reference_per_pixel_on_every_bundled_scene() {
         lights.to_str().unwrap(),
         smooth_rough.to_str().unwrap(),
         rough.to_str().unwrap(),
+        lit_rough.to_str().unwrap(),
     ];
     for scene in scenes {
         // The secondary gather at its default (many gather rays landing near: in one-pass

@@ -18,8 +18,8 @@ use crate::scene::camera::CameraRays;
 use crate::scene::{Scene, SurfacePoint};
 use crate::stats::{Numerics, RayCounts};
 use crate::transport::camera::render_pixels;
-use crate::transport::direct::direct_light;
-use crate::transport::estimate::{caustic_estimate, indirect_estimate, map_radiance};
+use crate::transport::direct::{delta_light, direct_light};
+use crate::transport::estimate::{camera_indirect_estimate, caustic_estimate, indirect_estimate, map_radiance};
 use crate::transport::gather::{glossy_ray, lands_near, trace_gather_rays};
 use crate::transport::specular::{continue_ray, emission_toward, first_non_specular, ChainEnd};
 use crate::transport::{streams, Context, PhotonMaps};
@@ -75,6 +75,10 @@ pub fn trace_camera_path(
         // metal): the path goes on by sampling, so the lights and sky seen through them are
         // found as emission, as their photons' caustics are found in the caustic map.
         if bsdf.is_delta() || bsdf.photon_specular() {
+            if !bsdf.is_delta() && !scene.delta_lights.is_empty() {
+                let d = delta_light(ctx, &sp, &bsdf, wo, &s.fork(streams::light(depth)), rays);
+                terms.add(Term::Direct.seen(through_specular), beta * d);
+            }
             if depth == ctx.settings.max_depth {
                 break;
             }
@@ -89,7 +93,7 @@ pub fn trace_camera_path(
         let indirect = if ctx.effects.final_gather.on {
             final_gather(ctx, &sp, &bsdf, wo, &s.fork(streams::gather(depth)), rays, scratch)
         } else {
-            indirect_estimate(ctx, &sp, &bsdf, wo, Some(pixel), scratch).into()
+            camera_indirect_estimate(ctx, &sp, &bsdf, wo, Some(pixel), scratch).into()
         };
         let glossy = glossy_reflection(ctx, &sp, &bsdf, wo, &s.fork(streams::glossy(depth)), rays, scratch);
         let (caustic_l, indirect_l, glossy_l) =

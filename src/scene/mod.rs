@@ -279,7 +279,7 @@ impl Scene {
                 // A textured emitter's radiance here only weighs its pick (its power): the
                 // samples read the texture where they land (`Scene::sample_incident`, …).
                 let radiance = match (&m.maps.ke, uv.get(i)) {
-                    (Some(t), Some(tri_uv)) => textured_mean(t, tri_uv),
+                    (Some(t), Some(tri_uv)) => m.emission * textured_mean(t, tri_uv),
                     _ => m.emission,
                 };
                 Light::Area { tri: i as u32, radiance }
@@ -564,13 +564,17 @@ impl Scene {
 
     /// The barycentrics of point `q` of triangle `tri`.
     fn barycentrics(&self, tri: u32, q: Vec3) -> [f32; 3] {
+        // In f64: |n|² of a large or thin triangle overflows or underflows f32.
         let i = tri as usize;
-        let (a, b, c) = (self.p0[i], self.p1[i], self.p2[i]);
+        let (a, b, c, q) = (self.p0[i].as_dvec3(), self.p1[i].as_dvec3(), self.p2[i].as_dvec3(), q.as_dvec3());
         let n = (b - a).cross(c - a);
-        let n2 = n.length_squared().max(f32::MIN_POSITIVE);
+        let n2 = n.length_squared();
+        if !(n2 > 0.0) {
+            return [1.0 / 3.0; 3];
+        }
         let b1 = (q - a).cross(c - a).dot(n) / n2;
         let b2 = (b - a).cross(q - a).dot(n) / n2;
-        [1.0 - b1 - b2, b1, b2]
+        [(1.0 - b1 - b2) as f32, b1 as f32, b2 as f32]
     }
 
     /// Radiance reaching a ray that leaves the scene in direction `d`: the environment's and

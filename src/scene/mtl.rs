@@ -243,7 +243,7 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
                 let Some(file) = texture_file(&words) else {
                     return Err(Error::parse(path, line, format!("`{kw}` names no image file")));
                 };
-                if matches!(kw, "map_Kd" | "map_Ks" | "map_Pr" | "map_Ke") {
+                if matches!(kw, "map_Kd" | "map_Ks" | "map_Pr" | "map_Ke" | "map_Pm") {
                     if words.first().is_some_and(|w| w.starts_with('-')) {
                         ignore(m, &format!("{kw} options"));
                     }
@@ -257,16 +257,23 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
     }
     for m in &mut out {
         // Without `Pr` > 0 the material is smooth and has no roughness for `map_Pr` to vary.
-        if !m.pr.is_some_and(|r| r > 0.0) && m.map("map_Pr").is_some() {
-            m.maps.retain(|s| s.key != "map_Pr");
-            m.ignored.push("map_Pr without Pr > 0".into());
+        for key in ["map_Pr", "map_Pm"] {
+            if !m.pr.is_some_and(|r| r > 0.0) && m.map(key).is_some() {
+                m.maps.retain(|s| s.key != key);
+                m.ignored.push(format!("{key} without Pr > 0"));
+            }
+        }
+        // A metallic map on a smooth mirror or glass (illum 3–9) has no plastic to mix with.
+        if matches!(m.illum, Some(3..=9)) && m.map("map_Pm").is_some() {
+            m.maps.retain(|s| s.key != "map_Pm");
+            m.ignored.push("map_Pm on a mirror or glass".into());
         }
     }
     for m in &out {
         if !m.ignored.is_empty() {
             warnings.push(format!(
                 "{}:{}: material `{}`: {} not simulated yet (of the texture maps only `map_Kd`, `map_Ks`, \
-                 `map_Ke` and `map_Pr` are, without options; transparency and the PBR keys are ignored); it renders with its constant \
+                 `map_Ke`, `map_Pr` and `map_Pm` are, without options; transparency and the PBR keys are ignored); it renders with its constant \
                  colours there",
                 path.display(),
                 m.line,

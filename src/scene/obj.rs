@@ -99,6 +99,7 @@ impl MaterialTable {
             ks: load("map_Ks", Encoding::Srgb)?,
             roughness: load("map_Pr", Encoding::Linear)?,
             ke: load("map_Ke", Encoding::Srgb)?,
+            metallic: load("map_Pm", Encoding::Linear)?,
         })
     }
 
@@ -220,6 +221,13 @@ pub fn load_obj(
         // A PBR metal's colour is its `Kd`: so is its texture's.
         if m.pm.is_some_and(|p| p >= 0.5) && material.maps.ks.is_none() {
             material.maps.ks = material.maps.kd.take();
+        }
+        // With a metallic map the material stores photons everywhere (its metal parts at least at
+        // the photon threshold's roughness): one photon class per material.
+        if material.maps.metallic.is_some() {
+            if let Bsdf::RoughConductor { alpha, .. } = &mut material.bsdf {
+                *alpha = alpha.max(crate::material::PHOTON_SPECULAR_ALPHA);
+            }
         }
         ids.push(table.insert(file, material, warnings));
     }

@@ -26,8 +26,8 @@ pub struct ShadowRay {
     pub contribution: Vec3,
 }
 
-/// The shadow rays of direct light at `sp` toward `wo`: every delta light once, then
-/// `light_samples` area-light samples chosen by power. Lights that cannot contribute (behind
+/// The shadow rays of direct light at `sp` toward `wo`: every delta light once, then (unless
+/// `delta_only`) `light_samples` area-light samples chosen by power. Lights that cannot contribute (behind
 /// the surface, back faces, outside a spot cone) get no ray.
 pub fn direct_light_rays(
     ctx: &Context,
@@ -35,6 +35,7 @@ pub fn direct_light_rays(
     bsdf: &Bsdf,
     wo: Vec3,
     s: &Sampler,
+    delta_only: bool,
     mut emit: impl FnMut(ShadowRay),
 ) {
     let scene = ctx.scene;
@@ -57,6 +58,9 @@ pub fn direct_light_rays(
     for &li in &scene.delta_lights {
         add(li, [0.5, 0.5], 1.0);
     }
+    if delta_only {
+        return;
+    }
     if let Some(dist) = &scene.area_power {
         let n = ctx.settings.light_samples;
         for j in 0..n {
@@ -77,7 +81,21 @@ pub fn direct_light(
     rays: &mut RayCounts,
 ) -> Vec3 {
     let mut sum = Vec3::ZERO;
-    direct_light_rays(ctx, sp, bsdf, wo, s, |r| {
+    direct_light_rays(ctx, sp, bsdf, wo, s, false, |r| {
+        rays.shadow += 1;
+        if !ctx.scene.occluded(r.origin, r.direction, r.t_max) {
+            sum += r.contribution;
+        }
+    });
+    sum
+}
+
+/// Direct light from the delta lights alone (point, spot, directional) at a surface that camera
+/// paths pass by sampling (frosted glass, smooth rough metal): sampling never reaches a delta
+/// light, and the other lights are found as emission along the sampled path.
+pub fn delta_light(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler, rays: &mut RayCounts) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    direct_light_rays(ctx, sp, bsdf, wo, s, true, |r| {
         rays.shadow += 1;
         if !ctx.scene.occluded(r.origin, r.direction, r.t_max) {
             sum += r.contribution;

@@ -27,8 +27,12 @@ fn map_estimate(
     wo: Vec3,
     mask: u8,
     fixed: Option<f32>,
+    base: bool,
     scratch: &mut Vec<(f32, u32)>,
 ) -> Estimate {
+    if base && !bsdf.has_base() {
+        return Estimate::default();
+    }
     let (ng, _) = sp.frame.oriented(wo);
     let lookup = Lookup {
         p: sp.p,
@@ -37,10 +41,12 @@ fn map_estimate(
         kernel: ctx.settings.kernel,
         filter: Filter { n: ng, flags_mask: mask },
     };
-    let eval = |wi| bsdf.eval(&sp.frame, wo, wi);
+    let eval = |wi| if base { bsdf.eval_base(&sp.frame, wo, wi) } else { bsdf.eval(&sp.frame, wo, wi) };
     let f = match *bsdf {
-        // Lambertian: f = kd/π above the surface, 0 below — no per-photon call.
+        // Lambertian (or a glossy material's base): f = kd/π above the surface, 0 below — no
+        // per-photon call.
         Bsdf::Lambert { kd } => Reflectance::Hemisphere { value: kd * std::f32::consts::FRAC_1_PI, ng },
+        Bsdf::Glossy { kd, .. } if base => Reflectance::Hemisphere { value: kd * std::f32::consts::FRAC_1_PI, ng },
         _ => Reflectance::PerPhoton(&eval),
     };
     let set = ctx.settings.code_path;
@@ -107,7 +113,19 @@ pub fn caustic_estimate(
     scratch: &mut Vec<(f32, u32)>,
 ) -> Estimate {
     let fixed = ctx.fixed.map(|r| r.caustic_at(pixel));
-    map_estimate(ctx, &ctx.maps.caustic, ctx.settings.caustic_k, ctx.caustic_radius, sp, bsdf, wo, 0, fixed, scratch)
+    map_estimate(
+        ctx,
+        &ctx.maps.caustic,
+        ctx.settings.caustic_k,
+        ctx.caustic_radius,
+        sp,
+        bsdf,
+        wo,
+        0,
+        fixed,
+        false,
+        scratch,
+    )
 }
 
 /// Global-map radiance estimate at `sp` toward `wo`, ignoring photons with any `mask` flag;
@@ -123,7 +141,7 @@ pub fn global_estimate(
     scratch: &mut Vec<(f32, u32)>,
 ) -> Estimate {
     let fixed = ctx.fixed.map(|r| r.global_at(pixel));
-    map_estimate(ctx, &ctx.maps.global, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, fixed, scratch)
+    map_estimate(ctx, &ctx.maps.global, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, fixed, false, scratch)
 }
 
 /// Indirect light at `sp` toward `wo` from the global map alone: its estimate without direct and
@@ -139,6 +157,24 @@ pub fn indirect_estimate(
     scratch: &mut Vec<(f32, u32)>,
 ) -> Estimate {
     global_estimate(ctx, sp, bsdf, wo, flags::OWN_TERMS, pixel, scratch)
+}
+
+/// [`indirect_estimate`] at a camera path's own vertex, where a glossy lobe is followed by its
+/// own ray ([`crate::transport::gather::glossy_ray`]): photons are weighed by the part of the
+/// BSDF that ray does not sample (a Phong material's kd/π, a rough plastic's base; nothing for
+/// a rough conductor or dielectric), so no path is counted twice.
+#[inline]
+pub fn camera_indirect_estimate(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    pixel: Option<usize>,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Estimate {
+    let fixed = ctx.fixed.map(|r| r.global_at(pixel));
+    let (k, r) = (ctx.settings.k, ctx.global_radius);
+    map_estimate(ctx, &ctx.maps.global, k, r, sp, bsdf, wo, flags::OWN_TERMS, fixed, true, scratch)
 }
 
 /// Radiance leaving a non-specular point toward `wo` as the photon maps see it: kd/π × the

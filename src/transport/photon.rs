@@ -146,6 +146,10 @@ pub fn start_photon(scene: &Scene, seed: u64, domain: Domain, index: u64, aim: b
     if !power.is_finite() || !em.direction.is_finite() {
         return Start::NonFinite;
     }
+    if power == Vec3::ZERO {
+        // A black texel of an emission texture, or an environment sample of no light.
+        return Start::Dark;
+    }
     let origin = match (em.normal, tri) {
         (Some(n), Some(t)) => {
             // The emission point's rounding error is bounded like any barycentric point.

@@ -10,7 +10,7 @@ use crate::film::Term;
 use crate::material::Bsdf;
 use crate::photon_map::Estimate;
 use crate::scene::SurfacePoint;
-use crate::transport::estimate::{caustic_estimate, indirect_estimate, map_radiance};
+use crate::transport::estimate::{camera_indirect_estimate, caustic_estimate, indirect_estimate, map_radiance};
 use crate::transport::Context;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -107,6 +107,8 @@ pub fn gather_global(
         |ctx, sp, bsdf, wo, kind, pixel, scratch| {
             if kind.reads_maps() {
                 map_radiance(ctx, sp, bsdf, wo, scratch)
+            } else if kind == PathKind::Camera {
+                camera_indirect_estimate(ctx, sp, bsdf, wo, pixel, scratch)
             } else {
                 indirect_estimate(ctx, sp, bsdf, wo, pixel, scratch)
             }

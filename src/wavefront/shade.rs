@@ -89,8 +89,23 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
     let t = Instant::now();
     let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
     let w = &*work;
-    let lanes: Vec<u32> =
+    let scene = &*shared.scene;
+    // Camera lanes at surfaces passed by sampling (frosted glass, smooth rough metal) take the
+    // delta lights' direct light there; lanes merged in order.
+    let passed = |l: &u32| {
+        let i = *l as usize;
+        w.paths.kind[i] == PathKind::Camera
+            && w.paths.hits.get(i).is_some_and(|h| {
+                let b = &scene.materials[scene.material[h.tri as usize] as usize].bsdf;
+                !b.is_delta() && b.photon_specular()
+            })
+    };
+    let mut lanes: Vec<u32> =
         w.classified.diffuse.iter().copied().filter(|&l| !w.paths.kind[l as usize].reads_maps()).collect();
+    if !scene.delta_lights.is_empty() {
+        lanes.extend(w.classified.mirror.iter().copied().filter(passed));
+        lanes.sort_unstable();
+    }
     let mut queued = ShadowQueue::default();
     par_columns(
         lanes.len(),
@@ -111,7 +126,9 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
                     _ => (s.fork(streams::GLOSSY_HIT_LIGHT), w.paths.term[i]),
                 };
                 let (beta, sample) = (w.paths.beta[i], w.paths.sample[i]);
-                direct_light_rays(&ctx, &sp, bsdf, -w.paths.rays.direction(i), &stream, |ray: ShadowRay| {
+                let delta_only = !bsdf.is_delta() && bsdf.photon_specular();
+                let wo = -w.paths.rays.direction(i);
+                direct_light_rays(&ctx, &sp, bsdf, wo, &stream, delta_only, |ray: ShadowRay| {
                     part.push(ShadowLane {
                         origin: ray.origin,
                         dir: ray.direction,
