@@ -134,12 +134,14 @@ pub fn conductor_sample(wo: Vec3, f0: Vec3, alpha: f32, u: [f32; 2]) -> Option<L
     Some(LocalSample { wi, weight })
 }
 
-/// The generalised half vector of refraction from `wo` to `wi` (opposite sides), `eta` =
-/// η(wi side)/η(wo side), turned to wo's side.
-fn refraction_half(wo: Vec3, wi: Vec3, eta: f32) -> Option<Vec3> {
-    let m = -(wo + wi * eta);
-    let m = m.try_normalize()?;
-    Some(if m.z < 0.0 { -m } else { m })
+/// The refraction from `wo` to `wi` (opposite sides), `eta` = η(wi side)/η(wo side): its
+/// generalised half vector m turned to wo's side, wo·m and wi·m; `None` unless they lie on the
+/// two sides of the microfacet, as refraction needs.
+fn refraction_half(wo: Vec3, wi: Vec3, eta: f32) -> Option<(Vec3, f32, f32)> {
+    let m = (-(wo + wi * eta)).try_normalize()?;
+    let m = if m.z < 0.0 { -m } else { m };
+    let (om, im) = (wo.dot(m), wi.dot(m));
+    (om > 0.0 && im < 0.0).then_some((m, om, im))
 }
 
 /// Rough dielectric, radiance form: reflection F·D·G2/(4·wo.z·wi.z) on wo's side; refraction
@@ -154,12 +156,7 @@ pub fn dielectric_eval(wo: Vec3, wi: Vec3, eta: f32, alpha: f32) -> f32 {
         let m = (wo + wi).normalize();
         return fresnel_dielectric(wo.dot(m), eta) * d(m, alpha) * g2(wo, wi, alpha) / (4.0 * wo.z * wi.z);
     }
-    let Some(m) = refraction_half(wo, wi, eta) else { return 0.0 };
-    let (om, im) = (wo.dot(m), wi.dot(m));
-    // Both sides of the microfacet, as refraction needs.
-    if om <= 0.0 || im >= 0.0 {
-        return 0.0;
-    }
+    let Some((m, om, im)) = refraction_half(wo, wi, eta) else { return 0.0 };
     let denom = om + eta * im;
     let f = 1.0 - fresnel_dielectric(om, eta);
     f * d(m, alpha) * g2(wo, -wi, alpha) * om * (-im) / (wo.z * (-wi.z) * denom * denom)
@@ -175,11 +172,7 @@ pub fn dielectric_pdf(wo: Vec3, wi: Vec3, eta: f32, alpha: f32) -> f32 {
         let m = (wo + wi).normalize();
         return fresnel_dielectric(wo.dot(m), eta) * visible_d(wo, m, alpha) / (4.0 * wo.dot(m));
     }
-    let Some(m) = refraction_half(wo, wi, eta) else { return 0.0 };
-    let (om, im) = (wo.dot(m), wi.dot(m));
-    if om <= 0.0 || im >= 0.0 {
-        return 0.0;
-    }
+    let Some((m, om, im)) = refraction_half(wo, wi, eta) else { return 0.0 };
     let denom = om + eta * im;
     (1.0 - fresnel_dielectric(om, eta)) * visible_d(wo, m, alpha) * eta * eta * (-im) / (denom * denom)
 }

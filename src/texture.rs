@@ -83,12 +83,6 @@ impl Texture {
         let sum: glam::DVec3 = self.texels.iter().map(|t| t.as_dvec3()).sum();
         (sum / self.texels.len() as f64).as_vec3()
     }
-
-    /// Bytes held by the texels.
-    #[must_use]
-    pub fn bytes(&self) -> u64 {
-        self.texels.len() as u64 * std::mem::size_of::<Vec3>() as u64
-    }
 }
 
 #[cfg(test)]

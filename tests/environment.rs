@@ -175,12 +175,7 @@ fn both_engines_see_the_sky_and_agree_per_pixel() {
     };
     let (b1, b2) = (wavefront(1), wavefront(2));
     assert_eq!(b1.pixels, b2.pixels, "the wavefront engine is bit-identical across thread counts");
-    for (k, (x, y)) in a.pixels.iter().zip(&b1.pixels).enumerate() {
-        for (u, v) in x.as_array().into_iter().zip(y.as_array()) {
-            let d = ((u - v).abs() / u.abs().max(Vec3::ONE)).max_element();
-            assert!(d <= 1e-6, "pixel {k}: reference {u} against wavefront {v}");
-        }
-    }
+    assert_terms_agree(&a, &b1, 1e-6);
     // Camera rays that leave the scene see the sky exactly, so a pixel's `emitted` is k/4 of it
     // for the k of its 4 samples that miss the cube. The cube's pixels (convex: no
     // interreflection, no caustics) return kd·L on average, within 4 standard errors of their

@@ -149,12 +149,7 @@ fn engines_agree_on_a_textured_scene_at_any_thread_count() {
     let (b1, b2) = (wavefront(1), wavefront(2));
     assert_eq!(b1.pixels, b2.pixels, "the wavefront engine is bit-identical across thread counts");
     // As in tests/wavefront.rs: 1e-6 relative per term and channel.
-    for (k, (x, y)) in a.pixels.iter().zip(&b1.pixels).enumerate() {
-        for (u, v) in x.as_array().into_iter().zip(y.as_array()) {
-            let d = ((u - v).abs() / u.abs().max(Vec3::ONE)).max_element();
-            assert!(d <= 1e-6, "pixel {k}: reference {u} against wavefront {v}");
-        }
-    }
+    assert_terms_agree(&a, &b1, 1e-6);
     assert!(a.pixels.iter().any(|p| p.indirect != Vec3::ZERO), "the textured floor reflects photons");
 }
 
@@ -268,11 +263,7 @@ fn a_one_colour_emission_texture_renders_as_the_constant_emission() {
     let loaded = load_scene(&textured).unwrap();
     let rays = loaded.camera.unwrap().prepare(s.width, s.height).unwrap();
     let w = photonwave::wavefront::render(Arc::new(loaded.scene), &rays, &s, &NoProgress).unwrap().0;
-    for (k, (x, y)) in a.pixels.iter().zip(&w.pixels).enumerate() {
-        for (u, v) in x.as_array().into_iter().zip(y.as_array()) {
-            assert!(((u - v).abs() / u.abs().max(Vec3::ONE)).max_element() <= 1e-6, "pixel {k}: {u} against {v}");
-        }
-    }
+    assert_terms_agree(&a, &w, 1e-6);
 }
 
 #[test]
@@ -332,11 +323,7 @@ fn engines_agree_on_a_metallic_and_roughness_mapped_floor() {
     let rays = loaded.camera.unwrap().prepare(s.width, s.height).unwrap();
     let w =
         photonwave::wavefront::render(Arc::new(load_scene(&path).unwrap().scene), &rays, &s, &NoProgress).unwrap().0;
-    for (k, (x, y)) in a.pixels.iter().zip(&w.pixels).enumerate() {
-        for (u, v) in x.as_array().into_iter().zip(y.as_array()) {
-            assert!(((u - v).abs() / u.abs().max(Vec3::ONE)).max_element() <= 1e-6, "pixel {k}: {u} against {v}");
-        }
-    }
+    assert_terms_agree(&a, &w, 1e-6);
     // Metal quadrants reflect the light's highlight through the glossy ray (the specular layer);
     // plastic ones have a diffuse base too: both are lit.
     assert!(a.pixels.iter().any(|p| p.specular != Vec3::ZERO) && a.pixels.iter().any(|p| p.direct != Vec3::ZERO));

@@ -87,66 +87,78 @@ impl Environment {
     /// Radiance arriving from direction `wi` (unit, pointing away from the scene).
     #[must_use]
     pub fn radiance(&self, wi: Vec3) -> Vec3 {
-        let Some((map, _)) = &self.map else { return self.constant };
-        let (i, j, _) = self.texel_of(map, wi);
-        map.texels[j * map.width as usize + i] * self.scale
+        self.radiance_pdf(wi).0
     }
 
-    /// A direction toward the environment with two uniform numbers: (direction, pdf per
-    /// steradian, radiance). `None` for a black map or a sample at a pole (sin θ = 0).
+    /// The pdf of [`Environment::sample`] for direction `wi`, per steradian.
+    #[must_use]
+    pub fn pdf(&self, wi: Vec3) -> f32 {
+        self.radiance_pdf(wi).1
+    }
+
+    /// Radiance from `wi` and the pdf of sampling it, from one texel lookup.
+    #[must_use]
+    pub fn radiance_pdf(&self, wi: Vec3) -> (Vec3, f32) {
+        let Some((map, dist)) = &self.map else { return (self.constant, 1.0 / (4.0 * PI)) };
+        let (i, j, sin_theta) = self.texel_of(map, wi);
+        let k = j * map.width as usize + i;
+        let radiance = map.texels[k] * self.scale;
+        if dist.total() <= 0.0 {
+            return (radiance, 0.0);
+        }
+        let p_map = if sin_theta > 0.0 {
+            let (w, h) = (map.width as f32, map.height as f32);
+            dist.pmf(k) as f32 * w * h / (2.0 * PI * PI * sin_theta)
+        } else {
+            0.0
+        };
+        (radiance, UNIFORM_SHARE / (4.0 * PI) + (1.0 - UNIFORM_SHARE) * p_map)
+    }
+
+    /// A direction toward the environment with two uniform numbers, as [`Environment::sample`]
+    /// draws it (without its radiance and pdf). `None` for a black environment.
     ///
     /// A map is sampled defensively: with probability [`UNIFORM_SHARE`] uniformly over the
     /// sphere, otherwise by the map's luminance, and the pdf is the mixture's. A sky whose sun
     /// holds most of the power would otherwise leave the faces that do not see the sun lit by
     /// a handful of samples.
     #[must_use]
-    pub fn sample(&self, u: [f32; 2]) -> Option<(Vec3, f32, Vec3)> {
+    pub fn sample_direction(&self, u: [f32; 2]) -> Option<Vec3> {
         let Some((map, dist)) = &self.map else {
-            return (self.constant != Vec3::ZERO).then(|| (uniform_sphere(u), 1.0 / (4.0 * PI), self.constant));
+            return (self.constant != Vec3::ZERO).then(|| uniform_sphere(u));
         };
         if dist.total() <= 0.0 {
             return None;
         }
-        let wi = if u[0] < UNIFORM_SHARE {
-            uniform_sphere([u[0] / UNIFORM_SHARE, u[1]])
-        } else {
-            let u0 = ((u[0] - UNIFORM_SHARE) / (1.0 - UNIFORM_SHARE)).min(1.0 - f32::EPSILON / 2.0);
-            let (k, ux) = dist.sample_remapped(u0);
-            let (w, h) = (map.width as usize, map.height as usize);
-            let (i, j) = (k % w, k / w);
-            let theta = PI * (j as f32 + u[1]) / h as f32;
-            let phi = 2.0 * PI * (i as f32 + ux) / w as f32 + self.rotation;
-            let sin_theta = theta.sin();
-            Vec3::new(sin_theta * phi.cos(), theta.cos(), sin_theta * phi.sin())
-        };
-        let pdf = self.pdf(wi);
-        (pdf > 0.0 && wi.is_finite()).then(|| (wi, pdf, self.radiance(wi)))
+        if u[0] < UNIFORM_SHARE {
+            return Some(uniform_sphere([u[0] / UNIFORM_SHARE, u[1]]));
+        }
+        let u0 = ((u[0] - UNIFORM_SHARE) / (1.0 - UNIFORM_SHARE)).min(1.0 - f32::EPSILON / 2.0);
+        let (k, ux) = dist.sample_remapped(u0);
+        let (w, h) = (map.width as usize, map.height as usize);
+        let (i, j) = (k % w, k / w);
+        let theta = PI * (j as f32 + u[1]) / h as f32;
+        let phi = 2.0 * PI * (i as f32 + ux) / w as f32 + self.rotation;
+        let sin_theta = theta.sin();
+        Some(Vec3::new(sin_theta * phi.cos(), theta.cos(), sin_theta * phi.sin()))
     }
 
-    /// The texel (column, row) a direction falls in.
+    /// A direction toward the environment with two uniform numbers: (direction, pdf per
+    /// steradian, radiance). `None` for a black map or a sample at a pole (sin θ = 0).
+    #[must_use]
+    pub fn sample(&self, u: [f32; 2]) -> Option<(Vec3, f32, Vec3)> {
+        let wi = self.sample_direction(u)?;
+        let (radiance, pdf) = self.radiance_pdf(wi);
+        (pdf > 0.0 && wi.is_finite()).then_some((wi, pdf, radiance))
+    }
+
+    /// The texel (column, row) a direction falls in, and sin θ.
     fn texel_of(&self, map: &Texture, wi: Vec3) -> (usize, usize, f32) {
         let theta = wi.y.clamp(-1.0, 1.0).acos();
         let phi = (wi.z.atan2(wi.x) - self.rotation).rem_euclid(2.0 * PI);
         let i = ((phi / (2.0 * PI) * map.width as f32) as usize).min(map.width as usize - 1);
         let j = ((theta / PI * map.height as f32) as usize).min(map.height as usize - 1);
         (i, j, theta.sin())
-    }
-
-    /// The pdf of [`Environment::sample`] for direction `wi`, per steradian.
-    #[must_use]
-    pub fn pdf(&self, wi: Vec3) -> f32 {
-        let Some((map, dist)) = &self.map else { return 1.0 / (4.0 * PI) };
-        if dist.total() <= 0.0 {
-            return 0.0;
-        }
-        let (i, j, sin_theta) = self.texel_of(map, wi);
-        let (w, h) = (map.width as f32, map.height as f32);
-        let p_map = if sin_theta > 0.0 {
-            dist.pmf(j * map.width as usize + i) as f32 * w * h / (2.0 * PI * PI * sin_theta)
-        } else {
-            0.0
-        };
-        UNIFORM_SHARE / (4.0 * PI) + (1.0 - UNIFORM_SHARE) * p_map
     }
 }
 

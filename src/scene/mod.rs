@@ -96,6 +96,8 @@ pub struct Scene {
     pub area_power: Option<Distribution1D>,
     /// Indices of delta lights in `lights`.
     pub delta_lights: Vec<u32>,
+    /// Indices of suns in `lights` (seen by rays that leave the scene).
+    suns: Vec<u32>,
     /// Bounding box of all triangles and lights.
     pub bounds: (Vec3, Vec3),
     /// Degenerate (zero-area) triangles dropped at load.
@@ -314,6 +316,7 @@ impl Scene {
             area_lights: vec![],
             area_power: None,
             delta_lights: vec![],
+            suns: vec![],
             bounds: (lo, hi),
             dropped_degenerate: dropped,
             zero_normals,
@@ -353,6 +356,8 @@ impl Scene {
             .ok_or_else(|| Error::scene("every light has zero power: check `Ke` and light intensities"))?;
         scene.area_lights = (0..scene.lights.len() as u32).filter(|&i| !scene.lights[i as usize].is_delta()).collect();
         scene.delta_lights = (0..scene.lights.len() as u32).filter(|&i| scene.lights[i as usize].is_delta()).collect();
+        scene.suns =
+            (0..scene.lights.len() as u32).filter(|&i| matches!(scene.lights[i as usize], Light::Sun { .. })).collect();
         let area_w: Vec<f64> = scene.area_lights.iter().map(|&i| powers[i as usize]).collect();
         scene.area_power = Distribution1D::try_new(&area_w);
         let edges = scene.edge_uses();
@@ -493,12 +498,13 @@ impl Scene {
                     let local = crate::sampling::cosine_hemisphere([(2.0 * u[0]).min(1.0), u[1]]);
                     crate::sampling::Frame::new(n).to_world(local)
                 } else {
-                    env.sample([(2.0 * u[0] - 1.0).min(1.0 - f32::EPSILON / 2.0), u[1]])?.0
+                    env.sample_direction([(2.0 * u[0] - 1.0).min(1.0 - f32::EPSILON / 2.0), u[1]])?
                 };
-                let pdf = 0.5 * wi.dot(n).max(0.0) * std::f32::consts::FRAC_1_PI + 0.5 * env.pdf(wi);
+                let (radiance, env_pdf) = env.radiance_pdf(wi);
+                let pdf = 0.5 * wi.dot(n).max(0.0) * std::f32::consts::FRAC_1_PI + 0.5 * env_pdf;
                 (pdf > 0.0 && wi.is_finite()).then(|| light::Incident {
                     wi,
-                    value: env.radiance(wi) / pdf,
+                    value: radiance / pdf,
                     distance: f32::INFINITY,
                     point: None,
                 })
@@ -558,7 +564,8 @@ impl Scene {
     }
 
     /// Whether triangle `tri`'s emission comes from a texture.
-    fn textured_emitter(&self, tri: u32) -> bool {
+    #[must_use]
+    pub fn textured_emitter(&self, tri: u32) -> bool {
         !self.uv.is_empty() && self.materials[self.material[tri as usize] as usize].maps.ke.is_some()
     }
 
@@ -583,14 +590,13 @@ impl Scene {
     pub fn background(&self, d: Vec3) -> Vec3 {
         let d = d.normalize_or(Vec3::Y);
         let env = self.environment.as_ref().map_or(Vec3::ZERO, |e| e.radiance(d));
-        self.lights.iter().filter(|l| matches!(l, Light::Sun { .. })).map(|l| l.radiance_at_infinity(d)).sum::<Vec3>()
-            + env
+        self.suns.iter().map(|&i| self.lights[i as usize].radiance_at_infinity(d)).sum::<Vec3>() + env
     }
 
     /// Whether any ray leaving the scene sees light ([`Scene::background`]).
     #[must_use]
     pub fn has_background(&self) -> bool {
-        self.environment.is_some() || self.lights.iter().any(|l| matches!(l, Light::Sun { .. }))
+        self.environment.is_some() || !self.suns.is_empty()
     }
 
     /// Number of triangles.

@@ -14,11 +14,11 @@
 //! Power: area L·cos·A/pdf, point I/pdf, spot I·falloff/pdf, distant E/pdf (the sun and the
 //! environment after their own direction sampling). A light whose own sampling is already
 //! narrower than the targets' cones (a spot aimed at a lens, a light inside a glass ball) keeps
-//! it ([`cones_cover`]).
+//! it (`Cones::cover`).
 
 use crate::sampling::{concentric_disk, uniform_sphere, Frame};
 use crate::scene::light::{spot_falloff, Emission, Light};
-use crate::scene::targets::Target;
+use crate::scene::targets::{Target, MAX_TARGETS};
 use crate::scene::Scene;
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -53,38 +53,58 @@ fn cone(x: Vec3, t: &Target) -> Cone {
     Cone { axis: d / dist2.sqrt(), one_minus_cos, sin2, solid_angle: 2.0 * PI * one_minus_cos }
 }
 
-/// The solid angle the targets' cones cover from `x`, counted with overlaps (their sum): the
-/// aimed pdf's normalisation. Where it reaches what the light's own sampling covers (a
-/// hemisphere for an area light, the sphere for a point light, a spot's cone), aiming gains
-/// nothing and the light's own sampling is used: chosen by the emission point alone, so either
-/// way the estimate stays unbiased.
-fn cones_cover(x: Vec3, targets: &[Target]) -> f32 {
-    targets.iter().map(|t| cone(x, t).solid_angle).sum()
+/// The targets' cones seen from one point, made once per photon (at most
+/// [`MAX_TARGETS`], on the stack), and their summed solid angle (counted with overlaps): the
+/// aimed pdf's normalisation.
+struct Cones {
+    list: [Cone; MAX_TARGETS],
+    len: usize,
+    total: f32,
 }
 
-/// A direction from `x` toward the targets with three uniform numbers, and its pdf.
-fn aim_from(x: Vec3, targets: &[Target], u: [f32; 3]) -> Option<(Vec3, f32)> {
-    let cones: Vec<Cone> = targets.iter().map(|t| cone(x, t)).collect();
-    let total: f32 = cones.iter().map(|c| c.solid_angle).sum();
-    if !(total > 0.0) {
-        return None;
+impl Cones {
+    fn from(x: Vec3, targets: &[Target]) -> Cones {
+        let empty = Cone { axis: Vec3::Z, one_minus_cos: 0.0, sin2: 0.0, solid_angle: 0.0 };
+        let mut c = Cones { list: [empty; MAX_TARGETS], len: 0, total: 0.0 };
+        for t in targets.iter().take(MAX_TARGETS) {
+            c.list[c.len] = cone(x, t);
+            c.total += c.list[c.len].solid_angle;
+            c.len += 1;
+        }
+        c
     }
-    let mut pick = u[2] * total;
-    let c = *cones.iter().find(|c| {
-        pick -= c.solid_angle;
-        pick < 0.0
-    })?;
-    let d = if c.one_minus_cos >= 2.0 {
-        uniform_sphere([u[0], u[1]])
-    } else {
-        let omc = u[0] * c.one_minus_cos;
-        let cos = 1.0 - omc;
-        let sin = (omc * (2.0 - omc)).max(0.0).sqrt();
-        let phi = 2.0 * PI * u[1];
-        Frame::new(c.axis).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos))
-    };
-    let holding = cones.iter().filter(|k| k.holds(d)).count();
-    Some((d, holding.max(1) as f32 / total))
+
+    /// Where the cones cover what the light's own sampling covers (a hemisphere for an area
+    /// light, the sphere for a point light, a spot's cone), aiming gains nothing and the light's
+    /// own sampling is used: chosen by the emission point alone, so either way the estimate
+    /// stays unbiased.
+    fn cover(&self, own: f32) -> bool {
+        self.total >= own
+    }
+
+    /// A direction toward the targets with three uniform numbers, and its pdf.
+    fn aim(&self, u: [f32; 3]) -> Option<(Vec3, f32)> {
+        let cones = &self.list[..self.len];
+        if !(self.total > 0.0) {
+            return None;
+        }
+        let mut pick = u[2] * self.total;
+        let c = *cones.iter().find(|c| {
+            pick -= c.solid_angle;
+            pick < 0.0
+        })?;
+        let d = if c.one_minus_cos >= 2.0 {
+            uniform_sphere([u[0], u[1]])
+        } else {
+            let omc = u[0] * c.one_minus_cos;
+            let cos = 1.0 - omc;
+            let sin = (omc * (2.0 - omc)).max(0.0).sqrt();
+            let phi = 2.0 * PI * u[1];
+            Frame::new(c.axis).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos))
+        };
+        let holding = cones.iter().filter(|k| k.holds(d)).count();
+        Some((d, holding.max(1) as f32 / self.total))
+    }
 }
 
 /// An origin for light travelling along `dir` that then crosses the targets' disks, with three
@@ -126,36 +146,35 @@ pub fn aimed_emission(scene: &Scene, light: &Light, u: [f32; 5]) -> Option<Emiss
             let t = scene.triangle(tri);
             let (b1, b2) = crate::sampling::uniform_triangle([u[0], u[1]]);
             let x = t.p[0] * (1.0 - b1 - b2) + t.p[1] * b1 + t.p[2] * b2;
-            if cones_cover(x, targets) >= 2.0 * PI {
+            let cones = Cones::from(x, targets);
+            if cones.cover(2.0 * PI) {
                 // The targets fill the emitter's hemisphere or more: cosine sampling is better.
                 return Some(scene.sample_emission(light, [u[0], u[1], u[2], u[3]]));
             }
-            let (d, pdf) = aim_from(x, targets, [u[2], u[3], u[4]])?;
+            let (d, pdf) = cones.aim([u[2], u[3], u[4]])?;
             let cos = d.dot(t.n);
             if !(cos > 0.0) {
                 return None;
             }
             let radiance =
-                if !scene.uv.is_empty() && scene.materials[scene.material[tri as usize] as usize].maps.ke.is_some() {
-                    scene.emitted_at(tri, [1.0 - b1 - b2, b1, b2])
-                } else {
-                    radiance
-                };
+                if scene.textured_emitter(tri) { scene.emitted_at(tri, [1.0 - b1 - b2, b1, b2]) } else { radiance };
             Emission { origin: x, direction: d, power: radiance * (cos * t.area / pdf), normal: Some(t.n) }
         }
         Light::Point { position, intensity } => {
-            if cones_cover(position, targets) >= 4.0 * PI {
+            let cones = Cones::from(position, targets);
+            if cones.cover(4.0 * PI) {
                 return Some(scene.sample_emission(light, [u[0], u[1], u[2], u[3]]));
             }
-            let (d, pdf) = aim_from(position, targets, [u[2], u[3], u[4]])?;
+            let (d, pdf) = cones.aim([u[2], u[3], u[4]])?;
             Emission { origin: position, direction: d, power: intensity / pdf, normal: None }
         }
         Light::Spot { position, direction, intensity, cos_inner, cos_outer } => {
-            if cones_cover(position, targets) >= 2.0 * PI * (1.0 - cos_outer) {
+            let cones = Cones::from(position, targets);
+            if cones.cover(2.0 * PI * (1.0 - cos_outer)) {
                 // The spot's own cone is the narrower: sample it as unaimed photons do.
                 return Some(scene.sample_emission(light, [u[0], u[1], u[2], u[3]]));
             }
-            let (d, pdf) = aim_from(position, targets, [u[2], u[3], u[4]])?;
+            let (d, pdf) = cones.aim([u[2], u[3], u[4]])?;
             let fall = spot_falloff(d.dot(direction), cos_inner, cos_outer);
             if !(fall > 0.0) {
                 return None;

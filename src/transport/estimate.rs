@@ -140,8 +140,25 @@ pub fn global_estimate(
     pixel: Option<usize>,
     scratch: &mut Vec<(f32, u32)>,
 ) -> Estimate {
+    global_part(ctx, sp, bsdf, wo, mask, pixel, false, scratch)
+}
+
+/// [`global_estimate`] weighing photons by the whole BSDF, or (`base`) by the part its glossy
+/// ray does not sample.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn global_part(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    mask: u8,
+    pixel: Option<usize>,
+    base: bool,
+    scratch: &mut Vec<(f32, u32)>,
+) -> Estimate {
     let fixed = ctx.fixed.map(|r| r.global_at(pixel));
-    map_estimate(ctx, &ctx.maps.global, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, fixed, false, scratch)
+    map_estimate(ctx, &ctx.maps.global, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, fixed, base, scratch)
 }
 
 /// Indirect light at `sp` toward `wo` from the global map alone: its estimate without direct and
@@ -172,9 +189,7 @@ pub fn camera_indirect_estimate(
     pixel: Option<usize>,
     scratch: &mut Vec<(f32, u32)>,
 ) -> Estimate {
-    let fixed = ctx.fixed.map(|r| r.global_at(pixel));
-    let (k, r) = (ctx.settings.k, ctx.global_radius);
-    map_estimate(ctx, &ctx.maps.global, k, r, sp, bsdf, wo, flags::OWN_TERMS, fixed, true, scratch)
+    global_part(ctx, sp, bsdf, wo, flags::OWN_TERMS, pixel, true, scratch)
 }
 
 /// Radiance leaving a non-specular point toward `wo` as the photon maps see it: kd/π × the

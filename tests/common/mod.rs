@@ -55,3 +55,15 @@ pub fn scratch_dir(test: &str) -> PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// Asserts that two films of the same scene agree per pixel in every term: relative difference
+/// (over max(1, |a|)) at most `tol`, naming the first pixel that does not. The engines'
+/// tolerance is 1e-6 (tests/wavefront.rs).
+pub fn assert_terms_agree(a: &Film, b: &Film, tol: f32) {
+    for (k, (x, y)) in a.pixels.iter().zip(&b.pixels).enumerate() {
+        for (u, v) in x.as_array().into_iter().zip(y.as_array()) {
+            let d = ((u - v).abs() / u.abs().max(Vec3::ONE)).max_element();
+            assert!(d <= tol, "pixel {k}: {u} against {v}");
+        }
+    }
+}
