@@ -72,6 +72,16 @@ pub struct TraversalRow {
     /// obvhs's CWBVH (8-wide nodes) single-ray traversal over the same boxes, million rays per
     /// second: the other tree obvhs offers.
     pub cwbvh_mrays: f64,
+    /// Single-ray traversal of the 8-wide BVH (one ray against eight child boxes per step),
+    /// million rays per second.
+    pub wide_mrays: f64,
+    /// 8-wide BVH nodes visited per ray (each a test of one ray against up to eight boxes).
+    pub nodes_per_ray: f64,
+    /// Triangles tested per ray by the 8-wide traversal (one ray against a block of up to eight
+    /// per test).
+    pub triangles_per_ray: f64,
+    /// Of those, tests the 8-wide triangle test handed to the scalar one, per ray.
+    pub scalar_per_ray: f64,
     /// Rays the BVH2 traversals (packet, twin, obvhs) report hit and obvhs's CWBVH traversal
     /// does not (negative: the other way round).
     pub cwbvh_lost_hits: i64,
@@ -228,16 +238,35 @@ pub fn traversal(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps
                     cw.closest(tris, q.origin, q.direction, q.t_max)
                 }
             });
-            let (mut hp, mut hs, mut ht, mut hc) = (0, 0, 0, 0);
+            let wide = |c: &[RayQuery]| {
+                use crate::geometry::wide_traverse as w;
+                if any {
+                    let mut out = vec![false; c.len()];
+                    w::occluded_rays::<true>(bvh.wide(tris), c, &mut out);
+                    out.iter().filter(|&&b| b).count()
+                } else {
+                    let mut out = vec![None; c.len()];
+                    w::closest_rays::<true>(bvh.wide(tris), c, &mut out);
+                    out.iter().filter(|h| h.is_some()).count()
+                }
+            };
+            let (mut hp, mut hs, mut ht, mut hc, mut hw) = (0, 0, 0, 0, 0);
             let (tp, ts) =
                 time_pair(reps, || hp = count_hits(rays, threads, packet), || hs = count_hits(rays, threads, &obvhs));
             assert_eq!(hp, hs, "{name} {label} {query}: packet and single-ray hit counts differ");
             let (tt, tc) =
                 time_pair(reps, || ht = count_hits(rays, threads, &twin), || hc = count_hits(rays, threads, &cwbvh));
             assert_eq!(ht, hs, "{name} {label} {query}: scalar twin and obvhs hit counts differ");
+            let (_, tw) =
+                time_pair(reps, || hp = count_hits(rays, threads, packet), || hw = count_hits(rays, threads, wide));
+            assert_eq!(hw, hs, "{name} {label} {query}: 8-wide and obvhs hit counts differ");
             // Not asserted: obvhs's CWBVH traversal loses a few hits (recorded, see BENCHMARKS.md).
+            let visits = count_visits(bvh.wide(tris), rays, any);
             let m = rays.len() as f64 * 1e-6;
             rows.push(TraversalRow {
+                nodes_per_ray: visits.nodes as f64 / rays.len() as f64,
+                triangles_per_ray: visits.triangles as f64 / rays.len() as f64,
+                scalar_per_ray: visits.scalar as f64 / rays.len() as f64,
                 scene: name.to_string(),
                 rays: label,
                 query,
@@ -247,11 +276,31 @@ pub fn traversal(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps
                 ratio: ts / tp,
                 twin_mrays: m / tt,
                 cwbvh_mrays: m / tc,
+                wide_mrays: m / tw,
                 cwbvh_lost_hits: hs as i64 - hc as i64,
             });
         }
     }
     rows
+}
+
+/// The 8-wide traversal's work over `rays` (closest hit, or any hit when `any`).
+fn count_visits(
+    bvh: &crate::geometry::wide::Bvh8,
+    rays: &[RayQuery],
+    any: bool,
+) -> crate::geometry::wide_traverse::Visits {
+    use crate::geometry::wide_traverse::{closest_counted, occluded_counted, Visits};
+    let mut stack = crate::geometry::traverse::Stack::new();
+    let mut v = Visits::default();
+    for r in rays {
+        if any {
+            let _ = occluded_counted::<true, true>(bvh, r, &mut stack, &mut v);
+        } else {
+            let _ = closest_counted::<true, true>(bvh, r, &mut stack, &mut v);
+        }
+    }
+    v
 }
 
 /// One density-estimate measurement.
@@ -327,8 +376,8 @@ pub fn table(traversal: &[TraversalRow], density: &[DensityRow]) -> String {
     for r in traversal {
         let _ = writeln!(
             s,
-            "  traversal {:<8} {:<8} {:>8} rays  packet {:>7.2} Mrays/s  obvhs single {:>7.2} Mrays/s  ×{:.2}  (scalar twin {:.2}, obvhs CWBVH {:.2}, {} hits lost)",
-            r.rays, r.query, r.count, r.packet_mrays, r.single_mrays, r.ratio, r.twin_mrays, r.cwbvh_mrays, r.cwbvh_lost_hits
+            "  traversal {:<8} {:<8} {:>8} rays  packet {:>7.2} Mrays/s  wide {:>7.2} ({:.1} nodes, {:.1} tris, {:.2} scalar)  obvhs single {:>7.2} Mrays/s  ×{:.2}  (scalar twin {:.2}, obvhs CWBVH {:.2}, {} hits lost)",
+            r.rays, r.query, r.count, r.packet_mrays, r.wide_mrays, r.nodes_per_ray, r.triangles_per_ray, r.scalar_per_ray, r.single_mrays, r.ratio, r.twin_mrays, r.cwbvh_mrays, r.cwbvh_lost_hits
         );
     }
     for r in density {

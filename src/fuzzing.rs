@@ -107,6 +107,11 @@ pub fn edge_ray(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3, target: Vec3, nor
     if scalar != packet {
         return Err(format!("{:?}: scalar {:?}, packet {:?}", rays[0], scalar[0], packet[0]));
     }
+    let mut wide = [None];
+    crate::geometry::wide_traverse::closest_rays::<true>(bvh.wide(cols), &rays, &mut wide);
+    if scalar != wide {
+        return Err(format!("{:?}: scalar {:?}, 8-wide {:?}", rays[0], scalar[0], wide[0]));
+    }
     if well_conditioned(a, b, c1, c2, o, target) && !scalar[0].is_some_and(|h| h.t > 0.0) {
         return Err(format!("{:?} slipped through the edge {a}–{b} (wings {c1}, {c2})", rays[0]));
     }

@@ -8,6 +8,7 @@ use glam::Vec3;
 use photonwave::geometry::bvh::TriangleColumns;
 use photonwave::geometry::packet::{closest_packets, occluded_packets};
 use photonwave::geometry::traverse::{closest_rays, occluded_rays};
+use photonwave::geometry::wide_traverse;
 use photonwave::geometry::{Bvh, Hit, RayQuery};
 use photonwave::rng::{Domain, Sampler};
 use photonwave::sampling::uniform_sphere;
@@ -21,12 +22,31 @@ fn agree(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery]) -> Vec<Option<
     for (i, (x, y)) in a.iter().zip(&b).enumerate() {
         assert_eq!(x, y, "closest hit differs for ray {i}: {:?}", rays[i]);
     }
+    // The 8-wide BVH, with its 8-wide child and triangle tests and with the child test's
+    // scalar twin.
+    for (label, simd) in [("8-wide", true), ("8-wide scalar", false)] {
+        let mut w = vec![None; rays.len()];
+        if simd {
+            wide_traverse::closest_rays::<true>(bvh.wide(tris), rays, &mut w);
+        } else {
+            wide_traverse::closest_rays::<false>(bvh.wide(tris), rays, &mut w);
+        }
+        for (i, (x, y)) in a.iter().zip(&w).enumerate() {
+            assert_eq!(x, y, "{label}: closest hit differs for ray {i}: {:?}", rays[i]);
+        }
+    }
     let mut oa = vec![false; rays.len()];
     let mut ob = vec![false; rays.len()];
+    let mut ow = vec![false; rays.len()];
+    let mut os = vec![false; rays.len()];
     occluded_rays(bvh, tris, rays, &mut oa);
     occluded_packets(bvh, tris, rays, &mut ob);
-    for (i, (x, y)) in oa.iter().zip(&ob).enumerate() {
-        assert_eq!(x, y, "any hit differs for ray {i}: {:?}", rays[i]);
+    wide_traverse::occluded_rays::<true>(bvh.wide(tris), rays, &mut ow);
+    wide_traverse::occluded_rays::<false>(bvh.wide(tris), rays, &mut os);
+    for (i, x) in oa.iter().enumerate() {
+        assert_eq!(*x, ob[i], "packet: any hit differs for ray {i}: {:?}", rays[i]);
+        assert_eq!(*x, ow[i], "8-wide: any hit differs for ray {i}: {:?}", rays[i]);
+        assert_eq!(*x, os[i], "8-wide scalar: any hit differs for ray {i}: {:?}", rays[i]);
         // Any hit and closest hit agree on whether something is in (0, t_max).
         assert_eq!(*x, a[i].is_some(), "any vs closest for ray {i}");
     }
@@ -244,5 +264,60 @@ fn watertight_mesh_edges_and_vertices_never_leak() {
     let hits = agree(s.bvh(), s.columns(), &rays);
     for (h, r) in hits.iter().zip(&rays) {
         assert!(h.is_some(), "{r:?} slipped out of the closed cube");
+    }
+}
+
+#[test]
+/// The 8-wide BVH over a grid of small triangles: every triangle lands in exactly one leaf lane,
+/// once, inside its child box.
+fn collapse_keeps_every_triangle_once() {
+    let mut p = [vec![], vec![], vec![]];
+    for i in 0..40 {
+        for j in 0..25 {
+            let o = Vec3::new(i as f32, j as f32, (i * j % 7) as f32 * 0.1);
+            p[0].push(o);
+            p[1].push(o + Vec3::X * 0.9);
+            p[2].push(o + Vec3::Y * 0.9);
+        }
+    }
+    let (bvh, order) = Bvh::build(&p[0], &p[1], &p[2]);
+    let cols: Vec<Vec<Vec3>> = p.iter().map(|c| order.iter().map(|&i| c[i as usize]).collect()).collect();
+    let tris = TriangleColumns { p0: &cols[0], p1: &cols[1], p2: &cols[2] };
+    let wide = bvh.wide(tris);
+    let mut seen = vec![0u32; order.len()];
+    for b in wide.blocks() {
+        for l in 0..8 {
+            if b.live >> l & 1 == 1 {
+                let id = (b.first + l) as usize;
+                seen[id] += 1;
+                assert_eq!(b.triangle(l as usize), [tris.p0[id], tris.p1[id], tris.p2[id]]);
+            }
+        }
+    }
+    assert!(
+        seen.iter().all(|&n| n == 1),
+        "{} triangles not in exactly one leaf",
+        seen.iter().filter(|&&n| n != 1).count()
+    );
+    for node in wide.nodes() {
+        for slot in 0..8 {
+            if node.valid >> slot & 1 == 0 || node.count[slot] == 0 {
+                continue;
+            }
+            let (lo, hi) = node.child_box(slot);
+            let first = node.child[slot] as usize;
+            for b in &wide.blocks()[first..first + (node.count[slot] as usize).div_ceil(8)] {
+                for l in 0..8 {
+                    if b.live >> l & 1 == 1 {
+                        for v in b.triangle(l) {
+                            assert!(
+                                lo.cmple(v.into()).all() && glam::Vec3A::from(v).cmple(hi).all(),
+                                "{v} outside its box"
+                            );
+                        }
+                    }
+                }
+            }
+        }
     }
 }

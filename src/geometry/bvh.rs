@@ -9,6 +9,7 @@
 //! conservative for flat boxes and rays that graze box faces.
 
 use super::triangle::{intersect_triangle, TriangleHit};
+use super::wide::Bvh8;
 use glam::{Vec3, Vec3A};
 use obvhs::{aabb::Aabb, bvh2::Bvh2, ray::Ray, BvhBuildParams};
 
@@ -29,6 +30,9 @@ pub struct Hit {
 /// A BVH over triangles stored as three vertex columns.
 pub struct Bvh {
     bvh: Bvh2,
+    /// The same tree collapsed to 8-wide nodes, built on first use (`photonwave bench`; the
+    /// renderer's queues measured faster with packets, BENCHMARKS.md).
+    wide: std::sync::OnceLock<Bvh8>,
 }
 
 impl Bvh {
@@ -41,13 +45,25 @@ impl Bvh {
         let mut build_time = std::time::Duration::ZERO;
         let bvh = obvhs::bvh2::builder::build_bvh2(&boxes, BvhBuildParams::medium_build(), &mut build_time);
         let order = bvh.primitive_indices.clone();
-        (Bvh { bvh }, order)
+        (Bvh { bvh, wide: std::sync::OnceLock::new() }, order)
     }
 
     /// The obvhs nodes (root first; children of an inner node at `first_index` and the next).
     #[must_use]
     pub fn nodes(&self) -> &[obvhs::bvh2::node::Bvh2Node] {
         &self.bvh.nodes
+    }
+
+    /// The tree collapsed to 8-wide nodes (same leaves, same triangle order), with the leaves'
+    /// triangles copied from `tris` (the BVH-ordered columns) into blocks; built on first call.
+    #[must_use]
+    pub fn wide(&self, tris: TriangleColumns<'_>) -> &Bvh8 {
+        self.wide.get_or_init(|| {
+            Bvh8::collapse(&self.bvh.nodes, |id| {
+                let i = id as usize;
+                [tris.p0[i], tris.p1[i], tris.p2[i]]
+            })
+        })
     }
 
     /// obvhs's own single-ray traversal (closest hit) calling the same triangle test: the

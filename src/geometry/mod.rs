@@ -3,8 +3,12 @@
 pub mod bvh;
 pub mod offset;
 pub mod packet;
+pub mod slab;
 pub mod traverse;
 pub mod triangle;
+pub mod triangle8;
+pub mod wide;
+pub mod wide_traverse;
 
 pub use bvh::{Bvh, Hit};
 pub use offset::{gamma, offset_ray_origin};

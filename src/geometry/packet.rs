@@ -13,9 +13,10 @@
 //! the lower triangle index), so hits are identical lane by lane; tests/packet.rs checks it.
 
 use super::bvh::{Bvh, Hit, TriangleColumns};
-use super::offset::gamma;
-use super::traverse::{closest_from, occluded_from, Best, RayQuery, Stack, FAR_GROWTH};
+use super::slab::FAR_GROWTH;
+use super::traverse::{closest_from, occluded_from, Best, RayQuery, Stack};
 use super::triangle::{intersect_triangle, is_degenerate};
+use super::triangle8::watertight8;
 use glam::Vec3;
 use obvhs::bvh2::node::Bvh2Node;
 use wide::f32x8;
@@ -139,15 +140,10 @@ fn bits(m: f32x8) -> u32 {
 }
 
 /// The watertight ray/triangle test of [`intersect_triangle`] for 8 rays against one triangle:
-/// the same operations in the same order (no fused multiply-adds on either side), so every lane's
-/// decision, t and barycentrics are bit-identical to the scalar test. Returns (hit lanes,
-/// lanes to decide with the scalar test, t, b0, b1, b2). The scalar test recomputes in f64 edge
-/// functions that round to exactly zero and the sign of a t that f32 cannot prove positive;
-/// lanes where either happens are handed back.
+/// each lane's vertices relative to its origin, permuted by its axis choice and sheared, then
+/// [`watertight8`] (see there for the fallbacks).
 #[inline(always)]
-#[allow(clippy::many_single_char_names)]
 fn intersect8(p: &Packet, lanes: u32, v: [Vec3; 3], t_max: f32x8) -> (u32, u32, f32x8, [f32x8; 3]) {
-    // Vertices relative to the origins, permuted per lane, sheared.
     let perm = |q: Vec3| {
         let x = f32x8::splat(q.x) - p.ox;
         let y = f32x8::splat(q.y) - p.oy;
@@ -160,44 +156,7 @@ fn intersect8(p: &Packet, lanes: u32, v: [Vec3; 3], t_max: f32x8) -> (u32, u32, 
     let (x0, y0, z0) = perm(v[0]);
     let (x1, y1, z1) = perm(v[1]);
     let (x2, y2, z2) = perm(v[2]);
-    let e0 = x1 * y2 - y1 * x2;
-    let e1 = x2 * y0 - y2 * x0;
-    let e2 = x0 * y1 - y0 * x1;
-    let zero = f32x8::ZERO;
-    let any_zero = e0.simd_eq(zero) | e1.simd_eq(zero) | e2.simd_eq(zero);
-    let fallback = bits(any_zero) & lanes;
-    let neg = e0.simd_lt(zero) | e1.simd_lt(zero) | e2.simd_lt(zero);
-    let pos = e0.simd_gt(zero) | e1.simd_gt(zero) | e2.simd_gt(zero);
-    let det = e0 + e1 + e2;
-    // The shear's error is in length units: it takes z before the scaling to ray parameters.
-    let max_z_len = z0.abs().max(z1.abs()).max(z2.abs());
-    let (z0, z1, z2) = (z0 * p.sz, z1 * p.sz, z2 * p.sz);
-    let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
-    let bound = t_max * det;
-    let det_neg = det.simd_lt(zero) & (t_scaled.simd_ge(zero) | t_scaled.simd_lt(bound));
-    let det_pos = det.simd_gt(zero) & (t_scaled.simd_le(zero) | t_scaled.simd_gt(bound));
-    let inv_det = f32x8::ONE / det;
-    let t = t_scaled * inv_det;
-    // pbrt-v4's bound on t's error; t must exceed it.
-    // Rounding is monotonic, so this is the largest scaled |z| exactly, as the scalar test has it.
-    let max_zt = max_z_len * p.sz.abs();
-    let delta_z = f32x8::splat(gamma(3)) * max_zt;
-    let max_xt = x0.abs().max(x1.abs()).max(x2.abs());
-    let max_yt = y0.abs().max(y1.abs()).max(y2.abs());
-    let delta_x = f32x8::splat(gamma(5)) * (max_xt + max_z_len);
-    let delta_y = f32x8::splat(gamma(5)) * (max_yt + max_z_len);
-    let delta_e = f32x8::splat(2.0) * (f32x8::splat(gamma(2)) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
-    let delta_t = f32x8::splat(3.0)
-        * (f32x8::splat(gamma(3)) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
-        * inv_det.abs();
-    let inside = !(neg & pos) & det.simd_ne(zero) & det.is_finite() & !det_neg & !det_pos & t.simd_lt(t_max);
-    let ok = inside & t.simd_gt(delta_t);
-    // Where f32 cannot prove t > 0 (slivers), the scalar test decides in f64.
-    let undecided = inside & t.simd_gt(zero) & !t.simd_gt(delta_t);
-    let fallback = fallback | (bits(undecided) & lanes);
-    let hit = bits(ok) & lanes & !fallback;
-    (hit, fallback, t, [e0 * inv_det, e1 * inv_det, e2 * inv_det])
+    watertight8([x0, x1, x2], [y0, y1, y2], [z0, z1, z2], p.sz, t_max, lanes)
 }
 
 /// [`Best::limit`] per lane.
@@ -480,7 +439,7 @@ pub fn occluded_packets_thin(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQu
 
 #[cfg(test)]
 mod tests {
-    use super::super::traverse::{box_entry, inverse_direction};
+    use super::super::slab::{box_entry, inverse_direction};
     use super::*;
 
     #[test]

@@ -8,15 +8,12 @@
 //! therefore the same whatever order the leaves are visited in.
 
 use super::bvh::{Bvh, Hit, TriangleColumns};
-use super::offset::gamma;
+use super::slab::{box_entry, inverse_direction};
 use super::triangle::intersect_triangle;
 use glam::{Vec3, Vec3A};
 
 /// No triangle.
 pub const NO_TRI: u32 = u32::MAX;
-
-/// Far-distance growth that makes the slab test conservative.
-pub const FAR_GROWTH: f32 = 1.0 + 2.0 * gamma(3);
 
 /// One ray query: origin, direction, and the open interval (0, `t_max`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,19 +37,6 @@ impl RayQuery {
     #[must_use]
     pub fn is_valid(&self) -> bool {
         self.origin.is_finite() && self.direction.is_finite() && self.direction != Vec3::ZERO && self.t_max > 0.0
-    }
-}
-
-/// 1/d, with ±f32::MAX where that overflows (d = ±0 or subnormal): finite, so (b − o)·inv is
-/// never 0·∞.
-#[inline]
-#[must_use]
-pub fn safe_inverse(d: f32) -> f32 {
-    let i = 1.0 / d;
-    if i.is_finite() {
-        i
-    } else {
-        f32::MAX.copysign(d)
     }
 }
 
@@ -105,22 +89,6 @@ impl Best {
         if let Some(h) = intersect_triangle(o, d, self.limit(), tris.p0[i], tris.p1[i], tris.p2[i]) {
             self.offer(h.t, id, h.b);
         }
-    }
-}
-
-/// Entry distance (≥ 0) of the ray into the box, or +∞ when it misses or enters beyond `t_max`
-/// (entry exactly at `t_max` counts: a tie may still win).
-#[inline]
-#[must_use]
-pub fn box_entry(min: Vec3A, max: Vec3A, o: Vec3A, inv: Vec3A, t_max: f32) -> f32 {
-    let t0 = (min - o) * inv;
-    let t1 = (max - o) * inv;
-    let near = t0.min(t1).max_element().max(0.0);
-    let far = t0.max(t1).min_element() * FAR_GROWTH;
-    if near <= far && near <= t_max {
-        near
-    } else {
-        f32::INFINITY
     }
 }
 
@@ -288,13 +256,6 @@ pub fn occluded_from(
         }
     }
     false
-}
-
-/// Inverse direction with finite components.
-#[inline]
-#[must_use]
-pub fn inverse_direction(d: Vec3) -> Vec3 {
-    Vec3::new(safe_inverse(d.x), safe_inverse(d.y), safe_inverse(d.z))
 }
 
 /// Closest hit of one ray, with a caller's stack.

@@ -1,0 +1,275 @@
+//! Single-ray traversal of the 8-wide BVH ([`super::wide`]): at each node one ray meets all
+//! eight child boxes in one `f32x8` test, and the children it enters are visited nearest first.
+//! Reads rays and the [`Bvh8`]; writes hits or occlusion flags.
+//!
+//! The kernel is generic over the child test: `SIMD = true` runs [`Node8::entries`], `false` its
+//! scalar twin [`Node8::entries_scalar`]; everything else is shared. Both make the decisions of
+//! [`super::traverse`] (conservative box test, the same watertight triangle test, ties in t to
+//! the lower triangle index), so the closest hit is the same triangle, t and barycentrics as
+//! every other traversal's, whatever order the leaves are met in; tests/packet.rs checks it.
+//!
+//! Any-hit traversal tests a node's leaf children as soon as the node is reached, nearest
+//! first, before entering any inner child (as the BVH2 traversals do: a leaf is cheap and often
+//! ends the ray).
+
+use super::bvh::Hit;
+use super::slab::inverse_direction;
+use super::traverse::{Best, RayQuery, Stack};
+use super::triangle8::{intersect_block, intersect_lane, ShearedRay, TriBlock};
+use super::wide::{Bvh8, Node8, WideRay, WIDTH};
+use glam::Vec3;
+
+/// A stack entry: child (node index, or first block of a leaf), leaf triangle count (0 for a
+/// node) and entry distance.
+type Entry = (u32, u32, f32);
+
+/// Work one traversal did: nodes whose child boxes were tested, triangle blocks and triangles
+/// (live lanes of those blocks) tested.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Visits {
+    /// Nodes visited.
+    pub nodes: u64,
+    /// Triangle blocks tested.
+    pub blocks: u64,
+    /// Triangles tested.
+    pub triangles: u64,
+    /// Triangle tests the 8-wide test handed to the scalar one (edge functions of exactly zero,
+    /// t not provably positive in f32, or a limit lowered within the block).
+    pub scalar: u64,
+}
+
+impl Visits {
+    #[inline(always)]
+    fn leaf(&mut self, blocks: &[TriBlock]) {
+        self.blocks += blocks.len() as u64;
+        self.triangles += blocks.iter().map(|b| u64::from(b.live.count_ones())).sum::<u64>();
+    }
+}
+
+/// The blocks of a leaf child.
+#[inline(always)]
+fn leaf(bvh: &Bvh8, first: u32, count: u32) -> &[TriBlock] {
+    let first = first as usize;
+    &bvh.blocks()[first..first + count.div_ceil(8) as usize]
+}
+
+/// Tests the leaf's triangles, keeping the closest hit by [`Best::offer`]'s rule. Each block is
+/// tested against the limit as it stood before it; a lane hit after an earlier lane of the same
+/// block has lowered the limit is decided again by the scalar test, so every triangle is
+/// decided exactly as the scalar traversal, testing them one by one, would decide it (a miss
+/// under a limit stays a miss under a lower one).
+#[inline]
+fn closest_leaf(blocks: &[TriBlock], r: &ShearedRay, best: &mut Best) -> u64 {
+    let mut scalar = 0;
+    for b in blocks {
+        let limit = best.limit();
+        let (hit, fallback, t, bary) = intersect_block(r, b, limit);
+        let mut todo = hit | fallback;
+        if todo == 0 {
+            continue;
+        }
+        let (t, bary) = (t.to_array(), bary.map(wide::f32x8::to_array));
+        while todo != 0 {
+            let l = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
+            let id = b.first + l as u32;
+            if hit >> l & 1 == 1 && best.limit().to_bits() == limit.to_bits() {
+                best.offer(t[l], id, [bary[0][l], bary[1][l], bary[2][l]]);
+            } else {
+                scalar += 1;
+                if let Some(h) = intersect_lane(r, b, l, best.limit()) {
+                    best.offer(h.t, id, h.b);
+                }
+            }
+        }
+    }
+    scalar
+}
+
+/// Whether any triangle of the leaf is hit within (0, t_max).
+#[inline]
+fn any_leaf(blocks: &[TriBlock], r: &ShearedRay, t_max: f32, scalar: &mut u64) -> bool {
+    blocks.iter().any(|b| {
+        let (hit, mut fallback, _, _) = intersect_block(r, b, t_max);
+        if hit != 0 {
+            return true;
+        }
+        *scalar += u64::from(fallback.count_ones());
+        while fallback != 0 {
+            let l = fallback.trailing_zeros() as usize;
+            fallback &= fallback - 1;
+            if intersect_lane(r, b, l, t_max).is_some() {
+                return true;
+            }
+        }
+        false
+    })
+}
+
+/// The children of `node` that the ray enters within `t_max`, as (t bits, slot) keys sorted
+/// nearest first, and their number. Entry distances are ≥ 0 and never NaN, so their bit
+/// patterns order as the values do.
+#[inline(always)]
+fn entered<const SIMD: bool>(node: &Node8, r: &WideRay, o: Vec3, inv: Vec3, t_max: f32) -> ([u64; WIDTH], usize) {
+    let (mut mask, t) = if SIMD {
+        let (m, t) = node.entries(r, t_max);
+        (m, t.to_array())
+    } else {
+        node.entries_scalar(o, inv, t_max)
+    };
+    let mut keys = [0u64; WIDTH];
+    let mut n = 0;
+    while mask != 0 {
+        let i = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        keys[n] = u64::from(t[i].to_bits()) << 32 | i as u64;
+        n += 1;
+    }
+    // Insertion sort: at most eight keys, usually two or three.
+    for j in 1..n {
+        let k = keys[j];
+        let mut m = j;
+        while m > 0 && keys[m - 1] > k {
+            keys[m] = keys[m - 1];
+            m -= 1;
+        }
+        keys[m] = k;
+    }
+    (keys, n)
+}
+
+/// The slot and entry distance of a key from [`entered`].
+#[inline(always)]
+fn unkey(key: u64) -> (usize, f32) {
+    ((key & 0xff) as usize, f32::from_bits((key >> 32) as u32))
+}
+
+/// Closest hit of one ray, with a caller's stack.
+#[must_use]
+pub fn closest_with<const SIMD: bool>(bvh: &Bvh8, ray: &RayQuery, stack: &mut Stack<Entry>) -> Option<Hit> {
+    closest_counted::<SIMD, false>(bvh, ray, stack, &mut Visits::default())
+}
+
+/// [`closest_with`], adding its work to `visits` when `COUNT`.
+#[must_use]
+pub fn closest_counted<const SIMD: bool, const COUNT: bool>(
+    bvh: &Bvh8,
+    ray: &RayQuery,
+    stack: &mut Stack<Entry>,
+    visits: &mut Visits,
+) -> Option<Hit> {
+    let nodes = bvh.nodes();
+    if nodes.is_empty() || !ray.is_valid() {
+        return None;
+    }
+    let (o, d) = (ray.origin, ray.direction);
+    let inv = inverse_direction(d);
+    let r = WideRay::new(o, inv);
+    let sheared = ShearedRay::new(o, d);
+    let mut best = Best::new(ray.t_max);
+    stack.clear();
+    stack.push((0, 0, 0.0));
+    while let Some((c, count, tc)) = stack.pop() {
+        if tc > best.t {
+            continue;
+        }
+        if count > 0 {
+            let blocks = leaf(bvh, c, count);
+            if COUNT {
+                visits.leaf(blocks);
+            }
+            let scalar = closest_leaf(blocks, &sheared, &mut best);
+            if COUNT {
+                visits.scalar += scalar;
+            }
+            continue;
+        }
+        if COUNT {
+            visits.nodes += 1;
+        }
+        let node = &nodes[c as usize];
+        let (keys, n) = entered::<SIMD>(node, &r, o, inv, best.t);
+        for &key in keys[..n].iter().rev() {
+            let (i, t) = unkey(key);
+            stack.push((node.child[i], u32::from(node.count[i]), t));
+        }
+    }
+    best.hit()
+}
+
+/// True if anything is hit in (0, t_max), with a caller's stack.
+#[must_use]
+pub fn occluded_with<const SIMD: bool>(bvh: &Bvh8, ray: &RayQuery, stack: &mut Stack<Entry>) -> bool {
+    occluded_counted::<SIMD, false>(bvh, ray, stack, &mut Visits::default())
+}
+
+/// [`occluded_with`], adding its work to `visits` when `COUNT`.
+#[must_use]
+pub fn occluded_counted<const SIMD: bool, const COUNT: bool>(
+    bvh: &Bvh8,
+    ray: &RayQuery,
+    stack: &mut Stack<Entry>,
+    visits: &mut Visits,
+) -> bool {
+    let nodes = bvh.nodes();
+    if nodes.is_empty() || !ray.is_valid() {
+        return false;
+    }
+    let (o, d, t_max) = (ray.origin, ray.direction, ray.t_max);
+    let inv = inverse_direction(d);
+    let r = WideRay::new(o, inv);
+    let sheared = ShearedRay::new(o, d);
+    let leaf_hit = |first: u32, count: u32, visits: &mut Visits| {
+        let blocks = leaf(bvh, first, count);
+        if COUNT {
+            visits.leaf(blocks);
+        }
+        any_leaf(blocks, &sheared, t_max, &mut visits.scalar)
+    };
+    stack.clear();
+    stack.push((0, 0, 0.0));
+    while let Some((c, count, _)) = stack.pop() {
+        if count > 0 {
+            if leaf_hit(c, count, visits) {
+                return true;
+            }
+            continue;
+        }
+        let node = &nodes[c as usize];
+        if COUNT {
+            visits.nodes += 1;
+        }
+        let (keys, n) = entered::<SIMD>(node, &r, o, inv, t_max);
+        // Leaf children first, nearest first; then the inner children, nearest on top.
+        for &key in &keys[..n] {
+            let (i, _) = unkey(key);
+            if node.count[i] > 0 && leaf_hit(node.child[i], u32::from(node.count[i]), visits) {
+                return true;
+            }
+        }
+        for &key in keys[..n].iter().rev() {
+            let (i, t) = unkey(key);
+            if node.count[i] == 0 {
+                stack.push((node.child[i], 0, t));
+            }
+        }
+    }
+    false
+}
+
+/// Closest hits of `rays` into `out`, one ray at a time through the 8-wide BVH (`SIMD`: the
+/// 8-wide child test; otherwise its scalar twin).
+pub fn closest_rays<const SIMD: bool>(bvh: &Bvh8, rays: &[RayQuery], out: &mut [Option<Hit>]) {
+    let mut stack = Stack::new();
+    for (r, o) in rays.iter().zip(out.iter_mut()) {
+        *o = closest_with::<SIMD>(bvh, r, &mut stack);
+    }
+}
+
+/// Any-hit tests of `rays` into `out` (see [`closest_rays`]).
+pub fn occluded_rays<const SIMD: bool>(bvh: &Bvh8, rays: &[RayQuery], out: &mut [bool]) {
+    let mut stack = Stack::new();
+    for (r, o) in rays.iter().zip(out.iter_mut()) {
+        *o = occluded_with::<SIMD>(bvh, r, &mut stack);
+    }
+}
