@@ -29,6 +29,7 @@
 //! scalar twin.
 
 pub mod boundary;
+mod candidates;
 mod filter;
 pub mod kernel;
 pub mod knn;

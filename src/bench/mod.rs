@@ -13,6 +13,8 @@
 //! Each set is traced for the closest hit and for any hit (shadow rays use their t_max, the
 //! others t = ∞ — any hit then answers "is anything there").
 
+mod density;
+
 use crate::geometry::packet::{closest_packets, occluded_packets};
 use crate::geometry::{offset_ray_origin, RayQuery};
 use crate::parallel::map_chunks;
@@ -20,6 +22,7 @@ use crate::rng::{Domain, Sampler};
 use crate::sampling::{cosine_hemisphere, Frame};
 use crate::scene::camera::CameraRays;
 use crate::scene::{Light, Scene};
+pub use density::{DensityRow, BENCH_PHOTONS};
 use glam::Vec3;
 use serde::Serialize;
 use std::time::Instant;
@@ -159,7 +162,7 @@ fn light_point(scene: &Scene, u: [f32; 3]) -> Option<Vec3> {
 }
 
 /// Median of the samples.
-fn median(mut v: Vec<f64>) -> f64 {
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
@@ -179,7 +182,7 @@ pub fn time_pair(reps: usize, mut a: impl FnMut(), mut b: impl FnMut()) -> (f64,
 }
 
 /// Chunk of rays per thread task.
-const CHUNK: usize = 4096;
+pub(crate) const CHUNK: usize = 4096;
 
 /// A per-ray kernel as a chunk counter for [`count_hits`].
 fn per_ray(hit: impl Fn(&RayQuery) -> bool + Sync) -> impl Fn(&[RayQuery]) -> usize + Sync {
@@ -303,25 +306,6 @@ fn count_visits(
     v
 }
 
-/// One density-estimate measurement.
-#[derive(Clone, Debug, Serialize)]
-pub struct DensityRow {
-    /// Scene name.
-    pub scene: String,
-    /// knn (k nearest under a maximum radius) or radius (every photon within a fixed radius).
-    pub lookup: &'static str,
-    /// Queries in the set.
-    pub count: usize,
-    /// Photons in the map.
-    pub photons: usize,
-    /// SIMD estimates per second (median).
-    pub simd_per_s: f64,
-    /// Scalar estimates per second (median).
-    pub scalar_per_s: f64,
-    /// simd / scalar.
-    pub ratio: f64,
-}
-
 /// Everything `photonwave bench --json` prints.
 #[derive(Debug, Serialize)]
 pub struct Report {
@@ -364,7 +348,7 @@ pub fn run_scene(
 ) -> (Vec<TraversalRow>, Vec<DensityRow>) {
     let sets = RaySets::new(scene, cam);
     let t = traversal(name, scene, &sets, threads, reps);
-    let d = density(name, scene, &sets, threads, reps);
+    let d = density::density(name, scene, &sets, threads, reps);
     (t, d)
 }
 
@@ -383,104 +367,22 @@ pub fn table(traversal: &[TraversalRow], density: &[DensityRow]) -> String {
     for r in density {
         let _ = writeln!(
             s,
-            "  density   {:<8} {:>8} queries over {} photons  simd {:>9.0}/s  scalar {:>9.0}/s  ×{:.2}",
-            r.lookup, r.count, r.photons, r.simd_per_s, r.scalar_per_s, r.ratio
+            "  density   {:<8} {:>8} queries over {} photons  simd {:>9.0}/s  scalar {:>9.0}/s  ×{:.2}  kiddo {}  ({:.0} photons tested per query, {:.2} ns each)",
+            r.lookup,
+            r.count,
+            r.photons,
+            r.simd_per_s,
+            r.scalar_per_s,
+            r.ratio,
+            match (r.kiddo_per_s, r.ratio_vs_kiddo) {
+                (Some(k), Some(x)) => format!("{k:>9.0}/s ×{x:.2}"),
+                _ => "– (build with --features baselines)".to_string(),
+            },
+            r.photons_tested_per_query,
+            r.ns_per_photon_tested
         );
     }
     s
-}
-
-/// Photons in the bench's global map.
-pub const BENCH_PHOTONS: u32 = 200_000;
-
-/// Queries per density row.
-const QUERIES: usize = 65_536;
-
-/// SIMD against scalar density estimates on the scene's global photon map (default settings,
-/// [`BENCH_PHOTONS`] photons), at the camera hits (in tile order, as the camera pass asks),
-/// Lambertian reflectance. `knn`: the k = 64 nearest under the default maximum radius;
-/// `radius`: every photon within a fixed radius, the median radius the k-NN lookups found.
-fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usize) -> Vec<DensityRow> {
-    use crate::code_path::CodePath;
-    use crate::photon_map::{Filter, Lookup, Reflectance};
-    use crate::reference::build_maps;
-    use crate::settings::Settings;
-    if sets.hits.is_empty() {
-        return vec![];
-    }
-    let settings = Settings { photons: BENCH_PHOTONS, threads: threads as u32, ..Default::default() };
-    // Default settings with a photon count: always valid, so an error here cannot happen.
-    let Ok((maps, _, _)) = build_maps(scene, &settings) else { return vec![] };
-    let map = &maps.global;
-    if map.is_empty() {
-        return vec![];
-    }
-    let step = sets.hits.len().div_ceil(QUERIES).max(1);
-    let queries: Vec<(Vec3, Vec3)> = sets.hits.iter().step_by(step).copied().collect();
-    let r_max = settings.global_radius * scene.diagonal();
-    let lookup = |p: Vec3, n: Vec3, k: usize, r: f32| Lookup {
-        p,
-        k,
-        r_max: r,
-        kernel: settings.kernel,
-        filter: Filter { n, flags_mask: 0 },
-    };
-    let f = |n: Vec3| Reflectance::Hemisphere { value: Vec3::splat(0.5 / std::f32::consts::PI), ng: n };
-    let knn = |set: CodePath| {
-        map_chunks(
-            queries.len(),
-            CHUNK,
-            threads,
-            |r| {
-                let mut scratch = Vec::new();
-                queries[r]
-                    .iter()
-                    .map(|&(p, n)| map.estimate(set, &lookup(p, n, settings.k as usize, r_max), f(n), &mut scratch))
-                    .collect::<Vec<_>>()
-            },
-            |_| {},
-        )
-        .concat()
-    };
-    let radius_lookup = |set: CodePath, r: f32| {
-        map_chunks(
-            queries.len(),
-            CHUNK,
-            threads,
-            |range| {
-                queries[range]
-                    .iter()
-                    .map(|&(p, n)| map.estimate_radius(set, &lookup(p, n, 0, r), f(n)).radiance.x)
-                    .sum::<f32>()
-            },
-            |_| {},
-        )
-        .into_iter()
-        .sum::<f32>()
-    };
-    let radii: Vec<f64> = knn(CodePath::Scalar).iter().map(|e| f64::from(e.radius)).collect();
-    let r_fixed = if radii.is_empty() { r_max } else { median(radii) as f32 };
-    let (ts, tk) = time_pair(reps, || drop(knn(CodePath::Simd)), || drop(knn(CodePath::Scalar)));
-    let (rs, rk) = time_pair(
-        reps,
-        || {
-            std::hint::black_box(radius_lookup(CodePath::Simd, r_fixed));
-        },
-        || {
-            std::hint::black_box(radius_lookup(CodePath::Scalar, r_fixed));
-        },
-    );
-    let n = queries.len() as f64;
-    let row = |lookup, simd: f64, scalar: f64| DensityRow {
-        scene: name.to_string(),
-        lookup,
-        count: queries.len(),
-        photons: map.len(),
-        simd_per_s: n / simd,
-        scalar_per_s: n / scalar,
-        ratio: scalar / simd,
-    };
-    vec![row("knn", ts, tk), row("radius", rs, rk)]
 }
 
 /// Throughput (Mrays/s, median) of packet traversal on each ray set and query for each
