@@ -2,7 +2,7 @@
 //! with `--features baselines`, against kiddo's k-d tree, with the photons each lookup tests.
 //! Reads a scene's camera hits and its global photon map; writes [`DensityRow`]s.
 
-use super::{median, time_pair, RaySets, CHUNK};
+use super::{median, time_alternating, RaySets, CHUNK};
 use crate::parallel::map_chunks;
 use crate::scene::Scene;
 use glam::Vec3;
@@ -109,75 +109,76 @@ pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize,
         .into_iter()
         .sum::<f32>()
     };
-    let radii: Vec<f64> = knn(CodePath::Scalar).iter().map(|e| f64::from(e.radius)).collect();
+    let scalar_knn = knn(CodePath::Scalar);
+    let radii: Vec<f64> = scalar_knn.iter().map(|e| f64::from(e.radius)).collect();
     let r_fixed = if radii.is_empty() { r_max } else { median(radii) as f32 };
-    let (ts, tk) = time_pair(reps, || drop(knn(CodePath::Simd)), || drop(knn(CodePath::Scalar)));
-    let (rs, rk) = time_pair(
-        reps,
-        || {
-            std::hint::black_box(radius_lookup(CodePath::Simd, r_fixed));
-        },
-        || {
-            std::hint::black_box(radius_lookup(CodePath::Scalar, r_fixed));
-        },
-    );
     let n = queries.len() as f64;
     let tested = |k: usize, r: f32| {
         queries.iter().map(|&(p, nrm)| map.photons_tested(&lookup(p, nrm, k, r))).sum::<u64>() as f64 / n
     };
+    let k = settings.k as usize;
+    // Each lookup through kiddo (k nearest, or `k` = 0: every photon within the radius), summed.
     #[cfg(feature = "baselines")]
-    let (kiddo_knn, kiddo_radius) = {
-        let tree = kiddo_baseline::Tree::new(map);
-        // Each lookup through kiddo, summed per chunk.
-        let through_kiddo = |k: usize, radius: f32| {
-            map_chunks(
-                queries.len(),
-                CHUNK,
-                threads,
-                |r| {
-                    let mut found = Vec::new();
-                    queries[r]
-                        .iter()
-                        .map(|&(p, nrm)| tree.estimate(&lookup(p, nrm, k, radius), f(nrm), &mut found).radiance.x)
-                        .sum::<f32>()
-                },
-                |_| {},
-            )
-            .into_iter()
-            .sum::<f32>()
-        };
-        let k = settings.k as usize;
+    let tree = kiddo_baseline::Tree::new(map);
+    #[cfg(feature = "baselines")]
+    let through_kiddo = |k: usize, radius: f32| {
+        map_chunks(
+            queries.len(),
+            CHUNK,
+            threads,
+            |r| {
+                let mut found = Vec::new();
+                queries[r]
+                    .iter()
+                    .map(|&(p, nrm)| tree.estimate(&lookup(p, nrm, k, radius), f(nrm), &mut found).radiance.x)
+                    .sum::<f32>()
+            },
+            |_| {},
+        )
+        .into_iter()
+        .sum::<f32>()
+    };
+    #[cfg(feature = "baselines")]
+    let through_kiddo: Option<&dyn Fn(usize, f32) -> f32> = Some(&through_kiddo);
+    #[cfg(not(feature = "baselines"))]
+    let through_kiddo: Option<&dyn Fn(usize, f32) -> f32> = None;
+    if let Some(kiddo) = through_kiddo {
         // The baseline computes the same estimates: the same photons within a fixed radius (sums
         // equal to rounding), nearly the same k nearest (its k are taken before the normal test).
-        let ours_knn: f32 = knn(CodePath::Simd).iter().map(|e| e.radiance.x).sum();
+        let ours_knn: f32 = scalar_knn.iter().map(|e| e.radiance.x).sum();
         let ours_radius = radius_lookup(CodePath::Simd, r_fixed);
-        let (theirs_knn, theirs_radius) = (through_kiddo(k, r_max), through_kiddo(0, r_fixed));
+        let (theirs_knn, theirs_radius) = (kiddo(k, r_max), kiddo(0, r_fixed));
         let close = |a: f32, b: f32, tol: f32| (a - b).abs() <= tol * a.abs().max(b.abs());
         assert!(close(ours_knn, theirs_knn, 0.02), "{name}: kiddo k-NN sum {theirs_knn} against {ours_knn}");
         assert!(
             close(ours_radius, theirs_radius, 1e-4),
             "{name}: kiddo radius sum {theirs_radius} against {ours_radius}"
         );
-        let knn_pair = time_pair(
-            reps,
-            || drop(knn(CodePath::Simd)),
-            || {
-                std::hint::black_box(through_kiddo(k, r_max));
-            },
-        );
-        let radius_pair = time_pair(
-            reps,
-            || {
+    }
+    // SIMD, scalar and (when built) kiddo in turn.
+    let kiddo_run = |k: usize, r: f32| {
+        if let Some(kiddo) = through_kiddo {
+            std::hint::black_box(kiddo(k, r));
+        }
+    };
+    let [ts, tk, tkd] = time_alternating(
+        reps,
+        [&mut || drop(knn(CodePath::Simd)), &mut || drop(knn(CodePath::Scalar)), &mut || kiddo_run(k, r_max)],
+    );
+    let [rs, rk, rkd] = time_alternating(
+        reps,
+        [
+            &mut || {
                 std::hint::black_box(radius_lookup(CodePath::Simd, r_fixed));
             },
-            || {
-                std::hint::black_box(through_kiddo(0, r_fixed));
+            &mut || {
+                std::hint::black_box(radius_lookup(CodePath::Scalar, r_fixed));
             },
-        );
-        (Some(knn_pair), Some(radius_pair))
-    };
-    #[cfg(not(feature = "baselines"))]
-    let (kiddo_knn, kiddo_radius): (Option<Timed>, Option<Timed>) = (None, None);
+            &mut || kiddo_run(0, r_fixed),
+        ],
+    );
+    let kiddo_knn = through_kiddo.map(|_| (ts, tkd));
+    let kiddo_radius = through_kiddo.map(|_| (rs, rkd));
     let row = |lookup, simd: f64, scalar: f64, tested: f64, kiddo: Option<Timed>| DensityRow {
         scene: name.to_string(),
         lookup,
@@ -191,10 +192,7 @@ pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize,
         kiddo_per_s: kiddo.map(|(_, k)| n / k),
         ratio_vs_kiddo: kiddo.map(|(s, k)| k / s),
     };
-    vec![
-        row("knn", ts, tk, tested(settings.k as usize, r_max), kiddo_knn),
-        row("radius", rs, rk, tested(0, r_fixed), kiddo_radius),
-    ]
+    vec![row("knn", ts, tk, tested(k, r_max), kiddo_knn), row("radius", rs, rk, tested(0, r_fixed), kiddo_radius)]
 }
 
 /// kiddo's k-d tree over a photon map's positions: the density benchmark's outside yardstick.

@@ -167,18 +167,23 @@ pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// Times the `kernels` in turn, `reps` rounds of one run each; returns their median seconds.
+pub fn time_alternating<const N: usize>(reps: usize, mut kernels: [&mut dyn FnMut(); N]) -> [f64; N] {
+    let mut times: [Vec<f64>; N] = std::array::from_fn(|_| vec![]);
+    for _ in 0..reps.max(1) {
+        for (k, t) in kernels.iter_mut().zip(&mut times) {
+            let start = Instant::now();
+            k();
+            t.push(start.elapsed().as_secs_f64());
+        }
+    }
+    times.map(median)
+}
+
 /// Times `a` and `b` alternately `reps` times each; returns their median seconds.
 pub fn time_pair(reps: usize, mut a: impl FnMut(), mut b: impl FnMut()) -> (f64, f64) {
-    let (mut ta, mut tb) = (vec![], vec![]);
-    for _ in 0..reps.max(1) {
-        let t = Instant::now();
-        a();
-        ta.push(t.elapsed().as_secs_f64());
-        let t = Instant::now();
-        b();
-        tb.push(t.elapsed().as_secs_f64());
-    }
-    (median(ta), median(tb))
+    let [ta, tb] = time_alternating(reps, [&mut a, &mut b]);
+    (ta, tb)
 }
 
 /// Chunk of rays per thread task.
@@ -254,15 +259,19 @@ pub fn traversal(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps
                 }
             };
             let (mut hp, mut hs, mut ht, mut hc, mut hw) = (0, 0, 0, 0, 0);
-            let (tp, ts) =
-                time_pair(reps, || hp = count_hits(rays, threads, packet), || hs = count_hits(rays, threads, &obvhs));
+            let [tp, ts, tw] = time_alternating(
+                reps,
+                [
+                    &mut || hp = count_hits(rays, threads, packet),
+                    &mut || hs = count_hits(rays, threads, &obvhs),
+                    &mut || hw = count_hits(rays, threads, wide),
+                ],
+            );
             assert_eq!(hp, hs, "{name} {label} {query}: packet and single-ray hit counts differ");
+            assert_eq!(hw, hs, "{name} {label} {query}: 8-wide and obvhs hit counts differ");
             let (tt, tc) =
                 time_pair(reps, || ht = count_hits(rays, threads, &twin), || hc = count_hits(rays, threads, &cwbvh));
             assert_eq!(ht, hs, "{name} {label} {query}: scalar twin and obvhs hit counts differ");
-            let (_, tw) =
-                time_pair(reps, || hp = count_hits(rays, threads, packet), || hw = count_hits(rays, threads, wide));
-            assert_eq!(hw, hs, "{name} {label} {query}: 8-wide and obvhs hit counts differ");
             // Not asserted: obvhs's CWBVH traversal loses a few hits (recorded, see BENCHMARKS.md).
             let visits = count_visits(bvh.wide(tris), rays, any);
             let m = rays.len() as f64 * 1e-6;

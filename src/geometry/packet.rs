@@ -16,7 +16,7 @@ use super::bvh::{Bvh, Hit, TriangleColumns};
 use super::slab::FAR_GROWTH;
 use super::traverse::{closest_from, occluded_from, Best, RayQuery, Stack};
 use super::triangle::{intersect_triangle, is_degenerate};
-use super::triangle8::watertight8;
+use super::triangle8::{bits, watertight8};
 use glam::Vec3;
 use obvhs::bvh2::node::Bvh2Node;
 use wide::f32x8;
@@ -131,12 +131,6 @@ impl Packet {
         let hit = near.simd_le(far) & near.simd_le(t_max);
         hit.select(near, f32x8::splat(f32::NAN))
     }
-}
-
-/// Bit mask of lanes where `m` is set.
-#[inline(always)]
-fn bits(m: f32x8) -> u32 {
-    m.to_bitmask()
 }
 
 /// The watertight ray/triangle test of [`intersect_triangle`] for 8 rays against one triangle:

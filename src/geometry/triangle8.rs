@@ -82,7 +82,7 @@ pub(super) fn watertight8(
 
 /// Bit mask of lanes where `m` is set.
 #[inline(always)]
-fn bits(m: f32x8) -> u32 {
+pub(super) fn bits(m: f32x8) -> u32 {
     m.to_bitmask()
 }
 

@@ -138,6 +138,26 @@ fn entered<const SIMD: bool>(node: &Node8, r: &WideRay, o: Vec3, inv: Vec3, t_ma
     (keys, n)
 }
 
+/// One ray as both tests want it: origin, inverse direction, splatted for the child test and
+/// sheared for the triangle test.
+struct Prepared {
+    o: Vec3,
+    inv: Vec3,
+    wide: WideRay,
+    sheared: ShearedRay,
+}
+
+/// The ray prepared, or `None` when there is nothing to trace (no nodes, or an invalid ray).
+#[inline(always)]
+fn prepare(bvh: &Bvh8, ray: &RayQuery) -> Option<Prepared> {
+    if bvh.nodes().is_empty() || !ray.is_valid() {
+        return None;
+    }
+    let (o, d) = (ray.origin, ray.direction);
+    let inv = inverse_direction(d);
+    Some(Prepared { o, inv, wide: WideRay::new(o, inv), sheared: ShearedRay::new(o, d) })
+}
+
 /// The slot and entry distance of a key from [`entered`].
 #[inline(always)]
 fn unkey(key: u64) -> (usize, f32) {
@@ -158,14 +178,8 @@ pub fn closest_counted<const SIMD: bool, const COUNT: bool>(
     stack: &mut Stack<Entry>,
     visits: &mut Visits,
 ) -> Option<Hit> {
+    let Prepared { o, inv, wide: r, sheared } = prepare(bvh, ray)?;
     let nodes = bvh.nodes();
-    if nodes.is_empty() || !ray.is_valid() {
-        return None;
-    }
-    let (o, d) = (ray.origin, ray.direction);
-    let inv = inverse_direction(d);
-    let r = WideRay::new(o, inv);
-    let sheared = ShearedRay::new(o, d);
     let mut best = Best::new(ray.t_max);
     stack.clear();
     stack.push((0, 0, 0.0));
@@ -211,14 +225,10 @@ pub fn occluded_counted<const SIMD: bool, const COUNT: bool>(
     stack: &mut Stack<Entry>,
     visits: &mut Visits,
 ) -> bool {
-    let nodes = bvh.nodes();
-    if nodes.is_empty() || !ray.is_valid() {
+    let Some(Prepared { o, inv, wide: r, sheared }) = prepare(bvh, ray) else {
         return false;
-    }
-    let (o, d, t_max) = (ray.origin, ray.direction, ray.t_max);
-    let inv = inverse_direction(d);
-    let r = WideRay::new(o, inv);
-    let sheared = ShearedRay::new(o, d);
+    };
+    let (nodes, t_max) = (bvh.nodes(), ray.t_max);
     let leaf_hit = |first: u32, count: u32, visits: &mut Visits| {
         let blocks = leaf(bvh, first, count);
         if COUNT {

@@ -8,7 +8,7 @@
 //! the baseline pays for the same estimate. (Its k nearest are taken before the normal test,
 //! ours after it: at corners the two sum slightly different photons.)
 
-use super::{Estimate, Lookup, PhotonMap, Reflectance, Test, BUCKET};
+use super::{Estimate, Lookup, PhotonMap, Reflectance, Test};
 use crate::code_path::CodePath;
 
 impl PhotonMap {
@@ -53,15 +53,9 @@ impl PhotonMap {
             let mut r2 = q.r_max * q.r_max;
             self.walk(q.p, &mut r2, |lo, hi, _, _| tested += (hi - lo) as u64);
         } else {
-            self.nearest_walk(CodePath::Scalar, q, &mut Vec::new(), &mut tested);
+            self.nearest_walk::<true>(CodePath::Scalar, q, &mut Vec::new(), &mut tested);
         }
         tested
-    }
-
-    /// Buckets are at most this long.
-    #[must_use]
-    pub const fn bucket() -> usize {
-        BUCKET
     }
 }
 

@@ -19,12 +19,18 @@ impl PhotonMap {
     /// [`Estimate::rejected`]); both code paths count the same photons.
     #[inline]
     pub(super) fn nearest_counted(&self, set: CodePath, q: &Lookup, out: &mut Vec<(f32, u32)>) -> u32 {
-        self.nearest_walk(set, q, out, &mut 0)
+        self.nearest_walk::<false>(set, q, out, &mut 0)
     }
 
-    /// [`Self::nearest_counted`], adding the photons its walk tests to `tested`.
+    /// [`Self::nearest_counted`], adding the photons its walk tests to `tested` when `COUNT`.
     #[inline]
-    pub(super) fn nearest_walk(&self, set: CodePath, q: &Lookup, out: &mut Vec<(f32, u32)>, tested: &mut u64) -> u32 {
+    pub(super) fn nearest_walk<const COUNT: bool>(
+        &self,
+        set: CodePath,
+        q: &Lookup,
+        out: &mut Vec<(f32, u32)>,
+        tested: &mut u64,
+    ) -> u32 {
         out.clear();
         if q.k == 0 || self.is_empty() {
             return 0;
@@ -53,7 +59,9 @@ impl PhotonMap {
         };
         let mut r2 = q.r_max * q.r_max;
         self.walk(q.p, &mut r2, |lo, hi, simd_ok, r2| {
-            *tested += (hi - lo) as u64;
+            if COUNT {
+                *tested += (hi - lo) as u64;
+            }
             if simd_ok && set == CodePath::Simd {
                 for base in (lo..hi).step_by(8) {
                     let (m, turned, d2) = self.accepts8(base, q.p, *r2, &q.filter);
