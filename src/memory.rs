@@ -4,14 +4,14 @@
 //! Cornell box, every engine (BENCHMARKS.md, "Memory"): about 147 bytes per pixel (film terms,
 //! per-pixel sums and radii, camera queues and the EXR's channels while it is written) and
 //! about 81 bytes per stored photon (the map's columns, the kd-tree and the deposits sorted
-//! before they are stored), over a base of about 12 MiB. The estimate rounds each up.
+//! before they are stored; the tree's nodes added about 3.4 B in issue 18: 84 B), over a base of about 12 MiB. The estimate rounds each up.
 
 use crate::error::{Error, Result};
 use crate::files::bytes;
 
 /// Bytes per pixel of the image (measured 147).
 pub const BYTES_PER_PIXEL: u64 = 160;
-/// Bytes per stored photon (measured 81).
+/// Bytes per stored photon (measured 81, then 84 with the tree's nodes).
 pub const BYTES_PER_PHOTON: u64 = 96;
 /// Bytes per pixel a progressive render adds (measured 390 at 800², peak resident set of
 /// `--passes 2` against one pass, BENCHMARKS.md "Divided renders"): its passes' exact sums

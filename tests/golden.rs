@@ -18,16 +18,16 @@ use std::sync::Arc;
 
 /// (scene, engine, passes) → FNV-1a 64 of the film's f32 bits.
 const GOLDEN: &[(&str, &str, u32, u64)] = &[
-    ("cornell-box.toml", "wavefront", 1, 0x1dea3d005dd55068),
-    ("cornell-box.toml", "reference", 1, 0x639845c897ccbb69),
+    ("cornell-box.toml", "wavefront", 1, 0x435f1804119a3d92),
+    ("cornell-box.toml", "reference", 1, 0x5c8c3379039cea2b),
     ("cornell-box.toml", "path", 1, 0xd3159bbc928efad9),
-    ("cornell-spheres.toml", "wavefront", 1, 0x4efa6111b3f00857),
-    ("cornell-spheres.toml", "reference", 1, 0xcf28f091ff0e045d),
-    ("cornell-spheres.toml", "wavefront", 3, 0x160d3adca67771c7),
-    ("cornell-spheres.toml", "reference", 3, 0x951152e606799b1f),
-    ("hard/furnace-materials.toml", "wavefront", 1, 0x7c9f828ee156795c),
-    ("hard/furnace-materials.toml", "reference", 1, 0x6315b918a5bd669e),
-    ("hard/nested.toml", "wavefront", 2, 0x4344acbc2a84072c),
+    ("cornell-spheres.toml", "wavefront", 1, 0x034173f33630ad6e),
+    ("cornell-spheres.toml", "reference", 1, 0x9f555459835a5c7f),
+    ("cornell-spheres.toml", "wavefront", 3, 0x6bd7632c75ac9b09),
+    ("cornell-spheres.toml", "reference", 3, 0x6cbe9a5f6836119d),
+    ("hard/furnace-materials.toml", "wavefront", 1, 0xd64f5f70d1adc150),
+    ("hard/furnace-materials.toml", "reference", 1, 0x3350babe3afe8869),
+    ("hard/nested.toml", "wavefront", 2, 0xb991a05c2d28d3cd),
 ];
 
 /// FNV-1a over the bits of every term of every pixel, in film order.

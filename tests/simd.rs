@@ -103,6 +103,72 @@ fn simd_lookups_find_the_same_photons_as_the_scalar_twins() {
     }
 }
 
+/// The tree prunes exactly: every photon a brute-force scan finds within the radius is found by
+/// both code paths' fixed-radius lookups, summed or turned away, and none outside — with photons
+/// at exactly the radius (lattice queries), NaN and infinite positions in the map, queries far
+/// outside it, radii from a hundredth to the whole scene, and an empty map. The corner photons
+/// have axis-aligned normals, stored exactly, so the normal filter's verdict is known: a photon
+/// is summed when its surface is the query's, turned away otherwise (no flags masked).
+#[test]
+fn fixed_radius_lookups_find_what_a_brute_force_scan_finds() {
+    let mut photons = corner_photons(6000);
+    for (i, position) in [
+        Vec3::splat(f32::NAN),
+        Vec3::new(0.3, f32::NAN, 0.3),
+        Vec3::new(f32::INFINITY, 0.0, 0.2),
+        Vec3::new(0.2, 0.0, f32::NEG_INFINITY),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        photons.insert(i * 1000, Photon { position, power: Vec3::ONE, wi: Vec3::Y, normal: Vec3::Y, flags: 0 });
+    }
+    let map = PhotonMap::build(photons);
+    let f = Reflectance::Constant(Vec3::ONE);
+    let mut checked = 0;
+    for (qi, (p, n)) in queries().into_iter().enumerate().step_by(7) {
+        for r in [0.01f32, 0.03, 0.1, 2.0] {
+            let q = Lookup { p, k: 0, r_max: r, kernel: Kernel::Box, filter: Filter { n, flags_mask: 0 } };
+            // The lookup's own distance arithmetic, photon by photon.
+            let (mut summed, mut turned) = (0u32, 0u32);
+            for i in 0..map.len() {
+                let (x, y, z) = (map.position(i).x - p.x, map.position(i).y - p.y, map.position(i).z - p.z);
+                if x * x + y * y + z * z < r * r {
+                    if map.photon(i).normal.dot(n) > 0.9 {
+                        summed += 1;
+                    } else {
+                        turned += 1;
+                    }
+                }
+            }
+            for set in [CodePath::Simd, CodePath::Scalar] {
+                let e = map.estimate_radius(set, &q, f);
+                assert_eq!((e.count, e.rejected), (summed, turned), "query {qi}, r {r}, {set:?}");
+                assert!(e.radiance.is_finite(), "query {qi}, r {r}, {set:?}");
+            }
+            assert!(map.photons_tested(&q) >= u64::from(summed + turned), "query {qi}, r {r}");
+            checked += summed;
+        }
+    }
+    assert!(checked > 10_000, "the queries found photons: {checked}");
+    // An empty map finds nothing, on both paths, for any query.
+    let empty = PhotonMap::build(vec![]);
+    for set in [CodePath::Simd, CodePath::Scalar] {
+        let q = Lookup {
+            p: Vec3::ZERO,
+            k: 0,
+            r_max: 1.0,
+            kernel: Kernel::Box,
+            filter: Filter { n: Vec3::Y, flags_mask: 0 },
+        };
+        let e = empty.estimate_radius(set, &q, f);
+        assert_eq!((e.count, e.rejected, e.radiance), (0, 0, Vec3::ZERO), "{set:?}");
+        let mut out = vec![];
+        empty.nearest(set, &Lookup { k: 8, ..q }, &mut out);
+        assert!(out.is_empty(), "{set:?}");
+    }
+}
+
 #[test]
 fn lookups_honour_the_radius_and_the_filters_exactly() {
     // Photons at exactly the search radius are outside (the interval is open), on both twins;

@@ -33,6 +33,11 @@ pub struct DensityRow {
     pub photons_tested_per_query: f64,
     /// SIMD time per photon tested, nanoseconds.
     pub ns_per_photon_tested: f64,
+    /// Photons each estimate sums (within the radius, passing the filter), per query: with
+    /// `photons_tested_per_query`, how tightly the tree's boxes fit the query's sphere.
+    pub photons_summed_per_query: f64,
+    /// Bytes of the map per photon: its 20-byte records and its tree's nodes.
+    pub map_bytes_per_photon: f64,
     /// kiddo's k-d tree (`ImmutableKdTree`, buckets of 32) over the same positions, its search
     /// followed by the same filter and scalar kernel sum, estimates per second (median); `null`
     /// unless built with `--features baselines`.
@@ -53,7 +58,7 @@ const QUERIES: usize = 65_536;
 /// `radius`: every photon within a fixed radius, the median radius the k-NN lookups found.
 pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usize) -> Vec<DensityRow> {
     use crate::code_path::CodePath;
-    use crate::photon_map::{Filter, Lookup, Reflectance};
+    use crate::photon_map::{Filter, Lookup, PhotonMap, Reflectance};
     use crate::reference::build_maps;
     use crate::settings::Settings;
     if sets.hits.is_empty() {
@@ -117,6 +122,12 @@ pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize,
         queries.iter().map(|&(p, nrm)| map.photons_tested(&lookup(p, nrm, k, r))).sum::<u64>() as f64 / n
     };
     let k = settings.k as usize;
+    let summed_knn = scalar_knn.iter().map(|e| f64::from(e.count)).sum::<f64>() / n;
+    let summed_radius = queries
+        .iter()
+        .map(|&(p, nrm)| f64::from(map.estimate_radius(CodePath::Scalar, &lookup(p, nrm, 0, r_fixed), f(nrm)).count))
+        .sum::<f64>()
+        / n;
     // Each lookup through kiddo (k nearest, or `k` = 0: every photon within the radius), summed.
     #[cfg(feature = "baselines")]
     let tree = kiddo_baseline::Tree::new(map);
@@ -179,7 +190,7 @@ pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize,
     );
     let kiddo_knn = through_kiddo.map(|_| (ts, tkd));
     let kiddo_radius = through_kiddo.map(|_| (rs, rkd));
-    let row = |lookup, simd: f64, scalar: f64, tested: f64, kiddo: Option<Timed>| DensityRow {
+    let row = |lookup, simd: f64, scalar: f64, tested: f64, summed: f64, kiddo: Option<Timed>| DensityRow {
         scene: name.to_string(),
         lookup,
         count: queries.len(),
@@ -189,10 +200,15 @@ pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize,
         ratio: scalar / simd,
         photons_tested_per_query: tested,
         ns_per_photon_tested: simd / n / tested * 1e9,
+        photons_summed_per_query: summed,
+        map_bytes_per_photon: PhotonMap::bytes_per_photon() as f64 + map.tree_bytes_per_photon(),
         kiddo_per_s: kiddo.map(|(_, k)| n / k),
         ratio_vs_kiddo: kiddo.map(|(s, k)| k / s),
     };
-    vec![row("knn", ts, tk, tested(k, r_max), kiddo_knn), row("radius", rs, rk, tested(0, r_fixed), kiddo_radius)]
+    vec![
+        row("knn", ts, tk, tested(k, r_max), summed_knn, kiddo_knn),
+        row("radius", rs, rk, tested(0, r_fixed), summed_radius, kiddo_radius),
+    ]
 }
 
 /// kiddo's k-d tree over a photon map's positions: the density benchmark's outside yardstick.

@@ -376,7 +376,7 @@ pub fn table(traversal: &[TraversalRow], density: &[DensityRow]) -> String {
     for r in density {
         let _ = writeln!(
             s,
-            "  density   {:<8} {:>8} queries over {} photons  simd {:>9.0}/s  scalar {:>9.0}/s  ×{:.2}  kiddo {}  ({:.0} photons tested per query, {:.2} ns each)",
+            "  density   {:<8} {:>8} queries over {} photons  simd {:>9.0}/s  scalar {:>9.0}/s  ×{:.2}  kiddo {}  ({:.0} photons tested per query for {:.0} summed, {:.2} ns each; {:.1} B per photon)",
             r.lookup,
             r.count,
             r.photons,
@@ -388,7 +388,9 @@ pub fn table(traversal: &[TraversalRow], density: &[DensityRow]) -> String {
                 _ => "– (build with --features baselines)".to_string(),
             },
             r.photons_tested_per_query,
-            r.ns_per_photon_tested
+            r.photons_summed_per_query,
+            r.ns_per_photon_tested,
+            r.map_bytes_per_photon
         );
     }
     s

@@ -40,8 +40,8 @@ impl PhotonMap {
         Estimate { radius: q.r_max, ..self.sum_estimate(CodePath::Scalar, q, r2, f, found) }
     }
 
-    /// Photons the kd-tree walk tests for a fixed-radius lookup (`q.k == 0`) or a k-nearest one:
-    /// the photons of every bucket and inner node it reaches (the scalar and SIMD lookups walk
+    /// Photons the tree walk tests for a fixed-radius lookup (`q.k == 0`) or a k-nearest one:
+    /// the photons of every block it reaches (the scalar and SIMD lookups walk
     /// alike).
     #[must_use]
     pub fn photons_tested(&self, q: &Lookup) -> u64 {
@@ -50,8 +50,11 @@ impl PhotonMap {
         }
         let mut tested = 0u64;
         if q.k == 0 {
-            let mut r2 = q.r_max * q.r_max;
-            self.walk(q.p, &mut r2, |lo, hi, _, _| tested += (hi - lo) as u64);
+            let r2 = q.r_max * q.r_max;
+            let mut walk = super::tree::Walk::<false>::new(self, CodePath::Scalar, q.p);
+            while let Some((lo, hi)) = walk.next(self, r2) {
+                tested += (hi - lo) as u64;
+            }
         } else {
             self.nearest_walk::<true>(CodePath::Scalar, q, &mut Vec::new(), &mut tested);
         }

@@ -1,5 +1,5 @@
 //! Which photons a lookup may use: the distance, flags and normal tests of one photon, and the
-//! 8-wide twin that tests a bucket's photons at once with the same operations.
+//! 8-wide twin that tests a block of 8 photons at once with the same operations.
 
 use super::packing::{dequantise8, key_flags, key_normal, oct_decode8, NORMAL_STEPS};
 use super::{Filter, PhotonMap, Test};
@@ -37,21 +37,21 @@ impl PhotonMap {
         u32x8::from(<[u32; 8]>::try_from(&self.power[base..base + 8]).expect("padded column"))
     }
 
-    /// Lanes of the 8 photons from `base` that lie within `r2` of `p` and pass `filter`, and the
-    /// lanes within `r2` that pass its flags but fail its normal test.
+    /// The filter's verdict on the 8 photons from `base` for a query at `p` within `r2`.
     #[inline]
-    pub(super) fn accepts8(&self, base: usize, p: Vec3, r2: f32, filter: &Filter) -> (u32, u32, f32x8) {
+    pub(super) fn accepts8(&self, base: usize, p: Vec3, r2: f32, filter: &Filter) -> Verdict8 {
         let load = |c: &[f32]| f32x8::from(<[f32; 8]>::try_from(&c[base..base + 8]).expect("padded column"));
         let (dx, dy, dz) =
             (load(&self.x) - f32x8::splat(p.x), load(&self.y) - f32x8::splat(p.y), load(&self.z) - f32x8::splat(p.z));
         let d2 = dx * dx + dy * dy + dz * dz;
         let near = d2.simd_lt(f32x8::splat(r2));
         if !near.any() {
-            return (0, 0, d2);
+            return Verdict8 { inside: f32x8::ZERO, bits: 0, turned: 0, d2, key: u32x8::ZERO };
         }
         let key = self.key8(base);
         let flags = (key >> 12_u32) & u32x8::splat(3);
-        let flags_ok = (flags & u32x8::splat(u32::from(filter.flags_mask))).simd_eq(u32x8::ZERO);
+        let flags_ok: f32x8 =
+            wide::bytemuck::cast((flags & u32x8::splat(u32::from(filter.flags_mask))).simd_eq(u32x8::ZERO));
         let [mx, my, mz] = oct_decode8(
             dequantise8(key & u32x8::splat(63), NORMAL_STEPS),
             dequantise8((key >> 6_u32) & u32x8::splat(63), NORMAL_STEPS),
@@ -59,9 +59,22 @@ impl PhotonMap {
         let dot = mx * f32x8::splat(filter.n.x) + my * f32x8::splat(filter.n.y) + mz * f32x8::splat(filter.n.z);
         let len2 = mx * mx + my * my + mz * mz;
         let normal_ok = dot.simd_gt(f32x8::ZERO) & (dot * dot).simd_gt(f32x8::splat(0.49) * len2);
-        let inside = near & normal_ok;
-        let flags_bits = flags_ok.to_bitmask();
-        let turned = (near & !normal_ok).to_bitmask() & flags_bits;
-        (inside.to_bitmask() & flags_bits, turned, d2)
+        let inside = near & normal_ok & flags_ok;
+        let turned = (near & !normal_ok & flags_ok).to_bitmask();
+        Verdict8 { inside, bits: inside.to_bitmask(), turned, d2, key }
     }
+}
+
+/// What [`PhotonMap::accepts8`] made of 8 photons (padding lanes, at +∞, are never near).
+pub(super) struct Verdict8 {
+    /// All-ones in the lanes of photons within the radius that pass the filter, zero elsewhere.
+    pub inside: f32x8,
+    /// `inside` as a bit mask.
+    pub bits: u32,
+    /// Lanes within the radius that pass the filter's flags but fail its normal test.
+    pub turned: u32,
+    /// Squared distances from the query.
+    pub d2: f32x8,
+    /// The photons' keys (zero when none is near).
+    pub key: u32x8,
 }

@@ -4,6 +4,7 @@
 //! order, so both find the same photons.
 
 use super::packing::key_normal;
+use super::tree::Walk;
 use super::{Estimate, Lookup, PhotonMap, Reflectance, Test};
 use crate::code_path::CodePath;
 use glam::Vec3;
@@ -58,44 +59,41 @@ impl PhotonMap {
             }
         };
         let mut r2 = q.r_max * q.r_max;
-        self.walk(q.p, &mut r2, |lo, hi, simd_ok, r2| {
+        let mut walk = Walk::<true>::new(self, set, q.p);
+        while let Some((lo, hi)) = walk.next(self, r2) {
             if COUNT {
                 *tested += (hi - lo) as u64;
             }
-            if simd_ok && set == CodePath::Simd {
-                for base in (lo..hi).step_by(8) {
-                    let (m, turned, d2) = self.accepts8(base, q.p, *r2, &q.filter);
-                    let valid = (1u32 << (hi - base).min(8)) - 1;
-                    let (m, turned) = (m & valid, turned & valid);
-                    let d2 = d2.to_array();
-                    // Lane order, as the scalar twin walks them: r² may have shrunk since the
-                    // 8-wide test, so each lane is re-checked at its turn.
-                    let mut all = m | turned;
-                    while all != 0 {
-                        let l = all.trailing_zeros() as usize;
-                        all &= all - 1;
-                        if d2[l] < *r2 {
-                            if m >> l & 1 == 1 {
-                                offer(out, r2, d2[l], base + l);
-                            } else {
-                                rejected += 1;
-                            }
+            if set == CodePath::Simd {
+                let v = self.accepts8(lo, q.p, r2, &q.filter);
+                let d2 = v.d2.to_array();
+                // Lane order, as the scalar twin walks them: r² may have shrunk since the
+                // 8-wide test, so each lane is re-checked at its turn.
+                let mut all = v.bits | v.turned;
+                while all != 0 {
+                    let l = all.trailing_zeros() as usize;
+                    all &= all - 1;
+                    if d2[l] < r2 {
+                        if v.bits >> l & 1 == 1 {
+                            offer(out, &mut r2, d2[l], lo + l);
+                        } else {
+                            rejected += 1;
                         }
                     }
                 }
             } else {
                 for i in lo..hi {
                     let d2 = self.d2(i, q.p);
-                    if d2 < *r2 {
+                    if d2 < r2 {
                         match Self::test(self.key[i], &q.filter) {
-                            Test::Accepted => offer(out, r2, d2, i),
+                            Test::Accepted => offer(out, &mut r2, d2, i),
                             Test::Normal => rejected += 1,
                             Test::Flags => {}
                         }
                     }
                 }
             }
-        });
+        }
         if out.len() > k {
             out.select_nth_unstable_by_key(k - 1, by_distance);
             out.truncate(k);

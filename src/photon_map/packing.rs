@@ -28,14 +28,13 @@ pub(super) const NORMAL_STEPS: u32 = 62;
 
 pub(super) const DIR_STEPS: u32 = 254;
 
-/// Packs normal, flags (2 bits), split axis and incoming direction into a key.
-pub(super) fn pack_key(normal: Vec3, flags: u8, axis: u8, wi: Vec3) -> u32 {
+/// Packs normal, flags (2 bits) and incoming direction into a key (bits 14 and 15 spare).
+pub(super) fn pack_key(normal: Vec3, flags: u8, wi: Vec3) -> u32 {
     let (nu, nv) = oct_encode(normal);
     let (wu, wv) = oct_encode(wi);
     quantise(nu, NORMAL_STEPS)
         | quantise(nv, NORMAL_STEPS) << 6
         | u32::from(flags & 3) << 12
-        | u32::from(axis & 3) << 14
         | quantise(wu, DIR_STEPS) << 16
         | quantise(wv, DIR_STEPS) << 24
 }

@@ -3,6 +3,7 @@
 //! with the estimate's bias from the same photons ([`Kernel::bias_normalisation`]).
 
 use super::boundary::{Coverage, Cut, Neighbours};
+use super::tree::Walk;
 use super::{Estimate, Kernel, Lookup, PhotonMap, Reflectance, Test};
 use crate::code_path::CodePath;
 use glam::Vec3;
@@ -57,51 +58,39 @@ impl PhotonMap {
         let mut neighbours = Neighbours::default();
         let (mut sum, mut bias) = (Vec3::ZERO, Vec3::ZERO);
         let (mut sum8, mut bias8) = ([f32x8::ZERO; 3], [f32x8::ZERO; 3]);
-        let mut r2_walk = r2;
-        self.walk(q.p, &mut r2_walk, |lo, hi, simd_ok, _| {
-            if simd_ok && set == CodePath::Simd {
-                for base in (lo..hi).step_by(8) {
-                    let (mut m, turned, d2) = self.accepts8(base, q.p, r2, &q.filter);
-                    let valid = (1u32 << (hi - base).min(8)) - 1;
-                    m &= valid;
-                    let turned = turned & valid;
-                    rejected += turned.count_ones();
-                    if on_surface.is_some() {
-                        // Lane order, as the scalar twin meets them.
-                        let mut left = turned;
-                        while left != 0 {
-                            let l = left.trailing_zeros() as usize;
-                            left &= left - 1;
-                            neighbours.note(self, base + l, q.p, q.filter.n);
-                        }
+        let mut walk = Walk::<false>::new(self, set, q.p);
+        while let Some((lo, hi)) = walk.next(self, r2) {
+            if set == CodePath::Simd {
+                let v = self.accepts8(lo, q.p, r2, &q.filter);
+                rejected += v.turned.count_ones();
+                if on_surface.is_some() {
+                    // Lane order, as the scalar twin meets them.
+                    let mut left = v.turned;
+                    while left != 0 {
+                        let l = left.trailing_zeros() as usize;
+                        left &= left - 1;
+                        neighbours.note(self, lo + l, q.p, q.filter.n);
                     }
-                    if m == 0 {
-                        continue;
+                }
+                if v.bits == 0 {
+                    continue;
+                }
+                count += v.bits.count_ones();
+                let power = self.power8(lo);
+                if BIAS {
+                    let r2_8 = f32x8::splat(r2);
+                    let weights = [q.kernel.weight8(v.d2, r2_8), Kernel::bias_weight8(v.d2, r2_8)];
+                    let [c, b] = Self::contributions8(v.key, power, v.inside, weights, f);
+                    for (s, v) in sum8.iter_mut().zip(c) {
+                        *s += v;
                     }
-                    count += m.count_ones();
-                    let lanes = f32x8::from(std::array::from_fn::<f32, 8, _>(|l| {
-                        if m >> l & 1 == 1 {
-                            f32::from_bits(u32::MAX)
-                        } else {
-                            0.0
-                        }
-                    }));
-                    let (key, power) = (self.key8(base), self.power8(base));
-                    if BIAS {
-                        let r2_8 = f32x8::splat(r2);
-                        let weights = [q.kernel.weight8(d2, r2_8), Kernel::bias_weight8(d2, r2_8)];
-                        let [c, b] = Self::contributions8(key, power, lanes, weights, f);
-                        for (s, v) in sum8.iter_mut().zip(c) {
-                            *s += v;
-                        }
-                        for (s, v) in bias8.iter_mut().zip(b) {
-                            *s += v;
-                        }
-                    } else {
-                        let c = Self::contribution8(key, power, lanes, d2, r2, q.kernel, f);
-                        for (s, v) in sum8.iter_mut().zip(c) {
-                            *s += v;
-                        }
+                    for (s, v) in bias8.iter_mut().zip(b) {
+                        *s += v;
+                    }
+                } else {
+                    let c = Self::contribution8(v.key, power, v.inside, v.d2, r2, q.kernel, f);
+                    for (s, v) in sum8.iter_mut().zip(c) {
+                        *s += v;
                     }
                 }
             } else {
@@ -130,7 +119,7 @@ impl PhotonMap {
                     }
                 }
             }
-        });
+        }
         let reduce = |v: [f32x8; 3]| Vec3::new(v[0].reduce_add(), v[1].reduce_add(), v[2].reduce_add());
         let coverage = match on_surface {
             Some(edges) => neighbours.coverage(self, q.p, q.filter.n, r2, q.kernel, edges),

@@ -1,4 +1,4 @@
-//! The photon maps of one render: the global and caustic kd-trees, and the irradiance
+//! The photon maps of one render: the global and caustic trees, and the irradiance
 //! precomputed at global photons for final gathering (Christensen 1999).
 
 use super::estimate::photon_visibility;
@@ -26,7 +26,7 @@ pub struct PhotonMaps {
 pub const IRRADIANCE_STRIDE: usize = 4;
 
 impl PhotonMaps {
-    /// Builds the kd-trees and, if the job asks for final gathering with precomputed irradiance
+    /// Builds the trees and, if the job asks for final gathering with precomputed irradiance
     /// (and is not a progressive pass), the irradiance map.
     #[must_use]
     pub fn build(scene: &Scene, job: &Job, global: Vec<Photon>, caustic: Vec<Photon>) -> Self {
