@@ -24,7 +24,7 @@
 //! - [`optics`]: reflection, refraction and Fresnel at a smooth interface;
 //! - [`microfacet`]: GGX rough conductors and dielectrics (eval, pdf, visible-normal sampling);
 //! - [`material`]: BSDFs (Lambert, glossy Phong, mirror, glass, the rough ones) and their textures;
-//! - [`photon_map`]: the 20-byte photon, the kd-tree, k-NN and fixed-radius density estimates;
+//! - [`photon_map`]: the 20-byte photon, the 8-wide photon tree, k-NN and fixed-radius density estimates;
 //! - [`settings`]: the user's knobs, their layering and validation;
 //! - [`scene`]: OBJ/MTL and TOML loading, image files, lights (area, point, spot, directional,
 //!   sun, environment), caustic targets, the camera;

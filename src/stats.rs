@@ -121,7 +121,7 @@ pub struct PhaseTimes {
     pub global_photons_s: f64,
     /// Caustic photon pass.
     pub caustic_photons_s: f64,
-    /// Building the kd-trees.
+    /// Building the photon trees.
     pub map_build_s: f64,
     /// Camera pass.
     pub camera_s: f64,

@@ -28,8 +28,7 @@ pub struct DensityRow {
     pub scalar_per_s: f64,
     /// simd / scalar.
     pub ratio: f64,
-    /// Photons the kd-tree walk tests per query (those of every bucket and inner node it
-    /// reaches).
+    /// Photons the tree walk tests per query (those of every block it reaches).
     pub photons_tested_per_query: f64,
     /// SIMD time per photon tested, nanoseconds.
     pub ns_per_photon_tested: f64,

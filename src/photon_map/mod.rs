@@ -82,7 +82,7 @@ pub struct PhotonMap {
     x: Vec<f32>,
     y: Vec<f32>,
     z: Vec<f32>,
-    /// Normal, flags, split axis, incoming direction (see the module notes).
+    /// Normal, flags, incoming direction (see the module notes).
     key: Vec<u32>,
     /// RGBE power.
     power: Vec<u32>,

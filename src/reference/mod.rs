@@ -2,7 +2,7 @@
 //! every faster engine is compared against. Written for obviousness: its loops are here, every
 //! vertex of physics is the shared transport core's ([`crate::transport`]).
 //!
-//! A render is: photon passes (global, caustic, as the plan asks) → kd-trees → camera pass
+//! A render is: photon passes (global, caustic, as the plan asks) → photon trees → camera pass
 //! (direct + specular + caustic + indirect per pixel sample).
 
 pub mod camera;
