@@ -19,7 +19,7 @@ use glam::Vec3;
 use wide::f32x8;
 
 /// Photons per block: one `f32x8` per column.
-pub const BLOCK: usize = 8;
+const BLOCK: usize = 8;
 
 /// A child slot holding a leaf carries this bit and the block's index; otherwise a node's index.
 const LEAF: u32 = 1 << 31;
@@ -104,8 +104,7 @@ impl<const NEAREST_FIRST: bool> Walk<NEAREST_FIRST> {
             if !NEAREST_FIRST && self.pending != 0 {
                 let c = self.pending.trailing_zeros() as usize;
                 self.pending &= self.pending - 1;
-                let lo = (map.nodes[self.node as usize].child[c] & !LEAF) as usize * BLOCK;
-                return Some((lo, (lo + BLOCK).min(map.len)));
+                return Some(map.block(map.nodes[self.node as usize].child[c]));
             }
             if self.top == 0 {
                 return None;
@@ -116,8 +115,7 @@ impl<const NEAREST_FIRST: bool> Walk<NEAREST_FIRST> {
                 continue;
             }
             if child & LEAF != 0 {
-                let lo = (child & !LEAF) as usize * BLOCK;
-                return Some((lo, (lo + BLOCK).min(map.len)));
+                return Some(map.block(child));
             }
             let node = &map.nodes[child as usize];
             let (d2s, mut hits) = match self.set {
@@ -156,6 +154,13 @@ impl<const NEAREST_FIRST: bool> Walk<NEAREST_FIRST> {
 }
 
 impl PhotonMap {
+    /// The photon range of the block in a leaf slot (`child` carries [`LEAF`]).
+    #[inline]
+    fn block(&self, child: u32) -> (usize, usize) {
+        let lo = (child & !LEAF) as usize * BLOCK;
+        (lo, (lo + BLOCK).min(self.len))
+    }
+
     /// Bytes of the tree's nodes per stored photon.
     #[must_use]
     pub fn tree_bytes_per_photon(&self) -> f64 {
