@@ -226,6 +226,36 @@ fn the_bench_command_checks_its_input_and_prints_one_json_object() {
     }
 }
 
+/// `bench --light` lights a bare mesh (which would not load without a light) and sends every
+/// shadow ray to the point; `--only` measures one half; the Embree columns are filled exactly
+/// when the `embree` feature is on.
+#[test]
+fn bench_lights_a_bare_mesh_and_measures_one_half() {
+    let (code, e) = cli(&["bench", "--only", "photons"]);
+    assert!(code != 0 && e.contains("--only"), "{e}");
+    let d = scratch_dir("bench-light");
+    let obj = d.join("quad.obj");
+    std::fs::write(&obj, "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n").unwrap();
+    let (code, e) = cli(&["bench", obj.to_str().unwrap(), "--reps", "1"]);
+    assert!(code != 0 && e.contains("no light"), "{e}");
+    let out = Command::new(env!("CARGO_BIN_EXE_photonwave"))
+        .args(["bench", obj.to_str().unwrap(), "--light", "0,0,3", "--only", "traversal", "--reps", "1", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
+    assert!(v["density"].as_array().unwrap().is_empty(), "{v}");
+    let traversal = v["traversal"].as_array().unwrap();
+    let shadow: Vec<_> = traversal.iter().filter(|r| r["rays"] == "shadow").collect();
+    assert_eq!(shadow.len(), 2, "{v}");
+    for row in &shadow {
+        assert!(row["count"].as_u64().unwrap() > 0, "{row}");
+    }
+    for row in traversal {
+        assert_eq!(row["embree1_mrays"].is_null(), !cfg!(feature = "embree"), "{row}");
+    }
+}
+
 /// A map that the photon-path cap leaves short of its count is reported: here no photon can
 /// reach the only diffuse surface (scenes/hard/tir-slab.toml), so both maps stay empty.
 #[test]

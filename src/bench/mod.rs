@@ -14,7 +14,10 @@
 //! others t = ∞ — any hit then answers "is anything there").
 
 mod density;
+#[cfg(feature = "embree")]
+pub mod embree;
 
+use crate::error::Error;
 use crate::geometry::packet::{closest_packets, occluded_packets};
 use crate::geometry::{offset_ray_origin, RayQuery};
 use crate::parallel::map_chunks;
@@ -88,6 +91,18 @@ pub struct TraversalRow {
     /// Rays the BVH2 traversals (packet, twin, obvhs) report hit and obvhs's CWBVH traversal
     /// does not (negative: the other way round).
     pub cwbvh_lost_hits: i64,
+    /// Embree 3's single-ray traversal (`rtcIntersect1`, `rtcOccluded1`) over its own
+    /// HIGH-quality BVH of the same triangles, million rays per second; `null` unless built with
+    /// `--features embree`.
+    pub embree1_mrays: Option<f64>,
+    /// Embree 3's 8-ray packets (`rtcIntersect8`, `rtcOccluded8`) on the same packets of 8 the
+    /// packet traversal takes, million rays per second; `null` without `--features embree`.
+    pub embree8_mrays: Option<f64>,
+    /// packet ÷ the faster of Embree's two.
+    pub ratio_vs_embree: Option<f64>,
+    /// Rays Embree reports hit minus rays ours report hit (Embree counts hits at t = 0 and
+    /// differs from our watertight test on edges).
+    pub embree_extra_hits: Option<i64>,
 }
 
 /// Image side of the bench camera.
@@ -113,9 +128,16 @@ fn tile_pixel(i: u32) -> (u32, u32) {
 }
 
 impl RaySets {
-    /// Builds the sets (deterministic: fixed seed).
+    /// Builds the sets (deterministic: fixed seed), shadow rays toward the scene's lights.
     #[must_use]
     pub fn new(scene: &Scene, cam: &CameraRays) -> Self {
+        Self::with_light(scene, cam, None)
+    }
+
+    /// As [`Self::new`], but with `light` given, every shadow ray goes to that point instead of
+    /// to a sample of the scene's lights (so that a bare mesh without lights has shadow rays).
+    #[must_use]
+    pub fn with_light(scene: &Scene, cam: &CameraRays, light: Option<Vec3>) -> Self {
         let n = SIDE * SIDE;
         let camera: Vec<RayQuery> = (0..n)
             .map(|i| {
@@ -132,8 +154,8 @@ impl RaySets {
             hits.push((sp.p, ng));
             let s = Sampler::new(1, Domain::Camera, i as u64);
             // As the renderer does, only toward lights above the surface.
-            let light = light_point(scene, [s.get(0, 0), s.get(0, 1), s.get(0, 2)]);
-            if let Some(target) = light.filter(|&q| (q - sp.p).dot(ng) > 0.0) {
+            let target = light.or_else(|| light_point(scene, [s.get(0, 0), s.get(0, 1), s.get(0, 2)]));
+            if let Some(target) = target.filter(|&q| (q - sp.p).dot(ng) > 0.0) {
                 let o = offset_ray_origin(sp.p, sp.p_error, ng, target - sp.p);
                 shadow.push(RayQuery::new(o, target - o, 1.0 - 1e-4));
             }
@@ -169,7 +191,13 @@ pub(crate) fn median(mut v: Vec<f64>) -> f64 {
 
 /// Times the `kernels` in turn, `reps` rounds of one run each; returns their median seconds.
 pub fn time_alternating<const N: usize>(reps: usize, mut kernels: [&mut dyn FnMut(); N]) -> [f64; N] {
-    let mut times: [Vec<f64>; N] = std::array::from_fn(|_| vec![]);
+    let t = time_each(reps, &mut kernels);
+    std::array::from_fn(|i| t[i])
+}
+
+/// [`time_alternating`] over a list whose length is known only at run time.
+pub fn time_each(reps: usize, kernels: &mut [&mut dyn FnMut()]) -> Vec<f64> {
+    let mut times: Vec<Vec<f64>> = vec![vec![]; kernels.len()];
     for _ in 0..reps.max(1) {
         for (k, t) in kernels.iter_mut().zip(&mut times) {
             let start = Instant::now();
@@ -177,7 +205,7 @@ pub fn time_alternating<const N: usize>(reps: usize, mut kernels: [&mut dyn FnMu
             t.push(start.elapsed().as_secs_f64());
         }
     }
-    times.map(median)
+    times.into_iter().map(median).collect()
 }
 
 /// Times `a` and `b` alternately `reps` times each; returns their median seconds.
@@ -203,8 +231,19 @@ fn count_hits(rays: &[RayQuery], threads: usize, hits: impl Fn(&[RayQuery]) -> u
 /// Packet against obvhs single-ray traversal on every set and query. Also checks that both
 /// report the same number of hits (they differ only in ties between equally distant triangles,
 /// which do not change whether a ray hits).
-pub fn traversal(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usize) -> Vec<TraversalRow> {
+///
+/// # Errors
+/// With `--features embree`, if Embree cannot build its BVH over the scene.
+pub fn traversal(
+    name: &str,
+    scene: &Scene,
+    sets: &RaySets,
+    threads: usize,
+    reps: usize,
+) -> Result<Vec<TraversalRow>, Error> {
     let cw = crate::geometry::bvh::CwBaseline::build(scene.columns());
+    #[cfg(feature = "embree")]
+    let embree_scene = embree::EmbreeScene::build(scene.columns()).map_err(|message| Error::Scene { message })?;
     let (bvh, tris) = (scene.bvh(), scene.columns());
     let mut rows = vec![];
     for (label, rays) in [("camera", &sets.camera), ("shadow", &sets.shadow), ("diffuse", &sets.diffuse)] {
@@ -259,14 +298,29 @@ pub fn traversal(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps
                 }
             };
             let (mut hp, mut hs, mut ht, mut hc, mut hw) = (0, 0, 0, 0, 0);
-            let [tp, ts, tw] = time_alternating(
-                reps,
-                [
-                    &mut || hp = count_hits(rays, threads, packet),
-                    &mut || hs = count_hits(rays, threads, &obvhs),
-                    &mut || hw = count_hits(rays, threads, wide),
-                ],
-            );
+            // One alternating round: ours, obvhs, and (with the feature) Embree's two.
+            let mut run_packet = || hp = count_hits(rays, threads, packet);
+            let mut run_obvhs = || hs = count_hits(rays, threads, &obvhs);
+            let mut run_wide = || hw = count_hits(rays, threads, wide);
+            let mut kernels: Vec<&mut dyn FnMut()> = vec![&mut run_packet, &mut run_obvhs, &mut run_wide];
+            #[cfg(feature = "embree")]
+            let (mut h1, mut h8) = (0, 0);
+            #[cfg(feature = "embree")]
+            let mut run_embree1 = || h1 = count_hits(rays, threads, |c| embree_scene.count_single(c, any));
+            #[cfg(feature = "embree")]
+            let mut run_embree8 = || h8 = count_hits(rays, threads, |c| embree_scene.count_packets(c, any, false));
+            #[cfg(feature = "embree")]
+            kernels.extend([&mut run_embree1 as &mut dyn FnMut(), &mut run_embree8]);
+            let t = time_each(reps, &mut kernels);
+            drop(kernels);
+            let (tp, ts, tw) = (t[0], t[1], t[2]);
+            #[cfg(feature = "embree")]
+            let embree = {
+                assert_eq!(h1, h8, "{name} {label} {query}: Embree's single rays and packets disagree");
+                Some((t[3], t[4], h1 as i64 - hp as i64))
+            };
+            #[cfg(not(feature = "embree"))]
+            let embree: Option<(f64, f64, i64)> = None;
             assert_eq!(hp, hs, "{name} {label} {query}: packet and single-ray hit counts differ");
             assert_eq!(hw, hs, "{name} {label} {query}: 8-wide and obvhs hit counts differ");
             let (tt, tc) =
@@ -290,10 +344,14 @@ pub fn traversal(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps
                 cwbvh_mrays: m / tc,
                 wide_mrays: m / tw,
                 cwbvh_lost_hits: hs as i64 - hc as i64,
+                embree1_mrays: embree.map(|e| m / e.0),
+                embree8_mrays: embree.map(|e| m / e.1),
+                ratio_vs_embree: embree.map(|e| e.0.min(e.1) / tp),
+                embree_extra_hits: embree.map(|e| e.2),
             });
         }
     }
-    rows
+    Ok(rows)
 }
 
 /// The 8-wide traversal's work over `rays` (closest hit, or any hit when `any`).
@@ -346,19 +404,36 @@ impl Report {
     }
 }
 
-/// All measurements on one scene.
-#[must_use]
+/// What `bench` measures and how.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Shadow rays go to this point instead of the scene's lights (see [`RaySets::with_light`]).
+    pub light: Option<Vec3>,
+    /// Worker threads for every kernel.
+    pub threads: usize,
+    /// Timed repetitions of each kernel.
+    pub reps: usize,
+    /// Measure traversal.
+    pub traversal: bool,
+    /// Measure density estimates.
+    pub density: bool,
+}
+
+/// The measurements `options` asks for on one scene.
+///
+/// # Errors
+/// As [`traversal`].
 pub fn run_scene(
     name: &str,
     scene: &Scene,
     cam: &CameraRays,
-    threads: usize,
-    reps: usize,
-) -> (Vec<TraversalRow>, Vec<DensityRow>) {
-    let sets = RaySets::new(scene, cam);
-    let t = traversal(name, scene, &sets, threads, reps);
-    let d = density::density(name, scene, &sets, threads, reps);
-    (t, d)
+    options: &Options,
+) -> Result<(Vec<TraversalRow>, Vec<DensityRow>), Error> {
+    let (threads, reps) = (options.threads, options.reps);
+    let sets = RaySets::with_light(scene, cam, options.light);
+    let t = if options.traversal { traversal(name, scene, &sets, threads, reps)? } else { vec![] };
+    let d = if options.density { density::density(name, scene, &sets, threads, reps) } else { vec![] };
+    Ok((t, d))
 }
 
 /// The rows as a plain-text table.
@@ -369,8 +444,12 @@ pub fn table(traversal: &[TraversalRow], density: &[DensityRow]) -> String {
     for r in traversal {
         let _ = writeln!(
             s,
-            "  traversal {:<8} {:<8} {:>8} rays  packet {:>7.2} Mrays/s  wide {:>7.2} ({:.1} nodes, {:.1} tris, {:.2} scalar)  obvhs single {:>7.2} Mrays/s  ×{:.2}  (scalar twin {:.2}, obvhs CWBVH {:.2}, {} hits lost)",
-            r.rays, r.query, r.count, r.packet_mrays, r.wide_mrays, r.nodes_per_ray, r.triangles_per_ray, r.scalar_per_ray, r.single_mrays, r.ratio, r.twin_mrays, r.cwbvh_mrays, r.cwbvh_lost_hits
+            "  traversal {:<8} {:<8} {:>8} rays  packet {:>7.2} Mrays/s  wide {:>7.2} ({:.1} nodes, {:.1} tris, {:.2} scalar)  obvhs single {:>7.2} Mrays/s  ×{:.2}  (scalar twin {:.2}, obvhs CWBVH {:.2}, {} hits lost)  embree {}",
+            r.rays, r.query, r.count, r.packet_mrays, r.wide_mrays, r.nodes_per_ray, r.triangles_per_ray, r.scalar_per_ray, r.single_mrays, r.ratio, r.twin_mrays, r.cwbvh_mrays, r.cwbvh_lost_hits,
+            match (r.embree1_mrays, r.embree8_mrays, r.ratio_vs_embree, r.embree_extra_hits) {
+                (Some(e1), Some(e8), Some(x), Some(d)) => format!("1-ray {e1:.2}, 8-ray {e8:.2} Mrays/s, packet ×{x:.2} ({d:+} hits)"),
+                _ => "– (build with --features embree)".to_string(),
+            }
         );
     }
     for r in density {

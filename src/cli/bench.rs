@@ -4,7 +4,8 @@
 use super::parse_vec3;
 use glam::Vec3;
 use photonwave::error::{Error, Result};
-use photonwave::scene::file::{fitted_camera, load_scene};
+use photonwave::scene::file::{fitted_camera, load_scene_lit};
+use photonwave::scene::Light;
 use std::path::PathBuf;
 
 /// Flags of `bench`.
@@ -31,9 +32,16 @@ pub struct BenchArgs {
     /// Vertical field of view in degrees for scenes without a camera [40].
     #[arg(long)]
     pub fov: Option<f32>,
+    /// A point light at X,Y,Z: every shadow ray goes to it, and meshes without lights of their
+    /// own (a bare OBJ) can be measured at all.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub light: Option<Vec3>,
     /// Also time packet traversal at each single-ray hand-over threshold (0–4 lanes).
     #[arg(long)]
     pub thin_sweep: bool,
+    /// Measure only `traversal` or only `density` [both].
+    #[arg(long, value_parser = ["traversal", "density"])]
+    pub only: Option<String>,
     /// Sphere rings of `generated:sphere` (2·rings·2·rings triangles) [512].
     #[arg(long, default_value_t = 512)]
     pub rings: u32,
@@ -69,11 +77,23 @@ pub fn run(args: BenchArgs) -> Result<()> {
         eprintln!("build: target-cpu {cpu}; SIMD features {features:?}; RUSTFLAGS `{flags}`; {threads} thread(s)");
     }
     let mut report = bench::Report::new(threads);
+    let options = bench::Options {
+        light: args.light,
+        threads,
+        reps: args.reps as usize,
+        traversal: args.only.as_deref() != Some("density"),
+        density: args.only.as_deref() != Some("traversal"),
+    };
     for name in &names {
         let loaded = if name == generated::SPHERE_NAME {
             generated::displaced_sphere(args.rings, 2 * args.rings)?
         } else {
-            load_scene(std::path::Path::new(name))?
+            // `--light`: a point light there, so that bare meshes load, photons have a source
+            // and every shadow ray goes to it.
+            let added = |_: (Vec3, Vec3), _: Option<photonwave::scene::camera::Camera>| {
+                args.light.map(|p| Light::Point { position: p, intensity: Vec3::ONE }).into_iter().collect()
+            };
+            load_scene_lit(std::path::Path::new(name), &added)?
         };
         let label = std::path::Path::new(name).file_stem().map_or(name.clone(), |s| s.to_string_lossy().into_owned());
         let camera = loaded.camera.unwrap_or_else(|| {
@@ -91,14 +111,14 @@ pub fn run(args: BenchArgs) -> Result<()> {
             eprintln!("{label}: {} triangles", loaded.scene.triangle_count());
         }
         if args.thin_sweep {
-            let sets = bench::RaySets::new(&loaded.scene, &cam);
+            let sets = bench::RaySets::with_light(&loaded.scene, &cam, args.light);
             for (rays, query, thin, mrays) in
                 bench::thin_sweep(&loaded.scene, &sets, &[0, 1, 2, 3, 4], args.reps as usize)
             {
                 eprintln!("  hand-over at ≤{thin} lanes: {rays:<8} {query:<8} {mrays:>7.2} Mrays/s");
             }
         }
-        let rows = bench::run_scene(&label, &loaded.scene, &cam, threads, args.reps as usize);
+        let rows = bench::run_scene(&label, &loaded.scene, &cam, &options)?;
         if !args.json {
             eprint!("{}", bench::table(&rows.0, &rows.1));
         }
