@@ -8,7 +8,7 @@ use glam::Vec3;
 use photonwave::geometry::bvh::TriangleColumns;
 use photonwave::geometry::packet::{closest_packets, occluded_packets};
 use photonwave::geometry::traverse::{closest_rays, occluded_rays};
-use photonwave::geometry::wide_traverse;
+use photonwave::geometry::{wide_packet, wide_traverse};
 use photonwave::geometry::{Bvh, Hit, RayQuery};
 use photonwave::rng::{Domain, Sampler};
 use photonwave::sampling::uniform_sphere;
@@ -35,6 +35,14 @@ fn agree(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery]) -> Vec<Option<
             assert_eq!(x, y, "{label}: closest hit differs for ray {i}: {:?}", rays[i]);
         }
     }
+    // Packets of 8 through the 8-wide BVH.
+    let mut wp = vec![None; rays.len()];
+    wide_packet::closest_packets8(bvh.wide(tris), tris, rays, &mut wp);
+    for (i, (x, y)) in a.iter().zip(&wp).enumerate() {
+        assert_eq!(x, y, "8-wide packets: closest hit differs for ray {i}: {:?}", rays[i]);
+    }
+    let mut op = vec![false; rays.len()];
+    wide_packet::occluded_packets8(bvh.wide(tris), tris, rays, &mut op);
     let mut oa = vec![false; rays.len()];
     let mut ob = vec![false; rays.len()];
     let mut ow = vec![false; rays.len()];
@@ -47,6 +55,7 @@ fn agree(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery]) -> Vec<Option<
         assert_eq!(*x, ob[i], "packet: any hit differs for ray {i}: {:?}", rays[i]);
         assert_eq!(*x, ow[i], "8-wide: any hit differs for ray {i}: {:?}", rays[i]);
         assert_eq!(*x, os[i], "8-wide scalar: any hit differs for ray {i}: {:?}", rays[i]);
+        assert_eq!(*x, op[i], "8-wide packets: any hit differs for ray {i}: {:?}", rays[i]);
         // Any hit and closest hit agree on whether something is in (0, t_max).
         assert_eq!(*x, a[i].is_some(), "any vs closest for ray {i}");
     }

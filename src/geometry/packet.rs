@@ -31,7 +31,7 @@ pub const LANES: usize = 8;
 pub const THIN_LANES: u32 = 0;
 
 /// Eight rays in SIMD columns.
-struct Packet {
+pub(super) struct Packet {
     ox: f32x8,
     oy: f32x8,
     oz: f32x8,
@@ -50,14 +50,14 @@ struct Packet {
     d: [Vec3; LANES],
     inv: [Vec3; LANES],
     /// Lanes holding a valid ray.
-    valid: u32,
+    pub(super) valid: u32,
 }
 
 impl Packet {
     /// Loads up to 8 rays. Inverse directions, the watertight test's axis choice and its shear
     /// are computed 8-wide with the scalar code's operations (IEEE division, the same
     /// comparisons), so every lane's values equal the scalar ones bit for bit.
-    fn load(rays: &[RayQuery]) -> Self {
+    pub(super) fn load(rays: &[RayQuery]) -> Self {
         let mut o = [Vec3::ZERO; LANES];
         let mut d = [Vec3::X; LANES];
         let mut valid = 0u32;
@@ -116,14 +116,21 @@ impl Packet {
     #[inline(always)]
     fn entry(&self, node: &Bvh2Node, t_max: f32x8) -> f32x8 {
         let b = &node.aabb;
+        self.entry_box([b.min.x, b.min.y, b.min.z], [b.max.x, b.max.y, b.max.z], t_max)
+    }
+
+    /// [`Self::entry`] for the box `lo`–`hi`.
+    #[inline(always)]
+    pub(super) fn entry_box(&self, lo: [f32; 3], hi: [f32; 3], t_max: f32x8) -> f32x8 {
+        let b = (lo, hi);
         let slab = |lo: f32, hi: f32, o: f32x8, inv: f32x8| {
             let t0 = (f32x8::splat(lo) - o) * inv;
             let t1 = (f32x8::splat(hi) - o) * inv;
             (t0.fast_min(t1), t0.fast_max(t1))
         };
-        let (nx, fx) = slab(b.min.x, b.max.x, self.ox, self.ix);
-        let (ny, fy) = slab(b.min.y, b.max.y, self.oy, self.iy);
-        let (nz, fz) = slab(b.min.z, b.max.z, self.oz, self.iz);
+        let (nx, fx) = slab(b.0[0], b.1[0], self.ox, self.ix);
+        let (ny, fy) = slab(b.0[1], b.1[1], self.oy, self.iy);
+        let (nz, fz) = slab(b.0[2], b.1[2], self.oz, self.iz);
         // No NaN can arise (finite origins, boxes and inverse directions), so the min/max need
         // no NaN handling: the same values as the scalar test's.
         let near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
@@ -154,12 +161,12 @@ fn intersect8(p: &Packet, lanes: u32, v: [Vec3; 3], t_max: f32x8) -> (u32, u32, 
 }
 
 /// [`Best::limit`] per lane.
-fn limits(best: &[Best; LANES]) -> f32x8 {
+pub(super) fn limits(best: &[Best; LANES]) -> f32x8 {
     f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].limit()))
 }
 
 /// The best t per lane (the pruning bound of boxes).
-fn best_ts(best: &[Best; LANES]) -> f32x8 {
+pub(super) fn best_ts(best: &[Best; LANES]) -> f32x8 {
     f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| best[l].t))
 }
 
@@ -180,18 +187,18 @@ fn ordered_children(p: &Packet, nodes: &[Bvh2Node], node: &Bvh2Node, t: f32x8, m
     }
 }
 
-/// Tests the triangles of leaf `node` against the lanes of `lanes`, keeping each lane's closest
+/// Tests the triangles `ids` of a leaf against the lanes of `lanes`, keeping each lane's closest
 /// hit (ties to the lower index), and refreshes the lanes' `limit`s.
 #[inline]
-fn closest_leaf(
+pub(super) fn closest_leaf(
     p: &Packet,
     tris: TriangleColumns<'_>,
-    node: &Bvh2Node,
+    ids: std::ops::Range<u32>,
     lanes: u32,
     best: &mut [Best; LANES],
     limit: &mut f32x8,
 ) {
-    for id in node.first_index..node.first_index + node.prim_count {
+    for id in ids {
         let i = id as usize;
         let v = [tris.p0[i], tris.p1[i], tris.p2[i]];
         if is_degenerate(v[0], v[1], v[2]) {
@@ -260,7 +267,7 @@ fn closest8(
             continue;
         }
         if node.prim_count > 0 {
-            closest_leaf(&p, tris, node, mask, &mut best, &mut limit);
+            closest_leaf(&p, tris, leaf_ids(node), mask, &mut best, &mut limit);
             t_best = best_ts(&best);
             continue;
         }
@@ -277,18 +284,24 @@ fn closest8(
     }
 }
 
-/// Lanes of `lanes` blocked by a triangle of leaf `node` within (0, t_max).
+/// The triangles of leaf `node`.
+#[inline(always)]
+fn leaf_ids(node: &Bvh2Node) -> std::ops::Range<u32> {
+    node.first_index..node.first_index + node.prim_count
+}
+
+/// Lanes of `lanes` blocked by a triangle of the leaf's `ids` within (0, t_max).
 #[inline]
-fn any_leaf(
+pub(super) fn any_leaf(
     p: &Packet,
     tris: TriangleColumns<'_>,
-    node: &Bvh2Node,
+    ids: std::ops::Range<u32>,
     lanes: u32,
     t_max: f32x8,
     t_arr: &[f32; LANES],
 ) -> u32 {
     let mut blocked = 0u32;
-    for id in node.first_index..node.first_index + node.prim_count {
+    for id in ids {
         let i = id as usize;
         let v = [tris.p0[i], tris.p1[i], tris.p2[i]];
         let open = lanes & !blocked;
@@ -347,7 +360,7 @@ fn occluded8(
             continue;
         }
         if node.prim_count > 0 {
-            blocked |= any_leaf(&p, tris, node, mask & !blocked, t_max, &t_arr);
+            blocked |= any_leaf(&p, tris, leaf_ids(node), mask & !blocked, t_max, &t_arr);
             if blocked & p.valid == p.valid {
                 stack.clear();
                 break;
@@ -361,7 +374,7 @@ fn occluded8(
         for (child, _, lanes) in &mut children {
             let c = &nodes[*child as usize];
             if *lanes != 0 && c.prim_count > 0 {
-                blocked |= any_leaf(&p, tris, c, *lanes & !blocked, t_max, &t_arr);
+                blocked |= any_leaf(&p, tris, leaf_ids(c), *lanes & !blocked, t_max, &t_arr);
                 *lanes = 0;
             }
         }

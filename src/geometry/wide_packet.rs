@@ -1,0 +1,180 @@
+//! Packet traversal of the 8-wide BVH ([`super::wide`]): 8 rays (`f32x8`, one per lane) meet
+//! each of a node's up to eight child boxes in turn, and a child is visited while any lane enters
+//! it before its current closest hit — Embree's "hybrid" packets over wide nodes, where
+//! [`super::packet`] walks the BVH2 two boxes a step. Reads rays, the [`Bvh8`] and the
+//! BVH-ordered triangle columns; writes hits or occlusion flags.
+//!
+//! Box and triangle tests are [`super::packet`]'s (the same conservative slab test, the same
+//! 8-wide watertight test with its scalar fallbacks, ties in t to the lower triangle index), so
+//! every lane's hit is the one every other traversal finds; tests/packet.rs checks it. Children
+//! are visited nearest first by the smallest entry distance of the lanes that enter them. Any-hit
+//! traversal tests a node's leaf children as soon as the node is reached, before entering any
+//! inner child, as the other traversals do.
+
+use super::bvh::{Hit, TriangleColumns};
+use super::packet::{any_leaf, best_ts, closest_leaf, limits, Packet, LANES};
+use super::traverse::{Best, RayQuery, Stack};
+use super::triangle8::bits;
+use super::wide::{Bvh8, Node8, WIDTH};
+use wide::f32x8;
+
+/// A child waiting on the stack: node index or first block of a leaf, its triangle count (0 for
+/// a node), and per lane the entry distance (closest hit; NaN where the lane does not enter) or
+/// the lanes that enter it (any hit, in `lanes`).
+#[derive(Clone, Copy)]
+struct Entry {
+    child: u32,
+    count: u32,
+    t: f32x8,
+    lanes: u32,
+}
+
+impl Default for Entry {
+    fn default() -> Self {
+        Entry { child: 0, count: 0, t: f32x8::ZERO, lanes: 0 }
+    }
+}
+
+/// The triangles of a leaf child: `count` from its first block's first triangle.
+#[inline(always)]
+fn leaf_ids(bvh: &Bvh8, first_block: u32, count: u32) -> std::ops::Range<u32> {
+    let first = bvh.blocks()[first_block as usize].first;
+    first..first + count
+}
+
+/// The children of `node` that lanes of `mask` enter within `t`, nearest first: their keys (the
+/// smallest entry distance among those lanes as bits above the slot; distances are ≥ 0 and never
+/// NaN there, so bits order as values do) and number; and per slot the entry distances and
+/// entering lanes.
+#[inline(always)]
+fn entered(p: &Packet, node: &Node8, t: f32x8, mask: u32) -> ([u64; WIDTH], usize, [f32x8; WIDTH], [u32; WIDTH]) {
+    let (mut keys, mut n) = ([0u64; WIDTH], 0);
+    let (mut ts, mut lanes) = ([f32x8::ZERO; WIDTH], [0u32; WIDTH]);
+    let pl = &node.planes;
+    let mut valid = u32::from(node.valid);
+    while valid != 0 {
+        let s = valid.trailing_zeros() as usize;
+        valid &= valid - 1;
+        let te = p.entry_box([pl[0][s], pl[1][s], pl[2][s]], [pl[3][s], pl[4][s], pl[5][s]], t);
+        let inside = te.simd_le(t);
+        let m = bits(inside) & mask;
+        if m == 0 {
+            continue;
+        }
+        let near = te.to_array()[m.trailing_zeros() as usize];
+        keys[n] = u64::from(near.to_bits()) << 32 | s as u64;
+        n += 1;
+        (ts[s], lanes[s]) = (te, m);
+    }
+    keys[..n].sort_unstable();
+    (keys, n, ts, lanes)
+}
+
+/// Closest hits of 8 rays (fewer at the end of a slice).
+fn closest8(
+    bvh: &Bvh8,
+    tris: TriangleColumns<'_>,
+    rays: &[RayQuery],
+    out: &mut [Option<Hit>],
+    stack: &mut Stack<Entry>,
+) {
+    let nodes = bvh.nodes();
+    let p = Packet::load(rays);
+    let mut best: [Best; LANES] = std::array::from_fn(|l| Best::new(rays.get(l).map_or(0.0, |r| r.t_max)));
+    let mut t_best = best_ts(&best);
+    let mut limit = limits(&best);
+    stack.clear();
+    if !nodes.is_empty() && p.valid != 0 {
+        // The root's lanes: entry 0 for valid rays, NaN (never entering) for the others.
+        let t =
+            f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| if p.valid >> l & 1 == 1 { 0.0 } else { f32::NAN }));
+        stack.push(Entry { child: 0, count: 0, t, lanes: p.valid });
+    }
+    while let Some(e) = stack.pop() {
+        let mask = bits(e.t.simd_le(t_best));
+        if mask == 0 {
+            continue;
+        }
+        if e.count > 0 {
+            closest_leaf(&p, tris, leaf_ids(bvh, e.child, e.count), mask, &mut best, &mut limit);
+            t_best = best_ts(&best);
+            continue;
+        }
+        let node = &nodes[e.child as usize];
+        let (keys, n, ts, lanes) = entered(&p, node, t_best, mask);
+        // Farthest pushed first, so the nearest is popped first.
+        for &key in keys[..n].iter().rev() {
+            let s = (key & 0xff) as usize;
+            stack.push(Entry { child: node.child[s], count: u32::from(node.count[s]), t: ts[s], lanes: lanes[s] });
+        }
+    }
+    for (l, o) in out.iter_mut().enumerate() {
+        *o = best[l].hit();
+    }
+}
+
+/// Any-hit tests of 8 rays.
+fn occluded8(bvh: &Bvh8, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [bool], stack: &mut Stack<Entry>) {
+    let nodes = bvh.nodes();
+    let p = Packet::load(rays);
+    let t_max = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| rays.get(l).map_or(0.0, |r| r.t_max)));
+    let t_arr = t_max.to_array();
+    let mut blocked = 0u32;
+    stack.clear();
+    if !nodes.is_empty() && p.valid != 0 {
+        stack.push(Entry { child: 0, count: 0, t: f32x8::ZERO, lanes: p.valid });
+    }
+    'walk: while let Some(e) = stack.pop() {
+        let mask = e.lanes & !blocked;
+        if mask == 0 {
+            continue;
+        }
+        if e.count > 0 {
+            blocked |= any_leaf(&p, tris, leaf_ids(bvh, e.child, e.count), mask, t_max, &t_arr);
+            if blocked & p.valid == p.valid {
+                break;
+            }
+            continue;
+        }
+        let node = &nodes[e.child as usize];
+        let (keys, n, ts, lanes) = entered(&p, node, t_max, mask);
+        // Leaf children at once, nearest first; then the inner children, nearest on top.
+        for &key in &keys[..n] {
+            let s = (key & 0xff) as usize;
+            let open = lanes[s] & !blocked;
+            if node.count[s] > 0 && open != 0 {
+                blocked |=
+                    any_leaf(&p, tris, leaf_ids(bvh, node.child[s], u32::from(node.count[s])), open, t_max, &t_arr);
+                if blocked & p.valid == p.valid {
+                    break 'walk;
+                }
+            }
+        }
+        for &key in keys[..n].iter().rev() {
+            let s = (key & 0xff) as usize;
+            if node.count[s] == 0 {
+                stack.push(Entry { child: node.child[s], count: 0, t: ts[s], lanes: lanes[s] });
+            }
+        }
+    }
+    for (l, o) in out.iter_mut().enumerate() {
+        *o = blocked >> l & 1 == 1;
+    }
+}
+
+/// Closest hits of `rays` into `out`, 8 at a time through the 8-wide BVH (`tris`: the
+/// BVH-ordered columns its leaves address).
+pub fn closest_packets8(bvh: &Bvh8, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [Option<Hit>]) {
+    let mut stack = Stack::new();
+    for (r, o) in rays.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        closest8(bvh, tris, r, o, &mut stack);
+    }
+}
+
+/// Any-hit tests of `rays` into `out`, 8 at a time through the 8-wide BVH.
+pub fn occluded_packets8(bvh: &Bvh8, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [bool]) {
+    let mut stack = Stack::new();
+    for (r, o) in rays.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        occluded8(bvh, tris, r, o, &mut stack);
+    }
+}
