@@ -24,9 +24,9 @@ struct Context {
 
 impl Context {
     /// What `rtcInitIntersectContext` writes (an inline function in the header, so not in the
-    /// library): incoherent rays, no filter, no instance.
-    fn new(coherent: bool) -> Self {
-        Context { flags: u32::from(coherent), filter: std::ptr::null(), inst_id: [INVALID_ID] }
+    /// library): incoherent rays (flags 0), no filter, no instance.
+    fn new() -> Self {
+        Context { flags: 0, filter: std::ptr::null(), inst_id: [INVALID_ID] }
     }
 }
 
@@ -208,7 +208,7 @@ impl EmbreeScene {
     /// or `rtcOccluded1` (any) per ray.
     #[must_use]
     pub fn count_single(&self, rays: &[RayQuery], any: bool) -> usize {
-        let mut ctx = Context::new(false);
+        let mut ctx = Context::new();
         let mut hits = 0;
         for q in rays {
             let ray = Ray1 {
@@ -239,11 +239,10 @@ impl EmbreeScene {
     }
 
     /// As [`Self::count_single`], eight rays at a time (`rtcIntersect8`, `rtcOccluded8`; a last
-    /// packet of fewer rays has its other lanes switched off). `coherent` sets the context's
-    /// coherent-rays hint.
+    /// packet of fewer rays has its other lanes switched off).
     #[must_use]
-    pub fn count_packets(&self, rays: &[RayQuery], any: bool, coherent: bool) -> usize {
-        let mut ctx = Context::new(coherent);
+    pub fn count_packets(&self, rays: &[RayQuery], any: bool) -> usize {
+        let mut ctx = Context::new();
         let mut hits = 0;
         let mut rh = RayHit8::default();
         for chunk in rays.chunks(8) {
@@ -260,7 +259,8 @@ impl EmbreeScene {
                 rh.hit.geom_id[lane] = INVALID_ID;
                 rh.hit.inst_id[0][lane] = INVALID_ID;
             }
-            // SAFETY: as in count_single; `valid` switches off lanes past the chunk's end.
+            // SAFETY: as in count_single; `valid` (32-byte aligned, as Embree loads it) switches
+            // off lanes past the chunk's end.
             unsafe {
                 if any {
                     rtcOccluded8(valid.0.as_ptr(), self.scene, &raw mut ctx, &raw mut rh.ray);
@@ -312,7 +312,7 @@ mod tests {
         ];
         for any in [false, true] {
             assert_eq!(e.count_single(&rays, any), 1);
-            assert_eq!(e.count_packets(&rays, any, false), 1);
+            assert_eq!(e.count_packets(&rays, any), 1);
         }
     }
 }

@@ -171,7 +171,7 @@ pub fn traversal(
             #[cfg(feature = "embree")]
             let mut run_embree1 = || h1 = count_hits(rays, threads, |c| embree_scene.count_single(c, any));
             #[cfg(feature = "embree")]
-            let mut run_embree8 = || h8 = count_hits(rays, threads, |c| embree_scene.count_packets(c, any, false));
+            let mut run_embree8 = || h8 = count_hits(rays, threads, |c| embree_scene.count_packets(c, any));
             #[cfg(feature = "embree")]
             kernels.extend([&mut run_embree1 as &mut dyn FnMut(), &mut run_embree8]);
             let t = time_each(reps, &mut kernels);
