@@ -152,6 +152,17 @@ fn packets_match_scalar_on_edges_vertices_and_slab_planes() {
     for h in &hits[hits.len() - bad.len()..] {
         assert!(h.is_none(), "invalid rays hit nothing");
     }
+    // Each invalid ray in a packet with seven valid ones that hit (a packet traces a stand-in ray
+    // in an invalid lane; it must never report that ray's hits).
+    let valid: Vec<RayQuery> =
+        rays.iter().zip(&hits).filter(|(r, h)| r.is_valid() && h.is_some()).map(|(r, _)| *r).collect();
+    assert!(valid.len() >= 7);
+    for (slot, b) in bad.iter().enumerate() {
+        let mut mixed = valid[..7].to_vec();
+        mixed.insert(slot % 8, *b);
+        let got = agree(s.bvh(), s.columns(), &mixed);
+        assert!(got[slot % 8].is_none(), "invalid ray {b:?} in lane {} hit something", slot % 8);
+    }
     // Vertex- and edge-aimed rays from inside the closed box never slip through.
     let from_centre = hits.iter().zip(&rays).filter(|(_, r)| r.origin == c && r.t_max.is_infinite() && r.is_valid());
     for (h, r) in from_centre {

@@ -250,7 +250,9 @@ fn closest8(
         stack.push((0, Entry(active.select(t0, f32x8::splat(f32::NAN)))));
     }
     while let Some((n, Entry(tn))) = stack.pop() {
-        let mut mask = bits(tn.simd_le(t_best));
+        // Only valid lanes: children's entry distances are computed for every lane, and an
+        // invalid lane holds a stand-in ray (origin 0, direction +x) that must never be traced.
+        let mut mask = bits(tn.simd_le(t_best)) & p.valid;
         if mask == 0 {
             continue;
         }

@@ -7,7 +7,7 @@
 //! Box and triangle tests are [`super::packet`]'s (the same conservative slab test, the same
 //! 8-wide watertight test with its scalar fallbacks, ties in t to the lower triangle index), so
 //! every lane's hit is the one every other traversal finds; tests/packet.rs checks it. Children
-//! are visited nearest first by the smallest entry distance of the lanes that enter them. Any-hit
+//! are visited nearest first by the entry distance of the first lane that enters them. Any-hit
 //! traversal tests a node's leaf children as soon as the node is reached, before entering any
 //! inner child, as the other traversals do.
 
@@ -43,9 +43,9 @@ fn leaf_ids(bvh: &Bvh8, first_block: u32, count: u32) -> std::ops::Range<u32> {
 }
 
 /// The children of `node` that lanes of `mask` enter within `t`, nearest first: their keys (the
-/// smallest entry distance among those lanes as bits above the slot; distances are ≥ 0 and never
-/// NaN there, so bits order as values do) and number; and per slot the entry distances and
-/// entering lanes.
+/// entry distance of the first lane that enters, as bits above the slot; distances are ≥ 0 and
+/// never NaN there, so bits order as values do; the smallest over the lanes measured no better)
+/// and number; and per slot the entry distances and entering lanes.
 #[inline(always)]
 fn entered(p: &Packet, node: &Node8, t: f32x8, mask: u32) -> ([u64; WIDTH], usize, [f32x8; WIDTH], [u32; WIDTH]) {
     let (mut keys, mut n) = ([0u64; WIDTH], 0);
@@ -91,7 +91,9 @@ fn closest8(
         stack.push(Entry { child: 0, count: 0, t, lanes: p.valid });
     }
     while let Some(e) = stack.pop() {
-        let mask = bits(e.t.simd_le(t_best));
+        // Within the lanes that entered: entry distances are computed for every lane, and an
+        // invalid lane holds a stand-in ray that must never be traced.
+        let mask = bits(e.t.simd_le(t_best)) & e.lanes;
         if mask == 0 {
             continue;
         }
