@@ -246,6 +246,7 @@ fn bench_lights_a_bare_mesh_and_measures_one_half() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
     assert!(v["density"].as_array().unwrap().is_empty(), "{v}");
     let traversal = v["traversal"].as_array().unwrap();
+    assert_eq!(traversal.len(), 6, "three ray sets × closest/any: {v}");
     let shadow: Vec<_> = traversal.iter().filter(|r| r["rays"] == "shadow").collect();
     assert_eq!(shadow.len(), 2, "{v}");
     for row in &shadow {
@@ -253,6 +254,32 @@ fn bench_lights_a_bare_mesh_and_measures_one_half() {
     }
     for row in traversal {
         assert_eq!(row["embree1_mrays"].is_null(), !cfg!(feature = "embree"), "{row}");
+    }
+    // The other half alone.
+    let out = Command::new(env!("CARGO_BIN_EXE_photonwave"))
+        .args(["bench", obj.to_str().unwrap(), "--light", "0,0,3", "--only", "density", "--reps", "1", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
+    assert!(v["traversal"].as_array().unwrap().is_empty(), "{v}");
+    assert_eq!(v["density"].as_array().unwrap().len(), 2, "knn and radius: {v}");
+}
+
+/// With a light point given, every shadow ray of the bench's sets ends at that point (origin +
+/// direction is the point, t_max just short of it), whatever lights the scene has.
+#[test]
+fn bench_shadow_rays_go_to_the_light_point() {
+    let loaded = load("cornell-box.toml");
+    let side = photonwave::bench::SIDE;
+    let cam = loaded.camera.unwrap().prepare(side, side).unwrap();
+    let light = glam::Vec3::new(0.1, 0.5, 0.2);
+    let sets = photonwave::bench::RaySets::with_light(&loaded.scene, &cam, Some(light));
+    assert!(sets.shadow.len() > 1000, "{}", sets.shadow.len());
+    for r in &sets.shadow {
+        let end = r.origin + r.direction;
+        assert!((end - light).length() <= 1e-6, "{r:?} ends at {end}");
+        assert!(r.t_max < 1.0, "{r:?}");
     }
 }
 

@@ -162,43 +162,53 @@ impl EmbreeScene {
         if n == 0 {
             return Err("Embree: the scene has no triangles".into());
         }
-        // SAFETY: each call gets handles Embree returned (checked non-null) and buffers of the
-        // sizes it was asked for; the buffers are filled before the geometry is committed.
+        // SAFETY: each call gets handles Embree returned, checked non-null before use; the
+        // buffers Embree allocates (uninitialised) are written through raw pointers within the
+        // sizes asked for, before the geometry is committed.
         unsafe {
             let device = rtcNewDevice(std::ptr::null());
             if device.is_null() {
                 return Err("Embree: rtcNewDevice failed (is libembree3 usable on this CPU?)".into());
             }
             let scene = rtcNewScene(device);
+            if scene.is_null() {
+                let code = rtcGetDeviceError(device);
+                rtcReleaseDevice(device);
+                return Err(format!("Embree: rtcNewScene failed (error {code})"));
+            }
+            let fail = |what: &str| {
+                let code = rtcGetDeviceError(device);
+                rtcReleaseScene(scene);
+                rtcReleaseDevice(device);
+                Err(format!("Embree: {what} (error {code})"))
+            };
             rtcSetSceneBuildQuality(scene, BUILD_QUALITY_HIGH);
             let geometry = rtcNewGeometry(device, GEOMETRY_TRIANGLE);
+            if geometry.is_null() {
+                return fail("rtcNewGeometry failed");
+            }
             rtcSetGeometryBuildQuality(geometry, BUILD_QUALITY_HIGH);
             let vertices = rtcSetNewGeometryBuffer(geometry, BUFFER_VERTEX, 0, FORMAT_FLOAT3, 12, 3 * n);
             let indices = rtcSetNewGeometryBuffer(geometry, BUFFER_INDEX, 0, FORMAT_UINT3, 12, n);
             if vertices.is_null() || indices.is_null() {
-                let code = rtcGetDeviceError(device);
                 rtcReleaseGeometry(geometry);
-                rtcReleaseScene(scene);
-                rtcReleaseDevice(device);
-                return Err(format!("Embree: buffers of {n} triangles refused (error {code})"));
+                return fail(&format!("buffers of {n} triangles refused"));
             }
-            let v = std::slice::from_raw_parts_mut(vertices.cast::<f32>(), 9 * n);
-            let idx = std::slice::from_raw_parts_mut(indices.cast::<u32>(), 3 * n);
+            let (v, idx) = (vertices.cast::<f32>(), indices.cast::<u32>());
             for i in 0..n {
                 for (k, p) in [tris.p0[i], tris.p1[i], tris.p2[i]].into_iter().enumerate() {
-                    v[9 * i + 3 * k..9 * i + 3 * k + 3].copy_from_slice(&p.to_array());
-                    idx[3 * i + k] = (3 * i + k) as u32;
+                    for a in 0..3 {
+                        v.add(9 * i + 3 * k + a).write(p[a]);
+                    }
+                    idx.add(3 * i + k).write((3 * i + k) as u32);
                 }
             }
             rtcCommitGeometry(geometry);
             rtcAttachGeometry(scene, geometry);
             rtcReleaseGeometry(geometry);
             rtcCommitScene(scene);
-            let code = rtcGetDeviceError(device);
-            if code != 0 {
-                rtcReleaseScene(scene);
-                rtcReleaseDevice(device);
-                return Err(format!("Embree: building the scene failed (error {code})"));
+            if rtcGetDeviceError(device) != 0 {
+                return fail("building the scene failed");
             }
             Ok(EmbreeScene { device, scene })
         }
@@ -299,6 +309,13 @@ mod tests {
         assert_eq!(std::mem::size_of::<RayHit1>(), 80);
         assert_eq!(std::mem::size_of::<Ray8>(), 384);
         assert_eq!(std::mem::size_of::<Hit8>(), 256);
+        // RTCIntersectContext: flags, padding, filter pointer, instID[1], padding.
+        assert_eq!(std::mem::size_of::<Context>(), 24);
+        // RTC_ALIGN(16) and RTC_ALIGN(32); the 8-ray calls load the lane mask as one aligned
+        // 32-byte vector.
+        assert_eq!(std::mem::align_of::<RayHit1>(), 16);
+        assert_eq!(std::mem::align_of::<RayHit8>(), 32);
+        assert_eq!(std::mem::align_of::<Valid8>(), 32);
     }
 
     #[test]

@@ -1,12 +1,13 @@
 //! `photonwave bench`: throughput of the SIMD kernels against their baselines, in one process, on
-//! identical rays and queries. Each pair of kernels is timed alternately (packet, single, packet,
-//! …) and the median of the repetitions is reported, so machine noise hits both sides alike.
+//! identical rays and queries. The kernels compared on one set are timed in turn, round after
+//! round (packet, obvhs, 8-wide, …, packet, obvhs, …), and each one's median over the rounds is
+//! reported, so machine noise hits every side alike.
 //!
 //! Ray sets per scene, all from a 512 × 512 camera in 8 × 8 pixel tiles (packets of 8 are rows
 //! of a tile):
 //! - `camera`: primary rays;
-//! - `shadow`: from each camera hit to a uniform point on a light above its surface (t_max just
-//!   short of the light);
+//! - `shadow`: from each camera hit to a uniform point on a light above its surface, or to the
+//!   point `--light` gives (t_max just short of the light);
 //! - `diffuse`: cosine-distributed bounce rays from each camera hit, sorted by the renderer's
 //!   coherence key (direction octant, then origin cell) as the wavefront engine sorts its queues.
 //!

@@ -36,7 +36,8 @@ pub struct BenchArgs {
     /// own (a bare OBJ) can be measured at all.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub light: Option<Vec3>,
-    /// Also time packet traversal at each single-ray hand-over threshold (0–4 lanes).
+    /// Also time packet traversal at each single-ray hand-over threshold (0–4 lanes; part of the
+    /// traversal half, so not with `--only density`).
     #[arg(long)]
     pub thin_sweep: bool,
     /// Measure only `traversal` or only `density` [both].
@@ -110,7 +111,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         if !args.json {
             eprintln!("{label}: {} triangles", loaded.scene.triangle_count());
         }
-        if args.thin_sweep {
+        if args.thin_sweep && options.traversal {
             let sets = bench::RaySets::with_light(&loaded.scene, &cam, args.light);
             for (rays, query, thin, mrays) in
                 bench::thin_sweep(&loaded.scene, &sets, &[0, 1, 2, 3, 4], args.reps as usize)
