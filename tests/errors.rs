@@ -207,12 +207,7 @@ fn the_bench_command_checks_its_input_and_prints_one_json_object() {
     let (code, e) = cli(&["bench", "--rings", "1"]);
     assert!(code != 0 && e.contains("--rings"), "{e}");
     // A small generated sphere, one repetition: the report's shape, not its speed.
-    let out = Command::new(env!("CARGO_BIN_EXE_photonwave"))
-        .args(["bench", "generated:sphere", "--rings", "8", "--reps", "1", "--json"])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
+    let v = bench_json(&["bench", "generated:sphere", "--rings", "8", "--reps", "1", "--json"]);
     assert!(v["target_cpu"].is_string() && v["threads"] == 1, "{v}");
     let traversal = v["traversal"].as_array().unwrap();
     assert_eq!(traversal.len(), 6, "three ray sets × closest/any");
@@ -224,6 +219,13 @@ fn the_bench_command_checks_its_input_and_prints_one_json_object() {
     for row in density {
         assert!(row["photons"].as_u64().unwrap() > 0 && row["ratio"].as_f64().unwrap() > 0.0, "{row}");
     }
+}
+
+/// Runs `photonwave ARGS` (a bench with `--json`), asserts success and returns its one JSON object.
+fn bench_json(args: &[&str]) -> serde_json::Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_photonwave")).args(args).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("one JSON object on stdout")
 }
 
 /// `bench --light` lights a bare mesh (which would not load without a light) and sends every
@@ -238,12 +240,17 @@ fn bench_lights_a_bare_mesh_and_measures_one_half() {
     std::fs::write(&obj, "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n").unwrap();
     let (code, e) = cli(&["bench", obj.to_str().unwrap(), "--reps", "1"]);
     assert!(code != 0 && e.contains("no light"), "{e}");
-    let out = Command::new(env!("CARGO_BIN_EXE_photonwave"))
-        .args(["bench", obj.to_str().unwrap(), "--light", "0,0,3", "--only", "traversal", "--reps", "1", "--json"])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
+    let v = bench_json(&[
+        "bench",
+        obj.to_str().unwrap(),
+        "--light",
+        "0,0,3",
+        "--only",
+        "traversal",
+        "--reps",
+        "1",
+        "--json",
+    ]);
     assert!(v["density"].as_array().unwrap().is_empty(), "{v}");
     let traversal = v["traversal"].as_array().unwrap();
     assert_eq!(traversal.len(), 6, "three ray sets × closest/any: {v}");
@@ -256,12 +263,8 @@ fn bench_lights_a_bare_mesh_and_measures_one_half() {
         assert_eq!(row["embree1_mrays"].is_null(), !cfg!(feature = "embree"), "{row}");
     }
     // The other half alone.
-    let out = Command::new(env!("CARGO_BIN_EXE_photonwave"))
-        .args(["bench", obj.to_str().unwrap(), "--light", "0,0,3", "--only", "density", "--reps", "1", "--json"])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
+    let v =
+        bench_json(&["bench", obj.to_str().unwrap(), "--light", "0,0,3", "--only", "density", "--reps", "1", "--json"]);
     assert!(v["traversal"].as_array().unwrap().is_empty(), "{v}");
     assert_eq!(v["density"].as_array().unwrap().len(), 2, "knn and radius: {v}");
 }
