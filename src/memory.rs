@@ -4,7 +4,8 @@
 //! Cornell box, every engine (BENCHMARKS.md, "Memory"): about 147 bytes per pixel (film terms,
 //! per-pixel sums and radii, camera queues and the EXR's channels while it is written) and
 //! about 81 bytes per stored photon (the map's columns, the kd-tree and the deposits sorted
-//! before they are stored; the tree's nodes added about 3.4 B in issue 18: 84 B), over a base of about 12 MiB. The estimate rounds each up.
+//! before they are stored; the tree's nodes added about 3.4 B in issue 18: 84 B), over a base
+//! of about 12 MiB. The estimate rounds each up.
 
 use crate::error::{Error, Result};
 use crate::files::bytes;

@@ -122,15 +122,14 @@ impl Packet {
     /// [`Self::entry`] for the box `lo`–`hi`.
     #[inline(always)]
     pub(super) fn entry_box(&self, lo: [f32; 3], hi: [f32; 3], t_max: f32x8) -> f32x8 {
-        let b = (lo, hi);
-        let slab = |lo: f32, hi: f32, o: f32x8, inv: f32x8| {
-            let t0 = (f32x8::splat(lo) - o) * inv;
-            let t1 = (f32x8::splat(hi) - o) * inv;
+        let slab = |a: usize, o: f32x8, inv: f32x8| {
+            let t0 = (f32x8::splat(lo[a]) - o) * inv;
+            let t1 = (f32x8::splat(hi[a]) - o) * inv;
             (t0.fast_min(t1), t0.fast_max(t1))
         };
-        let (nx, fx) = slab(b.0[0], b.1[0], self.ox, self.ix);
-        let (ny, fy) = slab(b.0[1], b.1[1], self.oy, self.iy);
-        let (nz, fz) = slab(b.0[2], b.1[2], self.oz, self.iz);
+        let (nx, fx) = slab(0, self.ox, self.ix);
+        let (ny, fy) = slab(1, self.oy, self.iy);
+        let (nz, fz) = slab(2, self.oz, self.iz);
         // No NaN can arise (finite origins, boxes and inverse directions), so the min/max need
         // no NaN handling: the same values as the scalar test's.
         let near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
@@ -238,16 +237,9 @@ fn closest8(
     let mut best: [Best; LANES] = std::array::from_fn(|l| Best::new(rays.get(l).map_or(0.0, |r| r.t_max)));
     let mut t_best = best_ts(&best);
     let mut limit = limits(&best);
-    let active = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| {
-        if p.valid >> l & 1 == 1 {
-            f32::from_bits(u32::MAX)
-        } else {
-            0.0
-        }
-    }));
     if !nodes.is_empty() && p.valid != 0 {
-        let t0 = p.entry(&nodes[0], t_best);
-        stack.push((0, Entry(active.select(t0, f32x8::splat(f32::NAN)))));
+        // Invalid lanes are masked off at every pop.
+        stack.push((0, Entry(p.entry(&nodes[0], t_best))));
     }
     while let Some((n, Entry(tn))) = stack.pop() {
         // Only valid lanes: children's entry distances are computed for every lane, and an

@@ -85,10 +85,8 @@ fn closest8(
     let mut limit = limits(&best);
     stack.clear();
     if !nodes.is_empty() && p.valid != 0 {
-        // The root's lanes: entry 0 for valid rays, NaN (never entering) for the others.
-        let t =
-            f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| if p.valid >> l & 1 == 1 { 0.0 } else { f32::NAN }));
-        stack.push(Entry { child: 0, count: 0, t, lanes: p.valid });
+        // Entered at 0 by every lane; invalid lanes are masked off by `lanes`.
+        stack.push(Entry { child: 0, count: 0, t: f32x8::ZERO, lanes: p.valid });
     }
     while let Some(e) = stack.pop() {
         // Within the lanes that entered: entry distances are computed for every lane, and an

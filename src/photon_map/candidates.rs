@@ -73,11 +73,7 @@ mod tests {
     /// least the photons it sums.
     #[test]
     fn candidates_found_elsewhere_give_the_same_estimate() {
-        let mut s = 99u64;
-        let mut rnd = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rnd = super::super::test_uniforms(99);
         // Half the photons on the floor, half on a wall facing another way (filtered out).
         let photons: Vec<Photon> = (0..4000)
             .map(|i| {

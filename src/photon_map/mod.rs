@@ -232,6 +232,16 @@ impl PhotonMap {
     }
 }
 
+/// Uniform numbers in [0, 1) from a 64-bit linear congruential generator seeded with `seed`:
+/// the photon-map tests' fixed random photons and queries.
+#[cfg(test)]
+fn test_uniforms(mut seed: u64) -> impl FnMut() -> f32 {
+    move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -305,11 +315,7 @@ mod tests {
 
     #[test]
     fn nearest_matches_brute_force() {
-        let mut s = 12345u64;
-        let mut rnd = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rnd = super::test_uniforms(12345);
         let ps: Vec<Photon> = (0..2000).map(|_| photon(rnd(), rnd(), 1.0)).collect();
         let map = PhotonMap::build(ps.clone());
         let mut out = vec![];

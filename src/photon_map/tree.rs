@@ -295,11 +295,7 @@ mod tests {
     /// Every photon sits in exactly one leaf block, inside its box; nodes never nest a block twice.
     #[test]
     fn every_photon_lies_in_one_block_inside_its_box() {
-        let mut s = 7u64;
-        let mut rnd = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rnd = super::super::test_uniforms(7);
         for n in [1usize, 7, 8, 9, 63, 64, 65, 1000, 4099] {
             let mut photons: Vec<Photon> = (0..n)
                 .map(|i| Photon {
