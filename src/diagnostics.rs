@@ -37,7 +37,7 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
     let found = probe_first_surfaces(&ctx, job, rays, [0.0; 4], |pixel, s, sp, d, scratch, counts| {
         let bsdf = &scene.bsdf(sp);
         let caustic = if caustic_on {
-            let e = caustic_estimate(&ctx, sp, bsdf, -d, Some(pixel), scratch);
+            let e = caustic_estimate(&ctx, sp, bsdf, -d, Some(pixel), scratch).finish(&ctx);
             [e.radius, e.count as f32]
         } else {
             [0.0; 2]
@@ -49,7 +49,7 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
             let gather = s.fork(streams::gather(0));
             trace_gather_rays(&ctx, sp, -d, settings.gather_rays, &gather, counts, |end, _, _, _| {
                 let bsdf = &scene.bsdf(&end.point);
-                let e = global_estimate(&ctx, &end.point, bsdf, -end.dir, 0, None, scratch);
+                let e = global_estimate(&ctx, &end.point, bsdf, -end.dir, 0, None, scratch).finish(&ctx);
                 sum[0] += f64::from(e.radius);
                 sum[1] += f64::from(e.count);
                 hits += 1;
@@ -57,7 +57,7 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
             let n = f64::from(hits.max(1));
             [(sum[0] / n) as f32, (sum[1] / n) as f32]
         } else {
-            let e = indirect_estimate(&ctx, sp, bsdf, -d, Some(pixel), scratch);
+            let e = indirect_estimate(&ctx, sp, bsdf, -d, Some(pixel), scratch).finish(&ctx);
             [e.radius, e.count as f32]
         };
         [caustic[0], caustic[1], global[0], global[1]]

@@ -169,6 +169,102 @@ fn fixed_radius_lookups_find_what_a_brute_force_scan_finds() {
     }
 }
 
+/// Query packets (8 fixed-radius estimates sharing one walk) give each query exactly what its
+/// own SIMD estimate gives — the same photons met in the same order with the same arithmetic, so
+/// equal to the bit, bias and boundary correction included — and the scalar twin's photons (sums
+/// to rounding). Packets mix radii (a hundredth to the whole scene, zero, ∞, NaN), filters,
+/// reflectances, corrected and uncorrected queries, non-finite points, lattice points with
+/// photons at exactly the radius, and both coherent (jittered about one point) and scattered
+/// queries; the map holds NaN and infinite photons; an empty map answers every query with nothing.
+#[test]
+fn query_packets_match_single_estimates_to_the_bit() {
+    use photonwave::photon_map::boundary::Cut;
+    use photonwave::photon_map::query_packet::{RadiusQuery, PACKET};
+    use photonwave::photon_map::Estimate;
+    let mut photons = corner_photons(20_000);
+    for (i, position) in [Vec3::splat(f32::NAN), Vec3::new(f32::INFINITY, 0.0, 0.2)].into_iter().enumerate() {
+        photons.insert(i * 999, Photon { position, power: Vec3::ONE, wi: Vec3::Y, normal: Vec3::Y, flags: 0 });
+    }
+    let map = PhotonMap::build(photons);
+    let glossy = |wi: Vec3| Vec3::splat(wi.y.max(0.0).powi(8));
+    let cut = [Cut { point: Vec3::new(0.52, 0.0, 0.0), inward: -Vec3::X }];
+    let radii = [0.02f32, 0.05, 0.01, 0.1, 0.03, 2.0];
+    let query = |j: usize, p: Vec3, n: Vec3| {
+        let f = match j % 3 {
+            0 => Reflectance::Constant(Vec3::new(1.0, 0.5, 0.25)),
+            1 => Reflectance::Hemisphere { value: Vec3::splat(0.3), ng: n },
+            _ => Reflectance::PerPhoton(&glossy),
+        };
+        let flags_mask = if j % 4 == 3 { flags::OWN_TERMS } else { 0 };
+        RadiusQuery {
+            lookup: Lookup {
+                p,
+                k: 0,
+                r_max: radii[j % radii.len()],
+                kernel: Kernel::Epanechnikov,
+                filter: Filter { n, flags_mask },
+            },
+            f,
+            edges: j.is_multiple_of(2).then_some(&cut[..]),
+        }
+    };
+    let all = queries();
+    let mut packets: Vec<Vec<RadiusQuery>> = vec![];
+    // Coherent: 8 points jittered about each query, on its surface.
+    for (i, &(p, n)) in all.iter().enumerate().step_by(23) {
+        let len = 1 + i % PACKET;
+        let t = if n.y != 0.0 { Vec3::X } else { Vec3::Y };
+        let packet = (0..len).map(|j| query(i + j, p + t * (j as f32 * 0.004), n)).collect();
+        packets.push(packet);
+    }
+    // Scattered: consecutive queries.
+    for (c, chunk) in all.chunks(PACKET).enumerate().step_by(9) {
+        packets.push(chunk.iter().enumerate().map(|(j, &(p, n))| query(c + j, p, n)).collect());
+    }
+    // Non-finite points and radii beside ordinary ones, and lattice points (photons at exactly r).
+    let mut odd: Vec<RadiusQuery> =
+        (0..PACKET).map(|j| query(j, Vec3::new(0.55, 0.0, 0.55 + j as f32 * 0.01), Vec3::Y)).collect();
+    odd[1].lookup.p = Vec3::splat(f32::NAN);
+    odd[3].lookup.r_max = 0.0;
+    odd[4].lookup.r_max = f32::INFINITY;
+    odd[5].lookup.r_max = f32::NAN;
+    odd[6].lookup.p = Vec3::new(f32::INFINITY, 0.0, 0.5);
+    packets.push(odd);
+    let empty = PhotonMap::build(vec![]);
+    let mut found = 0;
+    for (m, map) in [&map, &empty].into_iter().enumerate() {
+        for (pi, packet) in packets.iter().enumerate() {
+            for bias in [false, true] {
+                let mut got = [Estimate::default(); PACKET];
+                let mut twin = [Estimate::default(); PACKET];
+                map.estimate_radius_packet(CodePath::Simd, packet, bias, &mut got);
+                map.estimate_radius_packet(CodePath::Scalar, packet, bias, &mut twin);
+                for (j, q) in packet.iter().enumerate() {
+                    let one = map.estimate_radius_with(CodePath::Simd, &q.lookup, q.f, q.edges, bias);
+                    let (g, t) = (got[j], twin[j]);
+                    let what = format!("map {m}, packet {pi}, query {j}, bias {bias}: {g:?} vs {one:?}");
+                    assert_eq!(
+                        (g.count, g.rejected, g.radius.to_bits()),
+                        (one.count, one.rejected, one.radius.to_bits()),
+                        "{what}"
+                    );
+                    assert_eq!(
+                        g.radiance.to_array().map(f32::to_bits),
+                        one.radiance.to_array().map(f32::to_bits),
+                        "{what}"
+                    );
+                    assert_eq!(g.bias.to_array().map(f32::to_bits), one.bias.to_array().map(f32::to_bits), "{what}");
+                    assert_eq!((t.count, t.rejected), (g.count, g.rejected), "{what}: the scalar twin");
+                    assert!(close(t.radiance, g.radiance), "{what}: the scalar twin {:?}", t.radiance);
+                    assert!(g.radiance.is_finite() && g.bias.is_finite(), "{what}");
+                    found += g.count;
+                }
+            }
+        }
+    }
+    assert!(found > 100_000, "the packets found photons: {found}");
+}
+
 #[test]
 fn lookups_honour_the_radius_and_the_filters_exactly() {
     // Photons at exactly the search radius are outside (the interval is open), on both twins;

@@ -43,6 +43,11 @@ pub struct DensityRow {
     pub kiddo_per_s: Option<f64>,
     /// simd / kiddo.
     pub ratio_vs_kiddo: Option<f64>,
+    /// Fixed-radius rows: the same estimates by query packets (8 consecutive queries sharing one
+    /// walk), estimates per second (median); `null` on k-NN rows.
+    pub packet_per_s: Option<f64>,
+    /// packet / scalar.
+    pub packet_ratio: Option<f64>,
 }
 
 /// Photons in the bench's global map.
@@ -113,6 +118,33 @@ pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize,
         .into_iter()
         .sum::<f32>()
     };
+    // The fixed-radius estimates 8 consecutive queries at a time, one walk per packet.
+    let radius_packets = |r: f32| {
+        use crate::photon_map::query_packet::{RadiusQuery, PACKET};
+        use crate::photon_map::Estimate;
+        map_chunks(
+            queries.len(),
+            CHUNK,
+            threads,
+            |range| {
+                let mut out = [Estimate::default(); PACKET];
+                queries[range]
+                    .chunks(PACKET)
+                    .map(|chunk| {
+                        let packet: Vec<RadiusQuery<'_>> = chunk
+                            .iter()
+                            .map(|&(p, n)| RadiusQuery { lookup: lookup(p, n, 0, r), f: f(n), edges: None })
+                            .collect();
+                        map.estimate_radius_packet(CodePath::Simd, &packet, false, &mut out);
+                        out[..chunk.len()].iter().map(|e| e.radiance.x).sum::<f32>()
+                    })
+                    .sum::<f32>()
+            },
+            |_| {},
+        )
+        .into_iter()
+        .sum::<f32>()
+    };
     let scalar_knn = knn(CodePath::Scalar);
     let radii: Vec<f64> = scalar_knn.iter().map(|e| f64::from(e.radius)).collect();
     let r_fixed = if radii.is_empty() { r_max } else { median(radii) as f32 };
@@ -165,6 +197,13 @@ pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize,
             "{name}: kiddo radius sum {theirs_radius} against {ours_radius}"
         );
     }
+    // Each packet estimate equals its single SIMD estimate to the bit (tests/simd.rs); the sums
+    // differ only in the order they are added (chunk by chunk against packet by packet).
+    let (single, packed) = (radius_lookup(CodePath::Simd, r_fixed), radius_packets(r_fixed));
+    assert!(
+        (single - packed).abs() <= 1e-5 * single.abs().max(packed.abs()),
+        "{name}: packet radius sum {packed} against {single}"
+    );
     // SIMD, scalar and (when built) kiddo in turn.
     let kiddo_run = |k: usize, r: f32| {
         if let Some(kiddo) = through_kiddo {
@@ -175,7 +214,7 @@ pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize,
         reps,
         [&mut || drop(knn(CodePath::Simd)), &mut || drop(knn(CodePath::Scalar)), &mut || kiddo_run(k, r_max)],
     );
-    let [rs, rk, rkd] = time_alternating(
+    let [rs, rk, rkd, rp] = time_alternating(
         reps,
         [
             &mut || {
@@ -185,28 +224,35 @@ pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize,
                 std::hint::black_box(radius_lookup(CodePath::Scalar, r_fixed));
             },
             &mut || kiddo_run(0, r_fixed),
+            &mut || {
+                std::hint::black_box(radius_packets(r_fixed));
+            },
         ],
     );
     let kiddo_knn = through_kiddo.map(|_| (ts, tkd));
     let kiddo_radius = through_kiddo.map(|_| (rs, rkd));
-    let row = |lookup, simd: f64, scalar: f64, tested: f64, summed: f64, kiddo: Option<Timed>| DensityRow {
-        scene: name.to_string(),
-        lookup,
-        count: queries.len(),
-        photons: map.len(),
-        simd_per_s: n / simd,
-        scalar_per_s: n / scalar,
-        ratio: scalar / simd,
-        photons_tested_per_query: tested,
-        ns_per_photon_tested: simd / n / tested * 1e9,
-        photons_summed_per_query: summed,
-        map_bytes_per_photon: PhotonMap::bytes_per_photon() as f64 + map.tree_bytes_per_photon(),
-        kiddo_per_s: kiddo.map(|(_, k)| n / k),
-        ratio_vs_kiddo: kiddo.map(|(s, k)| k / s),
+    let row = |lookup, simd: f64, scalar: f64, tested: f64, summed: f64, kiddo: Option<Timed>, packet: Option<f64>| {
+        DensityRow {
+            scene: name.to_string(),
+            lookup,
+            count: queries.len(),
+            photons: map.len(),
+            simd_per_s: n / simd,
+            scalar_per_s: n / scalar,
+            ratio: scalar / simd,
+            photons_tested_per_query: tested,
+            ns_per_photon_tested: simd / n / tested * 1e9,
+            photons_summed_per_query: summed,
+            map_bytes_per_photon: PhotonMap::bytes_per_photon() as f64 + map.tree_bytes_per_photon(),
+            kiddo_per_s: kiddo.map(|(_, k)| n / k),
+            ratio_vs_kiddo: kiddo.map(|(s, k)| k / s),
+            packet_per_s: packet.map(|p| n / p),
+            packet_ratio: packet.map(|p| scalar / p),
+        }
     };
     vec![
-        row("knn", ts, tk, tested(k, r_max), summed_knn, kiddo_knn),
-        row("radius", rs, rk, tested(0, r_fixed), summed_radius, kiddo_radius),
+        row("knn", ts, tk, tested(k, r_max), summed_knn, kiddo_knn, None),
+        row("radius", rs, rk, tested(0, r_fixed), summed_radius, kiddo_radius, Some(rp)),
     ]
 }
 

@@ -251,13 +251,17 @@ pub fn table(traversal: &[TraversalRow], density: &[DensityRow]) -> String {
     for r in density {
         let _ = writeln!(
             s,
-            "  density   {:<8} {:>8} queries over {} photons  simd {:>9.0}/s  scalar {:>9.0}/s  ×{:.2}  kiddo {}  ({:.0} photons tested per query for {:.0} summed, {:.2} ns each; {:.1} B per photon)",
+            "  density   {:<8} {:>8} queries over {} photons  simd {:>9.0}/s  scalar {:>9.0}/s  ×{:.2}  packets {}  kiddo {}  ({:.0} photons tested per query for {:.0} summed, {:.2} ns each; {:.1} B per photon)",
             r.lookup,
             r.count,
             r.photons,
             r.simd_per_s,
             r.scalar_per_s,
             r.ratio,
+            match (r.packet_per_s, r.packet_ratio) {
+                (Some(p), Some(x)) => format!("{p:>9.0}/s ×{x:.2}"),
+                _ => "–".to_string(),
+            },
             match (r.kiddo_per_s, r.ratio_vs_kiddo) {
                 (Some(k), Some(x)) => format!("{k:>9.0}/s ×{x:.2}"),
                 _ => "– (build with --features baselines)".to_string(),

@@ -49,19 +49,44 @@ impl PhotonMap {
             return Verdict8 { inside: f32x8::ZERO, bits: 0, turned: 0, d2, key: u32x8::ZERO };
         }
         let key = self.key8(base);
-        let flags = (key >> 12_u32) & u32x8::splat(3);
+        let (inside, turned) = Self::filter8(&Normals8::decode(key), near, filter);
+        Verdict8 { inside, bits: inside.to_bitmask(), turned, d2, key }
+    }
+
+    /// The filter's verdict on 8 photons (`normals`) for a query whose sphere holds the lanes of
+    /// `near`: all-ones in the lanes it accepts, and the bits of the lanes its normal test turns
+    /// away (they pass its flags).
+    #[inline]
+    pub(super) fn filter8(normals: &Normals8, near: f32x8, filter: &Filter) -> (f32x8, u32) {
         let flags_ok: f32x8 =
-            wide::bytemuck::cast((flags & u32x8::splat(u32::from(filter.flags_mask))).simd_eq(u32x8::ZERO));
-        let [mx, my, mz] = oct_decode8(
+            wide::bytemuck::cast((normals.flags & u32x8::splat(u32::from(filter.flags_mask))).simd_eq(u32x8::ZERO));
+        let [mx, my, mz] = normals.m;
+        let dot = mx * f32x8::splat(filter.n.x) + my * f32x8::splat(filter.n.y) + mz * f32x8::splat(filter.n.z);
+        let normal_ok = dot.simd_gt(f32x8::ZERO) & (dot * dot).simd_gt(f32x8::splat(0.49) * normals.len2);
+        (near & normal_ok & flags_ok, (near & !normal_ok & flags_ok).to_bitmask())
+    }
+}
+
+/// The stored normals and flags of 8 photons, decoded once for any number of queries.
+pub(super) struct Normals8 {
+    /// The normals (octahedral decode, not normalised).
+    m: [f32x8; 3],
+    /// Their squared lengths.
+    len2: f32x8,
+    /// The [`super::flags`] bits.
+    flags: u32x8,
+}
+
+impl Normals8 {
+    /// Decodes the normals and flags of the 8 keys `key`.
+    #[inline]
+    pub(super) fn decode(key: u32x8) -> Self {
+        let m = oct_decode8(
             dequantise8(key & u32x8::splat(63), NORMAL_STEPS),
             dequantise8((key >> 6_u32) & u32x8::splat(63), NORMAL_STEPS),
         );
-        let dot = mx * f32x8::splat(filter.n.x) + my * f32x8::splat(filter.n.y) + mz * f32x8::splat(filter.n.z);
-        let len2 = mx * mx + my * my + mz * mz;
-        let normal_ok = dot.simd_gt(f32x8::ZERO) & (dot * dot).simd_gt(f32x8::splat(0.49) * len2);
-        let inside = near & normal_ok & flags_ok;
-        let turned = (near & !normal_ok & flags_ok).to_bitmask();
-        Verdict8 { inside, bits: inside.to_bitmask(), turned, d2, key }
+        let len2 = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
+        Normals8 { m, len2, flags: (key >> 12_u32) & u32x8::splat(3) }
     }
 }
 

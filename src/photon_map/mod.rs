@@ -36,6 +36,7 @@ mod filter;
 pub mod kernel;
 pub mod knn;
 mod packing;
+pub mod query_packet;
 pub mod radius;
 mod sum;
 mod tree;

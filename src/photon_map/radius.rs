@@ -121,11 +121,29 @@ impl PhotonMap {
             }
         }
         let reduce = |v: [f32x8; 3]| Vec3::new(v[0].reduce_add(), v[1].reduce_add(), v[2].reduce_add());
+        let (sum, bias) = (sum + reduce(sum8), bias + reduce(bias8));
+        self.fixed_estimate::<BIAS>(q, r2, on_surface, &neighbours, [sum, bias], count, rejected)
+    }
+
+    /// A fixed-radius estimate from its kernel sum and bias sum over the photons found: normalised,
+    /// divided by the part of the disk on the query's surface (`on_surface`: the cuts beyond the
+    /// `neighbours` the filter met) and, with `BIAS`, its bias.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub(super) fn fixed_estimate<const BIAS: bool>(
+        &self,
+        q: &Lookup,
+        r2: f32,
+        on_surface: Option<&[Cut]>,
+        neighbours: &Neighbours,
+        [sum, bias]: [Vec3; 2],
+        count: u32,
+        rejected: u32,
+    ) -> Estimate {
         let coverage = match on_surface {
             Some(edges) => neighbours.coverage(self, q.p, q.filter.n, r2, q.kernel, edges),
             None => Coverage::WHOLE,
         };
-        let (sum, bias) = (sum + reduce(sum8), bias + reduce(bias8));
         let radiance = sum * q.kernel.normalisation(r2) / coverage.fraction;
         // A cut disk's bias sum is not zero even for a uniform density: subtract that part.
         let bias = if BIAS {

@@ -7,6 +7,33 @@ use crate::code_path::CodePath;
 use glam::Vec3;
 use wide::{f32x8, u32x8};
 
+/// The powers of 8 photons, decoded, and their incoming directions, decoded when first asked for.
+pub(super) struct Decoded8 {
+    key: u32x8,
+    power: [f32x8; 3],
+    wi: Option<[f32x8; 3]>,
+}
+
+impl Decoded8 {
+    /// The 8 photons of the `key` and `power` columns.
+    #[inline]
+    pub(super) fn new(key: u32x8, power: u32x8) -> Self {
+        Decoded8 { key, power: rgbe_decode8(power), wi: None }
+    }
+
+    /// Their incoming directions (octahedral decode, not normalised).
+    #[inline]
+    fn wi(&mut self) -> [f32x8; 3] {
+        let key = self.key;
+        *self.wi.get_or_insert_with(|| {
+            oct_decode8(
+                dequantise8((key >> 16_u32) & u32x8::splat(255), DIR_STEPS),
+                dequantise8(key >> 24_u32, DIR_STEPS),
+            )
+        })
+    }
+}
+
 impl PhotonMap {
     /// The kernel estimate over `found` within squared radius `r2`.
     #[inline]
@@ -98,7 +125,20 @@ impl PhotonMap {
         weights: [f32x8; W],
         f: Reflectance<'_>,
     ) -> [[f32x8; 3]; W] {
-        let [pr, pg, pb] = rgbe_decode8(power);
+        Self::contributions8_decoded(&mut Decoded8::new(key, power), lanes, weights, f)
+    }
+
+    /// [`Self::contributions8`] of photons already (partly) decoded: a block tested against
+    /// several queries decodes its powers and directions once.
+    #[inline(always)]
+    pub(super) fn contributions8_decoded<const W: usize>(
+        photons: &mut Decoded8,
+        lanes: f32x8,
+        weights: [f32x8; W],
+        f: Reflectance<'_>,
+    ) -> [[f32x8; 3]; W] {
+        let [pr, pg, pb] = photons.power;
+        let key = photons.key;
         let weighted = weights.map(|w| {
             let w = lanes.select(w, f32x8::ZERO);
             (pr * w, pg * w, pb * w)
@@ -108,10 +148,7 @@ impl PhotonMap {
                 weighted.map(|(pr, pg, pb)| [pr * f32x8::splat(v.x), pg * f32x8::splat(v.y), pb * f32x8::splat(v.z)])
             }
             Reflectance::Hemisphere { value, ng } => {
-                let [wx, wy, wz] = oct_decode8(
-                    dequantise8((key >> 16_u32) & u32x8::splat(255), DIR_STEPS),
-                    dequantise8(key >> 24_u32, DIR_STEPS),
-                );
+                let [wx, wy, wz] = photons.wi();
                 let up =
                     (wx * f32x8::splat(ng.x) + wy * f32x8::splat(ng.y) + wz * f32x8::splat(ng.z)).simd_gt(f32x8::ZERO);
                 let zero = f32x8::ZERO;

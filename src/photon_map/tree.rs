@@ -22,11 +22,11 @@ use wide::f32x8;
 const BLOCK: usize = 8;
 
 /// A child slot holding a leaf carries this bit and the block's index; otherwise a node's index.
-const LEAF: u32 = 1 << 31;
+pub(super) const LEAF: u32 = 1 << 31;
 
 /// Depth of the walk's stack: each node pushes at most 7 more entries than it pops, and a tree of
 /// 2³² photons is 10 nodes deep.
-const STACK: usize = 72;
+pub(super) const STACK: usize = 72;
 
 /// One node: its children's boxes in SoA form and what each child is. Empty slots have inverted
 /// boxes (low +∞, high −∞), which no sphere reaches.
@@ -34,9 +34,9 @@ const STACK: usize = 72;
 pub(super) struct Node {
     lo: [[f32; 8]; 3],
     hi: [[f32; 8]; 3],
-    child: [u32; 8],
+    pub(super) child: [u32; 8],
     /// The slots holding leaves, as bits.
-    leaves: u8,
+    pub(super) leaves: u8,
 }
 
 impl Node {
@@ -44,7 +44,7 @@ impl Node {
 
     /// Squared distances from `p` to the 8 child boxes (0 inside), and the mask of those below `r2`.
     #[inline]
-    fn distances8(&self, p: Vec3, r2: f32) -> ([f32; 8], u32) {
+    pub(super) fn distances8(&self, p: Vec3, r2: f32) -> ([f32; 8], u32) {
         let mut d2 = f32x8::ZERO;
         for a in 0..3 {
             let (lo, hi, pa) = (f32x8::from(self.lo[a]), f32x8::from(self.hi[a]), f32x8::splat(p[a]));
@@ -156,7 +156,7 @@ impl<const NEAREST_FIRST: bool> Walk<NEAREST_FIRST> {
 impl PhotonMap {
     /// The photon range of the block in a leaf slot (`child` carries [`LEAF`]).
     #[inline]
-    fn block(&self, child: u32) -> (usize, usize) {
+    pub(super) fn block(&self, child: u32) -> (usize, usize) {
         let lo = (child & !LEAF) as usize * BLOCK;
         (lo, (lo + BLOCK).min(self.len))
     }

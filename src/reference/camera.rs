@@ -89,11 +89,11 @@ pub fn trace_camera_path(
             continue;
         }
         let direct = beta * direct_light(ctx, &sp, &bsdf, wo, &s.fork(streams::light(depth)), rays);
-        let caustic = caustic_estimate(ctx, &sp, &bsdf, wo, Some(pixel), scratch);
+        let caustic = caustic_estimate(ctx, &sp, &bsdf, wo, Some(pixel), scratch).finish(ctx);
         let indirect = if ctx.effects.final_gather.on {
             final_gather(ctx, &sp, &bsdf, wo, &s.fork(streams::gather(depth)), rays, scratch)
         } else {
-            camera_indirect_estimate(ctx, &sp, &bsdf, wo, Some(pixel), scratch).into()
+            camera_indirect_estimate(ctx, &sp, &bsdf, wo, Some(pixel), scratch).finish(ctx).into()
         };
         let glossy = glossy_reflection(ctx, &sp, &bsdf, wo, &s.fork(streams::glossy(depth)), rays, scratch);
         let (caustic_l, indirect_l, glossy_l) =
@@ -171,16 +171,16 @@ fn gather_hit(
     let (y, wo) = (&end.point, -end.dir);
     let bsdf = &ctx.scene.bsdf(y);
     if !lands_near(end.t, end.bounces, bsdf, ctx.secondary_gather) {
-        return map_radiance(ctx, y, bsdf, wo, scratch).into();
+        return map_radiance(ctx, y, bsdf, wo, scratch).finish(ctx).into();
     }
     let direct = direct_light(ctx, y, bsdf, wo, &chain.fork(streams::SECONDARY_LIGHT), rays);
-    let caustic = caustic_estimate(ctx, y, bsdf, wo, None, scratch);
+    let caustic = caustic_estimate(ctx, y, bsdf, wo, None, scratch).finish(ctx);
     let kd = bsdf.diffuse();
     let mut far = Estimated::default();
     // A black surface sends no gather ray (as in `final_gather` and the wavefront engine).
     if kd != Vec3::ZERO {
         trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, _, _| {
-            let e = map_radiance(ctx, &z.point, &ctx.scene.bsdf(&z.point), -z.dir, scratch);
+            let e = map_radiance(ctx, &z.point, &ctx.scene.bsdf(&z.point), -z.dir, scratch).finish(ctx);
             far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias };
         });
     }
@@ -208,8 +208,8 @@ pub fn glossy_reflection(
     };
     let b = &ctx.scene.bsdf(&y);
     let direct = direct_light(ctx, &y, b, -d, &s.fork(streams::GLOSSY_HIT_LIGHT), rays);
-    let caustic = caustic_estimate(ctx, &y, b, -d, None, scratch);
-    let rest = indirect_estimate(ctx, &y, b, -d, None, scratch);
+    let caustic = caustic_estimate(ctx, &y, b, -d, None, scratch).finish(ctx);
+    let rest = indirect_estimate(ctx, &y, b, -d, None, scratch).finish(ctx);
     let w = ray.weight * beta;
     Estimated { radiance: w * (direct + caustic.radiance + rest.radiance), bias: w * (caustic.bias + rest.bias) }
 }

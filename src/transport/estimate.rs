@@ -1,25 +1,100 @@
 //! Photon-map density estimates at a surface point: the caustic and global maps' reflected
 //! radiance (k nearest photons, or every photon within a progressive pass's fixed radii,
 //! optionally only the visible ones), and the radiance a final-gather ray reads where it lands
-//! (precomputed irradiance where that applies). Each returns the map's [`Estimate`]: with fixed
-//! radii it carries the estimate's bias too (not with `visibility`, whose estimates are not
-//! boundary-corrected either).
+//! (precomputed irradiance where that applies). Each returns it [`Planned`]: the map's
+//! [`Estimate`], or a fixed-radius lookup left to run alone ([`Planned::finish`]) or in a query
+//! packet with its neighbours ([`run_packet`]). With fixed radii the estimate carries its bias
+//! too (not with `visibility`, whose estimates are not boundary-corrected either).
 
 use super::Context;
 use crate::material::Bsdf;
 use crate::photon_map::boundary::{Cut, MAX_EXTRA_CUTS};
+use crate::photon_map::query_packet::{RadiusQuery, PACKET};
 use crate::photon_map::{flags, Estimate, Filter, Lookup, PhotonMap, Reflectance};
 use crate::scene::{Scene, SurfacePoint};
 use glam::Vec3;
 use std::sync::atomic::Ordering;
 
+/// A density estimate at a surface point, planned: computed already, or a fixed-radius lookup
+/// with Lambertian reflectance left to run — alone ([`Planned::finish`]) or with up to 7 others
+/// in a query packet that shares one walk of the map ([`run_packet`]).
+#[derive(Clone, Copy)]
+pub enum Planned<'m> {
+    /// The estimate.
+    Done(Estimate),
+    /// A lookup still to run.
+    Fixed(FixedLookup<'m>),
+}
+
+/// A fixed-radius estimate (a progressive pass's) with Lambertian reflectance, ready to run.
+#[derive(Clone, Copy)]
+pub struct FixedLookup<'m> {
+    /// The map it reads.
+    pub map: &'m PhotonMap,
+    /// Point, filter, kernel; `r_max` is the fixed radius.
+    pub lookup: Lookup,
+    /// f for photons arriving above the surface (the filter's normal): kd/π.
+    pub value: Vec3,
+    /// The triangle the point lies on, whose region's open edges cut the disk.
+    pub tri: u32,
+    /// Whether the estimate is boundary-corrected ([`Settings::boundary_correction`]).
+    pub corrected: bool,
+}
+
+impl Planned<'_> {
+    /// The estimate: computed now if it was left to run.
+    #[inline]
+    #[must_use]
+    pub fn finish(self, ctx: &Context) -> Estimate {
+        match self {
+            Planned::Done(e) => e,
+            Planned::Fixed(q) => {
+                let mut out = [Estimate::default()];
+                run_packet(ctx, &[q], &mut out);
+                out[0]
+            }
+        }
+    }
+}
+
+/// Runs up to [`PACKET`] fixed-radius lookups of one map as a query packet, each estimate into
+/// `out` (each identical to the bit to the lookup run alone).
+///
+/// # Panics
+/// If the lookups read different maps, or there are more than [`PACKET`].
+pub fn run_packet(ctx: &Context, lookups: &[FixedLookup<'_>], out: &mut [Estimate]) {
+    let Some(first) = lookups.first() else { return };
+    assert!(lookups.iter().all(|q| std::ptr::eq(q.map, first.map)), "one packet, one map");
+    let at = |j: usize| lookups.get(j).unwrap_or(first);
+    let cuts: [_; PACKET] = std::array::from_fn(|j| {
+        let q = at(j);
+        q.corrected.then(|| open_edge_cuts(ctx.scene, q.tri, q.lookup.p, q.lookup.r_max))
+    });
+    let queries: [RadiusQuery<'_>; PACKET] = std::array::from_fn(|j| {
+        let q = at(j);
+        RadiusQuery {
+            lookup: q.lookup,
+            f: Reflectance::Hemisphere { value: q.value, ng: q.lookup.filter.n },
+            edges: cuts[j].as_ref().map(|(cuts, len)| &cuts[..*len]),
+        }
+    });
+    let bias = ctx.fixed.is_some_and(|r| r.bias);
+    let n = lookups.len();
+    first.map.estimate_radius_packet(ctx.settings.code_path, &queries[..n], bias, &mut out[..n]);
+    let rejected: u64 = out[..n].iter().map(|e| u64::from(e.rejected)).sum();
+    if rejected > 0 {
+        ctx.filtered.fetch_add(rejected, Ordering::Relaxed);
+    }
+}
+
 /// Radiance estimate from `map` at `sp` toward `wo` with `k` photons within `radius`, ignoring
-/// photons with any `mask` flag.
+/// photons with any `mask` flag: computed, or (a fixed radius, Lambertian reflectance, no
+/// visibility test) planned.
 #[allow(clippy::too_many_arguments)]
 #[inline]
-fn map_estimate(
+fn plan_map<'m>(
     ctx: &Context,
-    map: &PhotonMap,
+    map: &'m PhotonMap,
     k: u32,
     radius: f32,
     sp: &SurfacePoint,
@@ -29,9 +104,9 @@ fn map_estimate(
     fixed: Option<f32>,
     base: bool,
     scratch: &mut Vec<(f32, u32)>,
-) -> Estimate {
+) -> Planned<'m> {
     if base && !bsdf.has_base() {
-        return Estimate::default();
+        return Planned::Done(Estimate::default());
     }
     let (ng, _) = sp.frame.oriented(wo);
     let lookup = Lookup {
@@ -54,14 +129,19 @@ fn map_estimate(
     // are not: on CornellBox-Original the correction moved the one-pass image from 0.3 % dark
     // to 0.2 % bright and its 16×16-block error from 1.2 % to 1.6 % (BENCHMARKS.md).
     let bias = ctx.fixed.is_some_and(|r| r.bias);
-    let e = match (fixed, ctx.settings.visibility) {
-        (Some(r), false) if ctx.settings.boundary_correction => {
-            let (edges, len) = open_edge_cuts(ctx.scene, sp, r);
-            map.estimate_radius_with(set, &Lookup { r_max: r, ..lookup }, f, Some(&edges[..len]), bias)
+    let corrected = ctx.settings.boundary_correction;
+    let e = match (fixed, ctx.settings.visibility, f) {
+        (Some(r), false, Reflectance::Hemisphere { value, .. }) => {
+            let lookup = Lookup { r_max: r, ..lookup };
+            return Planned::Fixed(FixedLookup { map, lookup, value, tri: sp.tri, corrected });
         }
-        (Some(r), false) => map.estimate_radius_with(set, &Lookup { r_max: r, ..lookup }, f, None, bias),
-        (None, false) => map.estimate(set, &lookup, f, scratch),
-        (fixed, true) => {
+        (Some(r), false, _) => {
+            let edges = corrected.then(|| open_edge_cuts(ctx.scene, sp.tri, sp.p, r));
+            let cuts = edges.as_ref().map(|(cuts, len)| &cuts[..*len]);
+            map.estimate_radius_with(set, &Lookup { r_max: r, ..lookup }, f, cuts, bias)
+        }
+        (None, false, _) => map.estimate(set, &lookup, f, scratch),
+        (fixed, true, _) => {
             let lookup = fixed.map_or(lookup, |r| Lookup { r_max: r, k: 0, ..lookup });
             let visible = photon_visibility(ctx.scene, sp.p, ng, lookup.r_max);
             map.estimate_visible(set, &lookup, f, scratch, &visible)
@@ -70,20 +150,20 @@ fn map_estimate(
     if e.rejected > 0 {
         ctx.filtered.fetch_add(u64::from(e.rejected), Ordering::Relaxed);
     }
-    e
+    Planned::Done(e)
 }
 
-/// The open edges of `sp`'s flat region within `r` of it, as cuts of its estimate's disk (at most
+/// The open edges of the flat region of triangle `tri` within `r` of `p` on it, as cuts of its estimate's disk (at most
 /// [`MAX_EXTRA_CUTS`]; a region has few), and how many there are.
 #[inline]
-fn open_edge_cuts(scene: &Scene, sp: &SurfacePoint, r: f32) -> ([Cut; MAX_EXTRA_CUTS], usize) {
+fn open_edge_cuts(scene: &Scene, tri: u32, p: Vec3, r: f32) -> ([Cut; MAX_EXTRA_CUTS], usize) {
     let mut cuts = [Cut::default(); MAX_EXTRA_CUTS];
     let mut len = 0;
-    for e in scene.open_edges.of(sp.tri) {
+    for e in scene.open_edges.of(tri) {
         // Distance from the point to the segment.
         let ab = e.b - e.a;
-        let t = ((sp.p - e.a).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
-        if (e.a + ab * t).distance_squared(sp.p) < r * r && len < MAX_EXTRA_CUTS {
+        let t = ((p - e.a).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
+        if (e.a + ab * t).distance_squared(p) < r * r && len < MAX_EXTRA_CUTS {
             cuts[len] = Cut { point: e.a, inward: e.inward };
             len += 1;
         }
@@ -104,42 +184,31 @@ pub fn photon_visibility(scene: &Scene, q: Vec3, n: Vec3, r: f32) -> impl Fn(Vec
 /// Caustic-map radiance estimate at `sp` toward `wo`; `pixel` when `sp` is a camera path's first
 /// non-specular hit (progressive passes may give each pixel its own radius).
 #[inline]
-pub fn caustic_estimate(
-    ctx: &Context,
+pub fn caustic_estimate<'a>(
+    ctx: &Context<'a>,
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
     pixel: Option<usize>,
     scratch: &mut Vec<(f32, u32)>,
-) -> Estimate {
+) -> Planned<'a> {
     let fixed = ctx.fixed.map(|r| r.caustic_at(pixel));
-    map_estimate(
-        ctx,
-        &ctx.maps.caustic,
-        ctx.settings.caustic_k,
-        ctx.caustic_radius,
-        sp,
-        bsdf,
-        wo,
-        0,
-        fixed,
-        false,
-        scratch,
-    )
+    let map: &'a PhotonMap = &ctx.maps.caustic;
+    plan_map(ctx, map, ctx.settings.caustic_k, ctx.caustic_radius, sp, bsdf, wo, 0, fixed, false, scratch)
 }
 
 /// Global-map radiance estimate at `sp` toward `wo`, ignoring photons with any `mask` flag;
 /// `pixel` as for [`caustic_estimate`].
 #[inline]
-pub fn global_estimate(
-    ctx: &Context,
+pub fn global_estimate<'a>(
+    ctx: &Context<'a>,
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
     mask: u8,
     pixel: Option<usize>,
     scratch: &mut Vec<(f32, u32)>,
-) -> Estimate {
+) -> Planned<'a> {
     global_part(ctx, sp, bsdf, wo, mask, pixel, false, scratch)
 }
 
@@ -147,8 +216,8 @@ pub fn global_estimate(
 /// ray does not sample.
 #[allow(clippy::too_many_arguments)]
 #[inline]
-fn global_part(
-    ctx: &Context,
+fn global_part<'a>(
+    ctx: &Context<'a>,
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
@@ -156,24 +225,25 @@ fn global_part(
     pixel: Option<usize>,
     base: bool,
     scratch: &mut Vec<(f32, u32)>,
-) -> Estimate {
+) -> Planned<'a> {
     let fixed = ctx.fixed.map(|r| r.global_at(pixel));
-    map_estimate(ctx, &ctx.maps.global, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, fixed, base, scratch)
+    let map: &'a PhotonMap = &ctx.maps.global;
+    plan_map(ctx, map, ctx.settings.k, ctx.global_radius, sp, bsdf, wo, mask, fixed, base, scratch)
 }
 
 /// Indirect light at `sp` toward `wo` from the global map alone: its estimate without direct and
 /// caustic photons ([`flags::OWN_TERMS`]), whose light other terms compute; `pixel` as for
 /// [`caustic_estimate`].
 #[inline]
-pub fn indirect_estimate(
-    ctx: &Context,
+pub fn indirect_estimate<'a>(
+    ctx: &Context<'a>,
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
     pixel: Option<usize>,
     scratch: &mut Vec<(f32, u32)>,
-) -> Estimate {
-    global_estimate(ctx, sp, bsdf, wo, flags::OWN_TERMS, pixel, scratch)
+) -> Planned<'a> {
+    global_part(ctx, sp, bsdf, wo, flags::OWN_TERMS, pixel, false, scratch)
 }
 
 /// [`indirect_estimate`] at a camera path's own vertex, where a glossy lobe is followed by its
@@ -181,14 +251,14 @@ pub fn indirect_estimate(
 /// BSDF that ray does not sample (a Phong material's kd/π, a rough plastic's base; nothing for
 /// a rough conductor or dielectric), so no path is counted twice.
 #[inline]
-pub fn camera_indirect_estimate(
-    ctx: &Context,
+pub fn camera_indirect_estimate<'a>(
+    ctx: &Context<'a>,
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
     pixel: Option<usize>,
     scratch: &mut Vec<(f32, u32)>,
-) -> Estimate {
+) -> Planned<'a> {
     global_part(ctx, sp, bsdf, wo, flags::OWN_TERMS, pixel, true, scratch)
 }
 
@@ -196,13 +266,13 @@ pub fn camera_indirect_estimate(
 /// nearest precomputed irradiance for Lambertian surfaces when that is available (and a point
 /// with a similar normal lies within the global radius), the full global-map estimate otherwise.
 #[inline]
-pub fn map_radiance(
-    ctx: &Context,
+pub fn map_radiance<'a>(
+    ctx: &Context<'a>,
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
     scratch: &mut Vec<(f32, u32)>,
-) -> Estimate {
+) -> Planned<'a> {
     let irr = &ctx.maps.irradiance;
     if let (Bsdf::Lambert { kd }, false) = (bsdf, irr.is_empty()) {
         let (ng, _) = sp.frame.oriented(wo);
@@ -224,9 +294,9 @@ pub fn map_radiance(
             };
             if !ctx.settings.visibility || visible() {
                 let radiance = *kd * std::f32::consts::FRAC_1_PI * irr.power(i as usize);
-                return Estimate { radiance, radius: lookup.r_max, ..Default::default() };
+                return Planned::Done(Estimate { radiance, radius: lookup.r_max, ..Default::default() });
             }
         }
     }
-    global_estimate(ctx, sp, bsdf, wo, 0, None, scratch)
+    global_part(ctx, sp, bsdf, wo, 0, None, false, scratch)
 }
