@@ -2,8 +2,10 @@
 //!
 //! Every SIMD kernel has a scalar twin with the same signature: packet BVH traversal
 //! ([`crate::geometry::packet`]) and single-ray traversal ([`crate::geometry::traverse`]); the
-//! 8-wide and one-at-a-time photon lookups ([`crate::photon_map`]). The twins make the same
-//! decisions (same hits, same photons found); sums over photons differ only in rounding order.
+//! 8-wide and one-at-a-time photon lookups ([`crate::photon_map`]); query packets of fixed-radius
+//! lookups ([`crate::photon_map::query_packet`], whose twin runs the lookups one at a time). The
+//! twins make the same decisions (same hits, same photons found); sums over photons differ only
+//! in rounding order.
 //! The renderer runs [`CodePath::Simd`] unless `code_path = "scalar"` is set.
 
 use crate::geometry::bvh::{Bvh, Hit, TriangleColumns};

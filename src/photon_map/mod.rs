@@ -27,8 +27,8 @@
 //!
 //! Files: [`kernel`] (the density kernels), `packing` (key and RGBE codecs), `tree` (build and
 //! walk), `filter` (which photons a lookup may use), [`knn`] (k-nearest lookups and estimates),
-//! [`radius`] (fixed-radius estimates), `sum` (the kernel sums); each SIMD kernel beside its
-//! scalar twin.
+//! [`radius`] (fixed-radius estimates), [`query_packet`] (up to 8 fixed-radius estimates sharing
+//! one walk), `sum` (the kernel sums); each SIMD kernel beside its scalar twin.
 
 pub mod boundary;
 mod candidates;
