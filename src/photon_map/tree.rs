@@ -25,7 +25,8 @@ const BLOCK: usize = 8;
 pub(super) const LEAF: u32 = 1 << 31;
 
 /// Depth of the walk's stack: each node pushes at most 7 more entries than it pops, and a tree of
-/// 2³² photons is 10 nodes deep.
+/// 2³² photons is 10 nodes deep. A query packet's walk (depth first through the same nodes) is
+/// bounded alike.
 pub(super) const STACK: usize = 72;
 
 /// One node: its children's boxes in SoA form and what each child is. Empty slots have inverted

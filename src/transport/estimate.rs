@@ -16,8 +16,8 @@ use glam::Vec3;
 use std::sync::atomic::Ordering;
 
 /// A density estimate at a surface point, planned: computed already, or a fixed-radius lookup
-/// with Lambertian reflectance left to run — alone ([`Planned::finish`]) or with up to 7 others
-/// in a query packet that shares one walk of the map ([`run_packet`]).
+/// with reflectance kd/π ([`FixedLookup`]) left to run — alone ([`Planned::finish`]) or with up
+/// to 7 others in a query packet that shares one walk of the map ([`run_packet`]).
 #[derive(Clone, Copy)]
 pub enum Planned<'m> {
     /// The estimate.
@@ -26,7 +26,8 @@ pub enum Planned<'m> {
     Fixed(FixedLookup<'m>),
 }
 
-/// A fixed-radius estimate (a progressive pass's) with Lambertian reflectance, ready to run.
+/// A fixed-radius estimate (a progressive pass's) whose reflectance is kd/π above the surface
+/// (Lambertian, or a glossy material's base), ready to run.
 #[derive(Clone, Copy)]
 pub struct FixedLookup<'m> {
     /// The map it reads.
@@ -61,14 +62,14 @@ impl Planned<'_> {
 /// `out` (each identical to the bit to the lookup run alone).
 ///
 /// # Panics
-/// If the lookups read different maps, or there are more than [`PACKET`].
+/// If the lookups read different maps, there are more than [`PACKET`], or `out` is shorter.
 pub fn run_packet(ctx: &Context, lookups: &[FixedLookup<'_>], out: &mut [Estimate]) {
     let Some(first) = lookups.first() else { return };
     assert!(lookups.iter().all(|q| std::ptr::eq(q.map, first.map)), "one packet, one map");
     let at = |j: usize| lookups.get(j).unwrap_or(first);
     let cuts: [_; PACKET] = std::array::from_fn(|j| {
-        let q = at(j);
-        q.corrected.then(|| open_edge_cuts(ctx.scene, q.tri, q.lookup.p, q.lookup.r_max))
+        let q = lookups.get(j).filter(|q| q.corrected)?;
+        Some(open_edge_cuts(ctx.scene, q.tri, q.lookup.p, q.lookup.r_max))
     });
     let queries: [RadiusQuery<'_>; PACKET] = std::array::from_fn(|j| {
         let q = at(j);
@@ -88,8 +89,8 @@ pub fn run_packet(ctx: &Context, lookups: &[FixedLookup<'_>], out: &mut [Estimat
 }
 
 /// Radiance estimate from `map` at `sp` toward `wo` with `k` photons within `radius`, ignoring
-/// photons with any `mask` flag: computed, or (a fixed radius, Lambertian reflectance, no
-/// visibility test) planned.
+/// photons with any `mask` flag: computed, or (a fixed radius, reflectance kd/π above the
+/// surface, no visibility test) planned.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn plan_map<'m>(
@@ -153,8 +154,9 @@ fn plan_map<'m>(
     Planned::Done(e)
 }
 
-/// The open edges of the flat region of triangle `tri` within `r` of `p` on it, as cuts of its estimate's disk (at most
-/// [`MAX_EXTRA_CUTS`]; a region has few), and how many there are.
+/// The open edges of the flat region of triangle `tri` within `r` of the point `p` on it, as cuts
+/// of the disk of an estimate at `p` (at most [`MAX_EXTRA_CUTS`]; a region has few), and how many
+/// there are.
 #[inline]
 fn open_edge_cuts(scene: &Scene, tri: u32, p: Vec3, r: f32) -> ([Cut; MAX_EXTRA_CUTS], usize) {
     let mut cuts = [Cut::default(); MAX_EXTRA_CUTS];

@@ -85,14 +85,12 @@ fn estimate_at_diffuse_hits(
             }
         }
         packet.run(&ctx, &mut done);
-        // By map, then Morton code, ties in lane order; the low half is the place in `deferred`.
+        // By Morton code, ties in lane order; the low half is the place in `deferred`. (A packet
+        // holds lookups of one map: `Packet::add` runs it when the map changes.)
         let mut order: Vec<u64> = deferred
             .iter()
             .enumerate()
-            .map(|(k, (_, q))| {
-                let caustic = u64::from(std::ptr::eq(q.map, &maps.0.caustic));
-                caustic << 62 | u64::from(morton_key(q.lookup.p, ctx.scene.bounds)) << 32 | k as u64
-            })
+            .map(|(k, (_, q))| u64::from(morton_key(q.lookup.p, ctx.scene.bounds)) << 32 | k as u64)
             .collect();
         order.sort_unstable();
         for o in &order {
