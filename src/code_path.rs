@@ -42,21 +42,32 @@ impl CodePath {
     }
 }
 
+/// The Morton code of the cell holding `p` in a grid of `cells`³ (at most 1024) over `bounds`:
+/// points close in code are close in space. Points outside go to the nearest cell, NaN
+/// coordinates to cell 0 (`as` saturates).
+#[must_use]
+pub fn morton_code(p: Vec3, bounds: (Vec3, Vec3), cells: u32) -> u32 {
+    let ext = (bounds.1 - bounds.0).max(Vec3::splat(f32::MIN_POSITIVE));
+    let last = (cells.min(1024) - 1) as f32;
+    let cell = ((p - bounds.0) / ext * cells as f32).clamp(Vec3::ZERO, Vec3::splat(last));
+    // Bit i of each 10-bit coordinate to bit 3i.
+    let spread = |v: f32| {
+        let mut x = v as u32 & 1023;
+        x = (x | x << 16) & 0x0300_00ff;
+        x = (x | x << 8) & 0x0300_f00f;
+        x = (x | x << 4) & 0x030c_30c3;
+        (x | x << 2) & 0x0924_9249
+    };
+    spread(cell.x) | spread(cell.y) << 1 | spread(cell.z) << 2
+}
+
 /// The coherence key of a ray: direction octant in the top 3 bits, then the Morton code of its
 /// origin's cell in a 64³ grid over `bounds`, then the direction within the octant quantised
 /// to 4 × 4 bins — so that a run of 8 rays in key order starts close together and points alike.
 #[must_use]
 pub fn coherence_key(o: Vec3, d: Vec3, bounds: (Vec3, Vec3)) -> u32 {
     let octant = u32::from(d.x < 0.0) | u32::from(d.y < 0.0) << 1 | u32::from(d.z < 0.0) << 2;
-    let ext = (bounds.1 - bounds.0).max(Vec3::splat(f32::MIN_POSITIVE));
-    let cell = ((o - bounds.0) / ext * 64.0).clamp(Vec3::ZERO, Vec3::splat(63.0));
-    let spread = |v: f32| {
-        let mut x = v as u32 & 63;
-        x = (x | x << 8) & 0x0000_f00f;
-        x = (x | x << 4) & 0x0000_30c3;
-        (x | x << 2) & 0x0000_9249
-    };
-    let morton = spread(cell.x) | spread(cell.y) << 1 | spread(cell.z) << 2;
+    let morton = morton_code(o, bounds, 64);
     let a = d.abs() / d.abs().element_sum().max(f32::MIN_POSITIVE);
     let bin = |v: f32| ((v * 4.0) as u32).min(3);
     let dir = bin(a.x) << 2 | bin(a.y);

@@ -18,7 +18,7 @@
 
 use super::boundary::{Cut, Neighbours};
 use super::filter::Normals8;
-use super::sum::Decoded8;
+use super::sum::{reduce3, Decoded8};
 use super::tree::{Node, LEAF, STACK};
 use super::{Estimate, Kernel, Lookup, PhotonMap, Reflectance};
 use crate::code_path::CodePath;
@@ -95,7 +95,7 @@ impl PhotonMap {
         // Queries a single estimate would answer with nothing: no photons, no radius, or a point
         // at no finite distance from any photon.
         let live = queries.iter().enumerate().fold(0u8, |m, (j, q)| {
-            let ok = !self.nodes.is_empty() && r2[j] > 0.0 && r2[j].is_finite() && q.lookup.p.is_finite();
+            let ok = self.fixed_radius2(&q.lookup).is_some() && q.lookup.p.is_finite();
             m | u8::from(ok) << j
         });
         let mut sums = [Sums::default(); PACKET];
@@ -124,7 +124,7 @@ impl PhotonMap {
             }
         }
         for (j, q) in queries.iter().enumerate() {
-            out[j] = self.finish::<BIAS>(&q.lookup, r2[j], q.edges, &sums[j]);
+            out[j] = self.finish::<BIAS>(&q.lookup, q.edges, &sums[j]);
         }
     }
 
@@ -209,12 +209,11 @@ impl PhotonMap {
     }
 
     /// One query's estimate from its sums, as [`Self::estimate_radius_with`] finishes it.
-    fn finish<const BIAS: bool>(&self, q: &Lookup, r2: f32, edges: Option<&[Cut]>, s: &Sums) -> Estimate {
-        if self.is_empty() || !(r2 > 0.0) || !r2.is_finite() {
+    fn finish<const BIAS: bool>(&self, q: &Lookup, edges: Option<&[Cut]>, s: &Sums) -> Estimate {
+        let Some(r2) = self.fixed_radius2(q) else {
             return Estimate { radius: q.r_max, ..Default::default() };
-        }
-        let reduce = |v: [f32x8; 3]| Vec3::new(v[0].reduce_add(), v[1].reduce_add(), v[2].reduce_add());
-        let sums = [Vec3::ZERO + reduce(s.radiance), Vec3::ZERO + reduce(s.bias)];
+        };
+        let sums = [Vec3::ZERO + reduce3(s.radiance), Vec3::ZERO + reduce3(s.bias)];
         self.fixed_estimate::<BIAS>(q, r2, edges, &s.neighbours, sums, s.count, s.rejected)
     }
 }

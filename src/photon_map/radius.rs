@@ -3,6 +3,7 @@
 //! with the estimate's bias from the same photons ([`Kernel::bias_normalisation`]).
 
 use super::boundary::{Coverage, Cut, Neighbours};
+use super::sum::reduce3;
 use super::tree::Walk;
 use super::{Estimate, Kernel, Lookup, PhotonMap, Reflectance, Test};
 use crate::code_path::CodePath;
@@ -50,10 +51,9 @@ impl PhotonMap {
         f: Reflectance<'_>,
         on_surface: Option<&[Cut]>,
     ) -> Estimate {
-        let r2 = q.r_max * q.r_max;
-        if self.is_empty() || !(r2 > 0.0) || !r2.is_finite() {
+        let Some(r2) = self.fixed_radius2(q) else {
             return Estimate { radius: q.r_max, ..Default::default() };
-        }
+        };
         let (mut count, mut rejected) = (0u32, 0u32);
         let mut neighbours = Neighbours::default();
         let (mut sum, mut bias) = (Vec3::ZERO, Vec3::ZERO);
@@ -120,8 +120,7 @@ impl PhotonMap {
                 }
             }
         }
-        let reduce = |v: [f32x8; 3]| Vec3::new(v[0].reduce_add(), v[1].reduce_add(), v[2].reduce_add());
-        let (sum, bias) = (sum + reduce(sum8), bias + reduce(bias8));
+        let (sum, bias) = (sum + reduce3(sum8), bias + reduce3(bias8));
         self.fixed_estimate::<BIAS>(q, r2, on_surface, &neighbours, [sum, bias], count, rejected)
     }
 

@@ -34,7 +34,21 @@ impl Decoded8 {
     }
 }
 
+/// The sum of each of three 8-lane columns (per-channel sums of an estimate).
+#[inline]
+pub(super) fn reduce3(v: [f32x8; 3]) -> Vec3 {
+    Vec3::new(v[0].reduce_add(), v[1].reduce_add(), v[2].reduce_add())
+}
+
 impl PhotonMap {
+    /// The squared radius of the fixed-radius lookup `q` if it can find photons: a positive,
+    /// finite radius in a map that holds some.
+    #[inline]
+    pub(super) fn fixed_radius2(&self, q: &Lookup) -> Option<f32> {
+        let r2 = q.r_max * q.r_max;
+        (!self.is_empty() && r2 > 0.0 && r2.is_finite()).then_some(r2)
+    }
+
     /// The kernel estimate over `found` within squared radius `r2`.
     #[inline]
     pub(super) fn sum_estimate(

@@ -6,6 +6,7 @@
 
 use super::queues::PathKind;
 use super::{par_lanes, CameraWork, Maps, Shared, StageStats, GATHER_CHUNK};
+use crate::code_path::morton_code;
 use crate::film::Term;
 use crate::material::Bsdf;
 use crate::photon_map::query_packet::PACKET;
@@ -90,7 +91,7 @@ fn estimate_at_diffuse_hits(
         let mut order: Vec<u64> = deferred
             .iter()
             .enumerate()
-            .map(|(k, (_, q))| u64::from(morton_key(q.lookup.p, ctx.scene.bounds)) << 32 | k as u64)
+            .map(|(k, (_, q))| u64::from(morton_code(q.lookup.p, ctx.scene.bounds, 1024)) << 32 | k as u64)
             .collect();
         order.sort_unstable();
         for o in &order {
@@ -147,21 +148,6 @@ impl<'m> Packet<'m> {
         self.lookups.clear();
         self.slots.clear();
     }
-}
-
-/// A point's Morton code in a 1024³ grid over `bounds`: points close in code are close in space.
-fn morton_key(p: Vec3, bounds: (Vec3, Vec3)) -> u32 {
-    let ext = (bounds.1 - bounds.0).max(Vec3::splat(f32::MIN_POSITIVE));
-    // NaN points go to cell 0 (`as` saturates); their lookups find nothing either way.
-    let cell = ((p - bounds.0) / ext * 1024.0).clamp(Vec3::ZERO, Vec3::splat(1023.0));
-    let spread = |v: f32| {
-        let mut x = v as u32 & 1023;
-        x = (x | x << 16) & 0x0300_00ff;
-        x = (x | x << 8) & 0x0300_f00f;
-        x = (x | x << 4) & 0x030c_30c3;
-        (x | x << 2) & 0x0924_9249
-    };
-    spread(cell.x) | spread(cell.y) << 1 | spread(cell.z) << 2
 }
 
 /// Caustic-map estimates at the diffuse hits of camera, glossy and near-landed gather rays.
