@@ -5,7 +5,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec3;
 use photonwave::code_path::CodePath;
-use photonwave::photon_map::{Filter, Lookup, Reflectance};
+use photonwave::photon_map::{Filter, Lookup, Nearest, Reflectance};
 use photonwave::reference::build_maps;
 use photonwave::rng::{Domain, Sampler};
 use photonwave::sampling::uniform_sphere;
@@ -61,7 +61,7 @@ fn density(c: &mut Criterion) {
     let mut g = c.benchmark_group("density");
     g.throughput(Throughput::Elements(queries.len() as u64));
     g.bench_function(BenchmarkId::new("knn", settings.k), |b| {
-        let mut scratch = Vec::new();
+        let mut scratch = Nearest::default();
         b.iter(|| {
             let mut sum = Vec3::ZERO;
             for (p, n) in &queries {

@@ -10,7 +10,7 @@ use glam::Vec3;
 use photonwave::bench::RaySets;
 use photonwave::code_path::CodePath;
 use photonwave::geometry::packet::{closest_packets, occluded_packets};
-use photonwave::photon_map::{Filter, Lookup, Reflectance};
+use photonwave::photon_map::{Filter, Lookup, Nearest, Reflectance};
 use photonwave::reference::build_maps;
 use photonwave::scene::file::load_scene;
 use photonwave::settings::Settings;
@@ -72,7 +72,7 @@ fn density(c: &mut Criterion) {
             |p, n, k, r_max| Lookup { p, k, r_max, kernel: settings.kernel, filter: Filter { n, flags_mask: 0 } };
         let f = |n| Reflectance::Hemisphere { value: Vec3::splat(0.2), ng: n };
         g.bench_function(BenchmarkId::new("knn", &name), |b| {
-            let mut scratch = Vec::new();
+            let mut scratch = Nearest::default();
             b.iter(|| {
                 let mut sum = Vec3::ZERO;
                 for &(p, n) in &queries {

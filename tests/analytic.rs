@@ -7,7 +7,7 @@ use common::*;
 use glam::{Vec2, Vec3};
 use photonwave::code_path::CodePath;
 use photonwave::material::{Bsdf, Material, SurfaceFrame};
-use photonwave::photon_map::{Filter, Lookup, Photon, PhotonMap, Reflectance};
+use photonwave::photon_map::{Filter, Lookup, Nearest, Photon, PhotonMap, Reflectance};
 use photonwave::progress::NoProgress;
 use photonwave::reference::photons::trace_photons;
 use photonwave::rng::{Domain, Sampler};
@@ -144,7 +144,7 @@ fn every_kernel_returns_a_uniform_density() {
         }
     }
     let map = PhotonMap::build(photons);
-    let mut scratch = Vec::new();
+    let mut scratch = Nearest::default();
     for kernel in [Kernel::Box, Kernel::Cone, Kernel::Epanechnikov] {
         let q =
             Lookup { p: Vec3::ZERO, k: 100_000, r_max: 50.0 * h, kernel, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
@@ -172,7 +172,7 @@ fn knn_estimate_is_unbiased_on_a_uniform_plane() {
         })
         .collect();
     let map = PhotonMap::build(photons);
-    let mut scratch = Vec::new();
+    let mut scratch = Nearest::default();
     let (mut sum, mut q) = (0.0f64, 0);
     for i in 0..80 {
         for j in 0..80 {
@@ -321,7 +321,7 @@ fn directional_light_irradiance_is_cosine_weighted_by_both_methods() {
         };
         let job = job(&scene, &settings);
         let ctx = Context::new(&scene, &maps, &job);
-        let mut scratch = Vec::new();
+        let mut scratch = Nearest::default();
         let mut photon_sum = 0.0;
         for i in 0..8 {
             for j in 0..8 {

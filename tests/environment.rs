@@ -9,7 +9,7 @@ use common::*;
 use glam::{Vec2, Vec3};
 use photonwave::code_path::CodePath;
 use photonwave::material::{Bsdf, Material, SurfaceFrame};
-use photonwave::photon_map::{Filter, Lookup, PhotonMap, Reflectance};
+use photonwave::photon_map::{Filter, Lookup, Nearest, PhotonMap, Reflectance};
 use photonwave::progress::NoProgress;
 use photonwave::reference::photons::trace_photons;
 use photonwave::rng::{Domain, Sampler};
@@ -83,7 +83,7 @@ fn photon_estimate(scene: &Scene) -> f32 {
     )
     .photons;
     let maps = PhotonMaps { global: PhotonMap::build(photons), ..Default::default() };
-    let mut scratch = Vec::new();
+    let mut scratch = Nearest::default();
     let mut sum = 0.0;
     for i in 0..8 {
         for j in 0..8 {

@@ -18,15 +18,15 @@ use std::sync::Arc;
 
 /// (scene, engine, passes) → FNV-1a 64 of the film's f32 bits.
 const GOLDEN: &[(&str, &str, u32, u64)] = &[
-    ("cornell-box.toml", "wavefront", 1, 0x435f1804119a3d92),
-    ("cornell-box.toml", "reference", 1, 0x5c8c3379039cea2b),
+    ("cornell-box.toml", "wavefront", 1, 0x9f5591f3eaedbb36),
+    ("cornell-box.toml", "reference", 1, 0xbcdd6e556e63406f),
     ("cornell-box.toml", "path", 1, 0xd3159bbc928efad9),
-    ("cornell-spheres.toml", "wavefront", 1, 0x034173f33630ad6e),
-    ("cornell-spheres.toml", "reference", 1, 0x9f555459835a5c7f),
+    ("cornell-spheres.toml", "wavefront", 1, 0xde2b603c9395a260),
+    ("cornell-spheres.toml", "reference", 1, 0xfdc0d5f3c05d1eeb),
     ("cornell-spheres.toml", "wavefront", 3, 0x6bd7632c75ac9b09),
     ("cornell-spheres.toml", "reference", 3, 0x6cbe9a5f6836119d),
-    ("hard/furnace-materials.toml", "wavefront", 1, 0xd64f5f70d1adc150),
-    ("hard/furnace-materials.toml", "reference", 1, 0x3350babe3afe8869),
+    ("hard/furnace-materials.toml", "wavefront", 1, 0xd9a53996592b365d),
+    ("hard/furnace-materials.toml", "reference", 1, 0x8b2a713759699258),
     ("hard/nested.toml", "wavefront", 2, 0xb991a05c2d28d3cd),
 ];
 

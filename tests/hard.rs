@@ -522,7 +522,7 @@ fn no_photon_leaves_a_watertight_mesh() {
 fn no_photon_crosses_a_corner() {
     photons_turned_away_are_counted_alike();
     use photonwave::code_path::CodePath;
-    use photonwave::photon_map::{Filter, Lookup, PhotonMap, Reflectance};
+    use photonwave::photon_map::{Filter, Lookup, Nearest, PhotonMap, Reflectance};
     use photonwave::settings::Kernel;
     let loaded = hard("corner.toml");
     let scene = Arc::new(loaded.scene);
@@ -538,10 +538,10 @@ fn no_photon_crosses_a_corner() {
             assert!(others > 100, "{name}, {side}: only {others} photons of the other surface nearby");
             for set in [CodePath::Simd, CodePath::Scalar] {
                 let q = Lookup { p, k: 64, r_max: 0.2, kernel: Kernel::Box, filter: Filter { n, flags_mask: 0 } };
-                let mut near = Vec::new();
-                map.nearest(set, &q, &mut near);
+                let mut scratch = Nearest::default();
+                let near = map.nearest(set, &q, &mut scratch);
                 assert!(!near.is_empty(), "{name}, {side}: no photon found");
-                for &(_, i) in &near {
+                for &(_, i) in near {
                     let ph = map.photon(i as usize);
                     assert!(
                         ph.normal.dot(n) > 0.9,
@@ -557,7 +557,8 @@ fn no_photon_crosses_a_corner() {
                 assert_eq!(e.rejected as usize, others, "{name}, {side}, {set:?}");
                 // The k-nearest search counts those it met while its radius shrank, alike in both
                 // kernel sets.
-                let knn = |set| map.estimate(set, &q, Reflectance::Constant(Vec3::ONE), &mut Vec::new()).rejected;
+                let knn =
+                    |set| map.estimate(set, &q, Reflectance::Constant(Vec3::ONE), &mut Nearest::default()).rejected;
                 assert_eq!(knn(CodePath::Simd), knn(CodePath::Scalar), "{name}, {side}");
                 assert!(
                     (e.radiance - e_own.radiance).abs().max_element() <= 1e-5 * e_own.radiance.max_element(),

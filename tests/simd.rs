@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use glam::Vec3;
 use photonwave::code_path::CodePath;
-use photonwave::photon_map::{flags, Filter, Lookup, Photon, PhotonMap, Reflectance};
+use photonwave::photon_map::{flags, Filter, Lookup, Nearest, Photon, PhotonMap, Reflectance};
 use photonwave::rng::{Domain, Sampler};
 use photonwave::sampling::uniform_sphere;
 use photonwave::settings::{Kernel, Settings};
@@ -77,15 +77,15 @@ fn close(a: Vec3, b: Vec3) -> bool {
 #[test]
 fn simd_lookups_find_the_same_photons_as_the_scalar_twins() {
     let map = PhotonMap::build(corner_photons(30_000));
-    let (mut a, mut b) = (vec![], vec![]);
+    let (mut a, mut b) = (Nearest::default(), Nearest::default());
     let glossy = |wi: Vec3| Vec3::splat(wi.y.max(0.0).powi(8));
     for (qi, (p, n)) in queries().into_iter().enumerate() {
         for (k, r_max, flags_mask) in [(1, 0.05, 0), (16, 0.02, 0), (64, 0.1, flags::DIRECT), (200, 0.01, 0)] {
             for kernel in [Kernel::Box, Kernel::Cone, Kernel::Epanechnikov] {
                 let q = Lookup { p, k, r_max, kernel, filter: Filter { n, flags_mask } };
-                map.nearest(CodePath::Simd, &q, &mut a);
-                map.nearest(CodePath::Scalar, &q, &mut b);
-                assert_eq!(sorted(a.clone()), sorted(b.clone()), "query {qi} {q:?}: different photons");
+                let simd = map.nearest(CodePath::Simd, &q, &mut a).to_vec();
+                let scalar = map.nearest(CodePath::Scalar, &q, &mut b).to_vec();
+                assert_eq!(sorted(simd), sorted(scalar), "query {qi} {q:?}: different photons");
                 let lambert = Reflectance::Hemisphere { value: Vec3::splat(0.3), ng: n };
                 for f in [Reflectance::Constant(Vec3::ONE), lambert, Reflectance::PerPhoton(&glossy)] {
                     let es = map.estimate(CodePath::Simd, &q, f, &mut a);
@@ -163,9 +163,7 @@ fn fixed_radius_lookups_find_what_a_brute_force_scan_finds() {
         };
         let e = empty.estimate_radius(set, &q, f);
         assert_eq!((e.count, e.rejected, e.radiance), (0, 0, Vec3::ZERO), "{set:?}");
-        let mut out = vec![];
-        empty.nearest(set, &Lookup { k: 8, ..q }, &mut out);
-        assert!(out.is_empty(), "{set:?}");
+        assert!(empty.nearest(set, &Lookup { k: 8, ..q }, &mut Nearest::default()).is_empty(), "{set:?}");
     }
 }
 
@@ -288,9 +286,8 @@ fn lookups_honour_the_radius_and_the_filters_exactly() {
             kernel: Kernel::Box,
             filter: Filter { n: Vec3::Y, flags_mask: flags::DIRECT | flags::CAUSTIC },
         };
-        let mut out = vec![];
-        map.nearest(set, &q, &mut out);
-        assert_eq!(out.len(), 4, "{set:?}: only the four at half the radius");
+        let mut out = Nearest::default();
+        assert_eq!(map.nearest(set, &q, &mut out).len(), 4, "{set:?}: only the four at half the radius");
         let e = map.estimate_radius(set, &q, Reflectance::Constant(Vec3::ONE));
         assert_eq!(e.count, 4, "{set:?}");
         // Box kernel: 4 photons of unit power over πr².
@@ -299,8 +296,7 @@ fn lookups_honour_the_radius_and_the_filters_exactly() {
         // Non-finite queries find nothing and stay finite.
         for p in [Vec3::splat(f32::NAN), Vec3::splat(f32::INFINITY), Vec3::new(f32::NEG_INFINITY, 0.0, 0.0)] {
             let q = Lookup { p, ..q };
-            map.nearest(set, &q, &mut out);
-            assert!(out.is_empty(), "{set:?}: {p:?} found photons");
+            assert!(map.nearest(set, &q, &mut out).is_empty(), "{set:?}: {p:?} found photons");
             let e = map.estimate(set, &q, Reflectance::Constant(Vec3::ONE), &mut out);
             assert!(e.radiance.is_finite() && e.count == 0, "{set:?}: {p:?}");
         }

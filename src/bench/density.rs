@@ -62,7 +62,7 @@ const QUERIES: usize = 65_536;
 /// `radius`: every photon within a fixed radius, the median radius the k-NN lookups found.
 pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usize) -> Vec<DensityRow> {
     use crate::code_path::CodePath;
-    use crate::photon_map::{Filter, Lookup, PhotonMap, Reflectance};
+    use crate::photon_map::{Filter, Lookup, Nearest, PhotonMap, Reflectance};
     use crate::reference::build_maps;
     use crate::settings::Settings;
     if sets.hits.is_empty() {
@@ -92,7 +92,7 @@ pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize,
             CHUNK,
             threads,
             |r| {
-                let mut scratch = Vec::new();
+                let mut scratch = Nearest::default();
                 queries[r]
                     .iter()
                     .map(|&(p, n)| map.estimate(set, &lookup(p, n, settings.k as usize, r_max), f(n), &mut scratch))

@@ -56,7 +56,7 @@ impl PhotonMap {
                 tested += (hi - lo) as u64;
             }
         } else {
-            self.nearest_walk::<true>(CodePath::Scalar, q, &mut Vec::new(), &mut tested);
+            self.walk_nearest::<true>(CodePath::Scalar, q, &mut super::nearest::Nearest::default(), &mut tested);
         }
         tested
     }

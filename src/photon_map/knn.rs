@@ -1,119 +1,130 @@
 //! k-nearest-neighbour lookups and Jensen's density estimate over them (the (k−1)/(πr²) rule of
-//! the module notes), optionally counting only the photons visible from the query. The SIMD
-//! kernel and its scalar twin share the walk and the k-selection and visit photons in the same
-//! order, so both find the same photons.
+//! the module notes), optionally counting only the photons visible from the query. The search is
+//! [`super::nearest`]'s; the SIMD estimate sums the k − 1 nearest straight from the blocks the
+//! walk kept (no per-photon gather), its scalar twin one photon at a time.
 
+use super::nearest::{Kth, Nearest};
 use super::packing::key_normal;
-use super::tree::Walk;
-use super::{Estimate, Lookup, PhotonMap, Reflectance, Test};
+use super::sum::reduce3;
+use super::{Estimate, Lookup, PhotonMap, Reflectance};
 use crate::code_path::CodePath;
 use glam::Vec3;
+use wide::{f32x8, u32x8};
 
 impl PhotonMap {
-    /// The `k` nearest photons to `q.p` within `q.r_max` that pass `q.filter`, as
-    /// (distance², index), unordered, into `out`.
-    pub fn nearest(&self, set: CodePath, q: &Lookup, out: &mut Vec<(f32, u32)>) {
-        self.nearest_counted(set, q, out);
+    /// The `q.k` nearest photons to `q.p` within `q.r_max` that pass `q.filter`, as
+    /// (distance², index), unordered (all of them within the radius when fewer than k are).
+    pub fn nearest<'s>(&self, set: CodePath, q: &Lookup, scratch: &'s mut Nearest) -> &'s [(f32, u32)] {
+        self.nearest_counted(set, q, scratch);
+        &scratch.found
     }
 
-    /// [`Self::nearest`], returning how many photons the normal test turned away (see
-    /// [`Estimate::rejected`]); both code paths count the same photons.
-    #[inline]
-    pub(super) fn nearest_counted(&self, set: CodePath, q: &Lookup, out: &mut Vec<(f32, u32)>) -> u32 {
-        self.nearest_walk::<false>(set, q, out, &mut 0)
-    }
-
-    /// [`Self::nearest_counted`], adding the photons its walk tests to `tested` when `COUNT`.
-    #[inline]
-    pub(super) fn nearest_walk<const COUNT: bool>(
-        &self,
-        set: CodePath,
-        q: &Lookup,
-        out: &mut Vec<(f32, u32)>,
-        tested: &mut u64,
-    ) -> u32 {
-        out.clear();
-        if q.k == 0 || self.is_empty() {
-            return 0;
-        }
-        let mut rejected = 0u32;
-        let k = q.k;
-        // Candidates gather unsorted in `out`; when 2k have gathered, the k nearest are selected
-        // (O(k)) and r² shrinks to the k-th distance. Amortised O(1) per candidate, no heap.
-        // Order by (distance², index) as one integer: distances are non-negative (never −0 or
-        // NaN here), so their bit patterns order as the values do.
-        let by_distance = |c: &(f32, u32)| u64::from(c.0.to_bits()) << 32 | u64::from(c.1);
-        let offer = |out: &mut Vec<(f32, u32)>, r2: &mut f32, d2: f32, i: usize| {
-            if k == 1 {
-                // The nearest alone (precomputed-irradiance lookups): keep the best so far.
-                out.clear();
-                out.push((d2, i as u32));
-                *r2 = d2;
-                return;
-            }
-            out.push((d2, i as u32));
-            if out.len() == 2 * k {
-                out.select_nth_unstable_by_key(k - 1, by_distance);
-                out.truncate(k);
-                *r2 = out[k - 1].0;
-            }
-        };
-        let mut r2 = q.r_max * q.r_max;
-        let mut walk = Walk::<true>::new(self, set, q.p);
-        while let Some((lo, hi)) = walk.next(self, r2) {
-            if COUNT {
-                *tested += (hi - lo) as u64;
-            }
-            if set == CodePath::Simd {
-                let v = self.accepts8(lo, q.p, r2, &q.filter);
-                let d2 = v.d2.to_array();
-                // Lane order, as the scalar twin walks them: r² may have shrunk since the
-                // 8-wide test, so each lane is re-checked at its turn.
-                let mut all = v.bits | v.turned;
-                while all != 0 {
-                    let l = all.trailing_zeros() as usize;
-                    all &= all - 1;
-                    if d2[l] < r2 {
-                        if v.bits >> l & 1 == 1 {
-                            offer(out, &mut r2, d2[l], lo + l);
-                        } else {
-                            rejected += 1;
-                        }
-                    }
-                }
-            } else {
-                for i in lo..hi {
-                    let d2 = self.d2(i, q.p);
-                    if d2 < r2 {
-                        match Self::test(self.key[i], &q.filter) {
-                            Test::Accepted => offer(out, &mut r2, d2, i),
-                            Test::Normal => rejected += 1,
-                            Test::Flags => {}
-                        }
-                    }
+    /// [`Self::nearest`] into `scratch.found`, returning how many photons the normal test turned
+    /// away (see [`Estimate::rejected`]); both code paths count the same photons.
+    pub(super) fn nearest_counted(&self, set: CodePath, q: &Lookup, scratch: &mut Nearest) -> u32 {
+        let walked = self.walk_nearest::<false>(set, q, scratch, &mut 0);
+        let last =
+            if walked.live >= q.k && q.k > 0 { Some(scratch.kth(set, q.k, walked.live, walked.r2)) } else { None };
+        let mut found = std::mem::take(&mut scratch.found);
+        found.clear();
+        for (d2, &base) in scratch.d2.iter().zip(&scratch.base) {
+            for (l, &d) in d2.iter().enumerate() {
+                let i = base + l as u32;
+                let take = match last {
+                    Some(kth) => kth.before(d, i) || (d, i) == (kth.d2, kth.index),
+                    None => d < walked.r2,
+                };
+                if take {
+                    found.push((d, i));
                 }
             }
         }
-        if out.len() > k {
-            out.select_nth_unstable_by_key(k - 1, by_distance);
-            out.truncate(k);
-        }
-        rejected
+        scratch.found = found;
+        walked.rejected
     }
 
     /// Reflected radiance at `q.p` from its k nearest photons: Σ f(wi_p)·Φ_p·K over the
     /// (k−1)-of-k rule above, as if the whole disk lay on the query's surface (k-nearest
     /// estimates are not boundary-corrected: measured no better, BENCHMARKS.md).
     #[inline]
-    pub fn estimate(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>, scratch: &mut Vec<(f32, u32)>) -> Estimate {
+    pub fn estimate(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>, scratch: &mut Nearest) -> Estimate {
         if self.is_empty() {
             return Estimate { radius: q.r_max, ..Default::default() };
         }
-        let rejected = self.nearest_counted(set, q, scratch);
-        let Some(r2) = Self::knn_radius2(q, scratch) else {
-            return Estimate { radius: 0.0, rejected, ..Default::default() };
+        if q.k == 0 {
+            return Estimate { radius: 0.0, ..Default::default() };
+        }
+        let walked = self.walk_nearest::<false>(set, q, scratch, &mut 0);
+        let rejected = walked.rejected;
+        // The k-th photon defines r and lies on the boundary: the k − 1 before it are summed.
+        // With fewer than k within the maximum radius, all of them over that radius.
+        let (r2, last, count) = if walked.live >= q.k {
+            let kth = scratch.kth(set, q.k, walked.live, walked.r2);
+            (kth.d2, Some(kth), q.k - 1)
+        } else {
+            (q.r_max * q.r_max, None, walked.live)
         };
-        Estimate { rejected, ..self.sum_estimate(set, q, r2, f, scratch) }
+        if !(r2 > 0.0) {
+            return Estimate { radius: 0.0, rejected, ..Default::default() };
+        }
+        let sum = match set {
+            CodePath::Simd => self.sum_kept8(scratch, r2, last, q, f),
+            CodePath::Scalar => self.sum_kept(scratch, r2, last, q, f),
+        };
+        Estimate {
+            radiance: sum * q.kernel.normalisation(r2),
+            radius: r2.sqrt(),
+            bias: Vec3::ZERO,
+            count: count as u32,
+            rejected,
+        }
+    }
+
+    /// Σ f·Φ·K over the candidates in `buf` before `last` (or all within `r2` when `None`), 8
+    /// lanes of a kept block at a time, loaded straight from the map's columns.
+    fn sum_kept8(&self, buf: &Nearest, r2: f32, last: Option<Kth>, q: &Lookup, f: Reflectance<'_>) -> Vec3 {
+        let bound = f32x8::splat(r2);
+        let mut acc = [f32x8::ZERO; 3];
+        for (d2, &base) in buf.d2.iter().zip(&buf.base) {
+            let d = f32x8::from(*d2);
+            let mut keep = d.simd_lt(bound);
+            if let Some(kth) = last {
+                // Photons exactly as far as the k-th come before it by index.
+                let ties = d.simd_eq(bound);
+                if ties.any() {
+                    let index = u32x8::splat(base) + u32x8::from([0, 1, 2, 3, 4, 5, 6, 7]);
+                    let earlier: f32x8 = wide::bytemuck::cast(u32x8::splat(kth.index).simd_gt(index));
+                    keep |= ties & earlier;
+                }
+            }
+            if keep.none() {
+                continue;
+            }
+            let base = base as usize;
+            let c = Self::contribution8(self.key8(base), self.power8(base), keep, d, r2, q.kernel, f);
+            for (a, v) in acc.iter_mut().zip(c) {
+                *a += v;
+            }
+        }
+        reduce3(acc)
+    }
+
+    /// Scalar twin of [`Self::sum_kept8`]: the same candidates, one photon at a time.
+    fn sum_kept(&self, buf: &Nearest, r2: f32, last: Option<Kth>, q: &Lookup, f: Reflectance<'_>) -> Vec3 {
+        let mut sum = Vec3::ZERO;
+        for (d2, &base) in buf.d2.iter().zip(&buf.base) {
+            for (l, &d) in d2.iter().enumerate() {
+                let i = base + l as u32;
+                let keep = match last {
+                    Some(kth) => kth.before(d, i),
+                    None => d < r2,
+                };
+                if keep {
+                    sum += self.contribution(i as usize, d, r2, q.kernel, f);
+                }
+            }
+        }
+        sum
     }
 
     /// The squared radius of a k-nearest estimate over `found` (the k-th photon's distance, that
@@ -151,7 +162,7 @@ impl PhotonMap {
         set: CodePath,
         q: &Lookup,
         f: Reflectance<'_>,
-        scratch: &mut Vec<(f32, u32)>,
+        scratch: &mut Nearest,
         visible: &dyn Fn(Vec3, Vec3) -> bool,
     ) -> Estimate {
         if self.is_empty() {
@@ -159,7 +170,7 @@ impl PhotonMap {
         }
         let (r2, rejected) = if q.k == 0 {
             // Every photon within the fixed radius (a bound no search reaches).
-            let rejected = self.nearest_counted(set, &Lookup { k: u32::MAX as usize, ..*q }, scratch);
+            let rejected = self.nearest_counted(set, &Lookup { k: usize::MAX, ..*q }, scratch);
             let r2 = q.r_max * q.r_max;
             if !(r2 > 0.0) || !r2.is_finite() {
                 return Estimate { radius: q.r_max, ..Default::default() };
@@ -167,15 +178,15 @@ impl PhotonMap {
             (r2, rejected)
         } else {
             let rejected = self.nearest_counted(set, q, scratch);
-            let Some(r2) = Self::knn_radius2(q, scratch) else {
+            let Some(r2) = Self::knn_radius2(q, &mut scratch.found) else {
                 return Estimate { radius: 0.0, rejected, ..Default::default() };
             };
             (r2, rejected)
         };
-        scratch.retain(|&(_, i)| {
+        scratch.found.retain(|&(_, i)| {
             let key = self.key[i as usize];
             visible(self.position(i as usize), key_normal(key).normalize_or_zero())
         });
-        Estimate { rejected, ..self.sum_estimate(set, q, r2, f, scratch) }
+        Estimate { rejected, ..self.sum_estimate(set, q, r2, f, &scratch.found) }
     }
 }

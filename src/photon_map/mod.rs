@@ -35,6 +35,7 @@ mod candidates;
 mod filter;
 pub mod kernel;
 pub mod knn;
+pub mod nearest;
 mod packing;
 pub mod query_packet;
 pub mod radius;
@@ -42,6 +43,7 @@ mod sum;
 mod tree;
 
 pub use kernel::Kernel;
+pub use nearest::Nearest;
 
 use glam::Vec3;
 use packing::{dither, key_flags, key_normal, key_wi, pack_key, rgbe_decode, rgbe_encode};
@@ -261,7 +263,7 @@ mod tests {
             (0..400).map(|i| photon((i % 20) as f32 * 0.05 - 0.5, (i / 20) as f32 * 0.05 - 0.5, 1.0)).collect();
         let map = PhotonMap::build(photons);
         let f = Reflectance::Constant(Vec3::ONE);
-        let mut scratch = Vec::new();
+        let mut scratch = Nearest::default();
         for set in [CodePath::Scalar, CodePath::Simd] {
             for (k, r) in [(20usize, 0.3f32), (0, 0.2)] {
                 let q = Lookup {
@@ -319,14 +321,13 @@ mod tests {
         let mut rnd = super::test_uniforms(12345);
         let ps: Vec<Photon> = (0..2000).map(|_| photon(rnd(), rnd(), 1.0)).collect();
         let map = PhotonMap::build(ps.clone());
-        let mut out = vec![];
+        let mut out = Nearest::default();
         for i in 0..100 {
             let q = Vec3::new(rnd(), 0.0, rnd());
             let k = if i % 2 == 0 { 10 } else { 1 };
             let lookup =
                 Lookup { p: q, k, r_max: 0.2, kernel: Kernel::Box, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
-            map.nearest(CodePath::Simd, &lookup, &mut out);
-            let mut got: Vec<f32> = out.iter().map(|c| c.0).collect();
+            let mut got: Vec<f32> = map.nearest(CodePath::Simd, &lookup, &mut out).iter().map(|c| c.0).collect();
             got.sort_by(f32::total_cmp);
             let mut want: Vec<f32> =
                 ps.iter().map(|p| (p.position - q).length_squared()).filter(|&d| d < 0.04).collect();

@@ -16,7 +16,8 @@
 use super::{Photon, PhotonMap};
 use crate::code_path::CodePath;
 use glam::Vec3;
-use wide::f32x8;
+use wide::bytemuck::cast;
+use wide::{f32x8, u32x8};
 
 /// Photons per block: one `f32x8` per column.
 const BLOCK: usize = 8;
@@ -124,19 +125,31 @@ impl<const NEAREST_FIRST: bool> Walk<NEAREST_FIRST> {
                 CodePath::Scalar => node.distances(self.p, r2),
             };
             if NEAREST_FIRST {
-                // Pushed farthest first, so that the nearest is popped first; ties in slot order.
-                let base = self.top;
+                // Pushed farthest first, so that the nearest is popped first (of equals, the
+                // later slot). A child's place above `top` is the number of reached children
+                // popped after it, counted 8 at a time without branches (an insertion sort's
+                // mispredicted compares measured 4 % of a k-nearest lookup).
+                let reached = hits.count_ones() as usize;
+                let d = f32x8::from(d2s);
+                let slot = u32x8::from([0, 1, 2, 3, 4, 5, 6, 7]);
+                let mut rank = u32x8::ZERO;
+                let mut left = hits;
+                while left != 0 {
+                    let c = left.trailing_zeros();
+                    left &= left - 1;
+                    let dc = f32x8::splat(d2s[c as usize]);
+                    let earlier: f32x8 = cast(slot.simd_gt(u32x8::splat(c)));
+                    // Child c is popped after child i: it lies farther, or as far in an earlier slot.
+                    let after: u32x8 = cast(dc.simd_gt(d) | (dc.simd_eq(d) & earlier));
+                    rank += after & u32x8::ONE;
+                }
+                let rank = rank.to_array();
                 while hits != 0 {
                     let c = hits.trailing_zeros() as usize;
                     hits &= hits - 1;
-                    let mut j = self.top;
-                    while j > base && self.stack[j - 1].1 < d2s[c] {
-                        self.stack[j] = self.stack[j - 1];
-                        j -= 1;
-                    }
-                    self.stack[j] = (node.child[c], d2s[c]);
-                    self.top += 1;
+                    self.stack[self.top + rank[c] as usize] = (node.child[c], d2s[c]);
                 }
+                self.top += reached;
             } else {
                 // Leaves at once, in slot order; nodes pushed last slot first, so that they are
                 // popped in slot order.

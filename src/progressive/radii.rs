@@ -5,7 +5,7 @@
 
 use crate::code_path::CodePath;
 use crate::job::{FixedRadii, Job, Pass, PixelRadii};
-use crate::photon_map::{flags, Filter, Kernel, Lookup, PhotonMap};
+use crate::photon_map::{flags, Filter, Kernel, Lookup, Nearest, PhotonMap};
 use crate::reference::build_job_maps;
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
@@ -35,7 +35,7 @@ pub fn median_knn_radius(map: &PhotonMap, k: u32, r_max: f32, code_path: CodePat
         return None;
     }
     let step = map.len().div_ceil(RADIUS_SAMPLES).max(1);
-    let mut scratch = Vec::new();
+    let mut scratch = Nearest::default();
     let mut radii: Vec<f32> = (0..map.len())
         .step_by(step)
         .filter_map(|i| {
@@ -47,8 +47,8 @@ pub fn median_knn_radius(map: &PhotonMap, k: u32, r_max: f32, code_path: CodePat
                 kernel: Kernel::Box,
                 filter: Filter { n: p.normal, flags_mask: 0 },
             };
-            map.nearest(code_path, &q, &mut scratch);
-            (scratch.len() == k as usize).then(|| scratch.iter().map(|c| c.0).fold(0.0, f32::max).sqrt())
+            let found = map.nearest(code_path, &q, &mut scratch);
+            (found.len() == k as usize).then(|| found.iter().map(|c| c.0).fold(0.0, f32::max).sqrt())
         })
         .collect();
     if radii.is_empty() {
@@ -106,10 +106,10 @@ pub fn pixel_radii(
     let settings = &job.settings;
     let ctx = Context::new(scene, maps, job);
     let want_global = ctx.effects.global_map.on && !ctx.effects.final_gather.on;
-    let knn = |map: &PhotonMap, k: u32, r_max: f32, q: Lookup, scratch: &mut Vec<(f32, u32)>| {
-        map.nearest(settings.code_path, &Lookup { k: k as usize, r_max, ..q }, scratch);
-        let r = scratch.iter().map(|c| c.0).fold(0.0, f32::max).sqrt();
-        if scratch.len() == k as usize && r > 0.0 && r.is_finite() {
+    let knn = |map: &PhotonMap, k: u32, r_max: f32, q: Lookup, scratch: &mut Nearest| {
+        let found = map.nearest(settings.code_path, &Lookup { k: k as usize, r_max, ..q }, scratch);
+        let r = found.iter().map(|c| c.0).fold(0.0, f32::max).sqrt();
+        if found.len() == k as usize && r > 0.0 && r.is_finite() {
             r
         } else {
             r_max

@@ -12,6 +12,7 @@
 use crate::film::{Film, Term, Terms};
 use crate::job::Job;
 use crate::material::Bsdf;
+use crate::photon_map::Nearest;
 use crate::progress::Progress;
 use crate::rng::Sampler;
 use crate::scene::camera::CameraRays;
@@ -49,7 +50,7 @@ pub fn trace_camera_path(
     mut d: Vec3,
     s: &Sampler,
     rays: &mut RayCounts,
-    scratch: &mut Vec<(f32, u32)>,
+    scratch: &mut Nearest,
 ) -> Terms {
     let scene = ctx.scene;
     let mut terms = Terms::default();
@@ -137,7 +138,7 @@ pub fn final_gather(
     wo: Vec3,
     s: &Sampler,
     rays: &mut RayCounts,
-    scratch: &mut Vec<(f32, u32)>,
+    scratch: &mut Nearest,
 ) -> Estimated {
     let kd = bsdf.diffuse();
     if kd == Vec3::ZERO {
@@ -166,7 +167,7 @@ fn gather_hit(
     end: &ChainEnd,
     chain: &Sampler,
     rays: &mut RayCounts,
-    scratch: &mut Vec<(f32, u32)>,
+    scratch: &mut Nearest,
 ) -> Estimated {
     let (y, wo) = (&end.point, -end.dir);
     let bsdf = &ctx.scene.bsdf(y);
@@ -198,7 +199,7 @@ pub fn glossy_reflection(
     wo: Vec3,
     s: &Sampler,
     rays: &mut RayCounts,
-    scratch: &mut Vec<(f32, u32)>,
+    scratch: &mut Nearest,
 ) -> Estimated {
     let Some(ray) = glossy_ray(sp, bsdf, wo, s) else { return Estimated::default() };
     let Some(ChainEnd { point: y, dir: d, beta, .. }) =

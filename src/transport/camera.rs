@@ -5,6 +5,7 @@
 use crate::film::{Film, PixelMean, Terms};
 use crate::job::Job;
 use crate::parallel::map_chunks;
+use crate::photon_map::Nearest;
 use crate::progress::Progress;
 use crate::rng::{Domain, Sampler};
 use crate::scene::camera::CameraRays;
@@ -44,7 +45,7 @@ pub fn probe_first_surfaces<T: Send + Sync + Clone>(
     job: &Job,
     rays: &CameraRays,
     miss: T,
-    probe: impl Fn(usize, &Sampler, &SurfacePoint, Vec3, &mut Vec<(f32, u32)>, &mut RayCounts) -> T + Sync,
+    probe: impl Fn(usize, &Sampler, &SurfacePoint, Vec3, &mut Nearest, &mut RayCounts) -> T + Sync,
 ) -> Vec<T> {
     let w = job.settings.width as usize;
     let pixels = w * job.settings.height as usize;
@@ -53,7 +54,7 @@ pub fn probe_first_surfaces<T: Send + Sync + Clone>(
         256,
         job.threads,
         |range| {
-            let (mut scratch, mut counts) = (Vec::new(), RayCounts::default());
+            let (mut scratch, mut counts) = (Nearest::default(), RayCounts::default());
             range
                 .map(|pixel| {
                     let (s, (fx, fy)) = camera_sample(job, pixel as u64 * u64::from(job.settings.spp));
@@ -78,7 +79,7 @@ pub fn render_pixels(
     job: &Job,
     camera: &CameraRays,
     progress: &dyn Progress,
-    radiance: impl Fn(usize, Vec3, Vec3, &Sampler, &mut RayCounts, &mut Vec<(f32, u32)>) -> Terms + Sync,
+    radiance: impl Fn(usize, Vec3, Vec3, &Sampler, &mut RayCounts, &mut Nearest) -> Terms + Sync,
 ) -> (Film, RayCounts, Numerics) {
     let (w, h) = (job.settings.width as usize, job.settings.height as usize);
     let spp = job.settings.spp;
@@ -90,7 +91,7 @@ pub fn render_pixels(
         |range| {
             let mut rays = RayCounts::default();
             let mut numerics = Numerics::default();
-            let mut scratch = Vec::new();
+            let mut scratch = Nearest::default();
             let mut row = Vec::with_capacity(w * range.len());
             for y in range {
                 for x in 0..w {

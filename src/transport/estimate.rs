@@ -10,7 +10,7 @@ use super::Context;
 use crate::material::Bsdf;
 use crate::photon_map::boundary::{Cut, MAX_EXTRA_CUTS};
 use crate::photon_map::query_packet::{RadiusQuery, PACKET};
-use crate::photon_map::{flags, Estimate, Filter, Lookup, PhotonMap, Reflectance};
+use crate::photon_map::{flags, Estimate, Filter, Lookup, Nearest, PhotonMap, Reflectance};
 use crate::scene::{Scene, SurfacePoint};
 use glam::Vec3;
 use std::sync::atomic::Ordering;
@@ -104,7 +104,7 @@ fn plan_map<'m>(
     mask: u8,
     fixed: Option<f32>,
     base: bool,
-    scratch: &mut Vec<(f32, u32)>,
+    scratch: &mut Nearest,
 ) -> Planned<'m> {
     if base && !bsdf.has_base() {
         return Planned::Done(Estimate::default());
@@ -192,7 +192,7 @@ pub fn caustic_estimate<'a>(
     bsdf: &Bsdf,
     wo: Vec3,
     pixel: Option<usize>,
-    scratch: &mut Vec<(f32, u32)>,
+    scratch: &mut Nearest,
 ) -> Planned<'a> {
     let fixed = ctx.fixed.map(|r| r.caustic_at(pixel));
     let map: &'a PhotonMap = &ctx.maps.caustic;
@@ -209,7 +209,7 @@ pub fn global_estimate<'a>(
     wo: Vec3,
     mask: u8,
     pixel: Option<usize>,
-    scratch: &mut Vec<(f32, u32)>,
+    scratch: &mut Nearest,
 ) -> Planned<'a> {
     global_part(ctx, sp, bsdf, wo, mask, pixel, false, scratch)
 }
@@ -226,7 +226,7 @@ fn global_part<'a>(
     mask: u8,
     pixel: Option<usize>,
     base: bool,
-    scratch: &mut Vec<(f32, u32)>,
+    scratch: &mut Nearest,
 ) -> Planned<'a> {
     let fixed = ctx.fixed.map(|r| r.global_at(pixel));
     let map: &'a PhotonMap = &ctx.maps.global;
@@ -243,7 +243,7 @@ pub fn indirect_estimate<'a>(
     bsdf: &Bsdf,
     wo: Vec3,
     pixel: Option<usize>,
-    scratch: &mut Vec<(f32, u32)>,
+    scratch: &mut Nearest,
 ) -> Planned<'a> {
     global_part(ctx, sp, bsdf, wo, flags::OWN_TERMS, pixel, false, scratch)
 }
@@ -259,7 +259,7 @@ pub fn camera_indirect_estimate<'a>(
     bsdf: &Bsdf,
     wo: Vec3,
     pixel: Option<usize>,
-    scratch: &mut Vec<(f32, u32)>,
+    scratch: &mut Nearest,
 ) -> Planned<'a> {
     global_part(ctx, sp, bsdf, wo, flags::OWN_TERMS, pixel, true, scratch)
 }
@@ -273,7 +273,7 @@ pub fn map_radiance<'a>(
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
-    scratch: &mut Vec<(f32, u32)>,
+    scratch: &mut Nearest,
 ) -> Planned<'a> {
     let irr = &ctx.maps.irradiance;
     if let (Bsdf::Lambert { kd }, false) = (bsdf, irr.is_empty()) {
@@ -285,8 +285,7 @@ pub fn map_radiance<'a>(
             kernel: ctx.settings.kernel,
             filter: Filter { n: ng, flags_mask: 0 },
         };
-        irr.nearest(ctx.settings.code_path, &lookup, scratch);
-        if let Some(&(_, i)) = scratch.first() {
+        if let Some(&(_, i)) = irr.nearest(ctx.settings.code_path, &lookup, scratch).first() {
             // With visibility on, a point behind a wall is not read: the full estimate below is.
             // (The point's record is decoded only then: decoding it for every gather ray cost 4 %
             // of a one-thread default render.)

@@ -4,7 +4,7 @@
 use super::estimate::photon_visibility;
 use crate::job::Job;
 use crate::parallel::map_chunks;
-use crate::photon_map::{Filter, Lookup, Photon, PhotonMap, Reflectance};
+use crate::photon_map::{Filter, Lookup, Nearest, Photon, PhotonMap, Reflectance};
 use crate::scene::Scene;
 use crate::settings::Settings;
 use glam::Vec3;
@@ -76,7 +76,7 @@ fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings,
         4096,
         threads,
         |range| {
-            let mut scratch = Vec::new();
+            let mut scratch = Nearest::default();
             range
                 .map(|j| {
                     let src = global.photon(picks[j]);

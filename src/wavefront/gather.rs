@@ -10,7 +10,7 @@ use crate::code_path::morton_code;
 use crate::film::Term;
 use crate::material::Bsdf;
 use crate::photon_map::query_packet::PACKET;
-use crate::photon_map::Estimate;
+use crate::photon_map::{Estimate, Nearest};
 use crate::scene::SurfacePoint;
 use crate::transport::estimate::{
     camera_indirect_estimate, caustic_estimate, indirect_estimate, map_radiance, run_packet, FixedLookup, Planned,
@@ -38,15 +38,7 @@ fn estimate_at_diffuse_hits(
     work: &mut CameraWork,
     wanted: impl Fn(PathKind) -> bool,
     own: Term,
-    estimate: impl for<'a> Fn(
-            &Context<'a>,
-            &SurfacePoint,
-            &Bsdf,
-            Vec3,
-            PathKind,
-            Option<usize>,
-            &mut Vec<(f32, u32)>,
-        ) -> Planned<'a>
+    estimate: impl for<'a> Fn(&Context<'a>, &SurfacePoint, &Bsdf, Vec3, PathKind, Option<usize>, &mut Nearest) -> Planned<'a>
         + Sync,
 ) -> usize {
     let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
@@ -59,7 +51,7 @@ fn estimate_at_diffuse_hits(
     // least four a thread.
     let chunk = lanes.len().div_ceil(4 * threads.max(1)).clamp(GATHER_CHUNK, SORTED_CHUNK);
     let done: Vec<Lane> = par_lanes(lanes.len(), chunk, threads, |r| {
-        let mut scratch = Vec::new();
+        let mut scratch = Nearest::default();
         let mut done: Vec<Lane> = Vec::with_capacity(r.len());
         // Lookups deferred to the sorted packets, with the index of their lane in `done`.
         let mut deferred: Vec<(u32, FixedLookup)> = Vec::new();
