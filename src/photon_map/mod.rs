@@ -26,7 +26,8 @@
 //! the same arithmetic in the same order, so both find the same photons.
 //!
 //! Files: [`kernel`] (the density kernels), `packing` (key and RGBE codecs), `tree` (build and
-//! walk), `filter` (which photons a lookup may use), [`knn`] (k-nearest lookups and estimates),
+//! walk), `filter` (which photons a lookup may use), [`nearest`] (the k-nearest search, by
+//! counting), [`knn`] (k-nearest lookups and estimates),
 //! [`radius`] (fixed-radius estimates), [`query_packet`] (up to 8 fixed-radius estimates sharing
 //! one walk), `sum` (the kernel sums); each SIMD kernel beside its scalar twin.
 
