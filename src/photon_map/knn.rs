@@ -22,23 +22,13 @@ impl PhotonMap {
     /// [`Self::nearest`] into `scratch.found`, returning how many photons the normal test turned
     /// away (see [`Estimate::rejected`]); both code paths count the same photons.
     pub(super) fn nearest_counted(&self, set: CodePath, q: &Lookup, scratch: &mut Nearest) -> u32 {
-        let walked = self.walk_nearest::<false>(set, q, scratch, &mut 0);
-        let last =
-            if walked.live >= q.k && q.k > 0 { Some(scratch.kth(set, q.k, walked.live, walked.r2)) } else { None };
+        let (walked, last) = self.search_nearest(set, q, scratch);
         let mut found = std::mem::take(&mut scratch.found);
         found.clear();
-        for (d2, &base) in scratch.d2.iter().zip(&scratch.base) {
-            for (l, &d) in d2.iter().enumerate() {
-                let i = base + l as u32;
-                let take = match last {
-                    Some(kth) => kth.before(d, i) || (d, i) == (kth.d2, kth.index),
-                    None => d < walked.r2,
-                };
-                if take {
-                    found.push((d, i));
-                }
-            }
-        }
+        found.extend(scratch.lanes().filter(|&(d, i)| match last {
+            Some(kth) => kth.before(d, i) || (d, i) == (kth.d2, kth.index),
+            None => d < walked.r2,
+        }));
         scratch.found = found;
         walked.rejected
     }
@@ -54,15 +44,13 @@ impl PhotonMap {
         if q.k == 0 {
             return Estimate { radius: 0.0, ..Default::default() };
         }
-        let walked = self.walk_nearest::<false>(set, q, scratch, &mut 0);
+        let (walked, last) = self.search_nearest(set, q, scratch);
         let rejected = walked.rejected;
         // The k-th photon defines r and lies on the boundary: the k − 1 before it are summed.
         // With fewer than k within the maximum radius, all of them over that radius.
-        let (r2, last, count) = if walked.live >= q.k {
-            let kth = scratch.kth(set, q.k, walked.live, walked.r2);
-            (kth.d2, Some(kth), q.k - 1)
-        } else {
-            (q.r_max * q.r_max, None, walked.live)
+        let (r2, count) = match last {
+            Some(kth) => (kth.d2, q.k - 1),
+            None => (q.r_max * q.r_max, walked.live),
         };
         if !(r2 > 0.0) {
             return Estimate { radius: 0.0, rejected, ..Default::default() };
@@ -112,16 +100,13 @@ impl PhotonMap {
     /// Scalar twin of [`Self::sum_kept8`]: the same candidates, one photon at a time.
     fn sum_kept(&self, buf: &Nearest, r2: f32, last: Option<Kth>, q: &Lookup, f: Reflectance<'_>) -> Vec3 {
         let mut sum = Vec3::ZERO;
-        for (d2, &base) in buf.d2.iter().zip(&buf.base) {
-            for (l, &d) in d2.iter().enumerate() {
-                let i = base + l as u32;
-                let keep = match last {
-                    Some(kth) => kth.before(d, i),
-                    None => d < r2,
-                };
-                if keep {
-                    sum += self.contribution(i as usize, d, r2, q.kernel, f);
-                }
+        for (d, i) in buf.lanes() {
+            let keep = match last {
+                Some(kth) => kth.before(d, i),
+                None => d < r2,
+            };
+            if keep {
+                sum += self.contribution(i as usize, d, r2, q.kernel, f);
             }
         }
         sum

@@ -80,6 +80,14 @@ impl Nearest {
         }
     }
 
+    /// Every lane in the buffer as (distance², photon index), +∞ where no candidate is.
+    pub(super) fn lanes(&self) -> impl Iterator<Item = (f32, u32)> + '_ {
+        self.d2
+            .iter()
+            .zip(&self.base)
+            .flat_map(|(d2, &base)| d2.iter().enumerate().map(move |(l, &d)| (d, base + l as u32)))
+    }
+
     /// The farthest candidate's squared distance (0 for none).
     fn farthest(&self) -> f32 {
         self.d2.iter().flatten().filter(|d| d.is_finite()).fold(0.0, |m: f32, &d| m.max(d))
@@ -121,14 +129,12 @@ impl Nearest {
             }
             halve = 2 * (cb - ca) > width;
         }
-        self.near_kth.clear();
-        for (d2, &base) in self.d2.iter().zip(&self.base) {
-            for (l, &d) in d2.iter().enumerate() {
-                if d >= a && d < b {
-                    self.near_kth.push(u64::from(d.to_bits()) << 32 | u64::from(base + l as u32));
-                }
-            }
-        }
+        let mut near_kth = std::mem::take(&mut self.near_kth);
+        near_kth.clear();
+        near_kth.extend(
+            self.lanes().filter(|&(d, _)| d >= a && d < b).map(|(d, i)| u64::from(d.to_bits()) << 32 | u64::from(i)),
+        );
+        self.near_kth = near_kth;
         // Distances are non-negative (never −0 or NaN here): their bits order as the values do.
         let (_, &mut kth, _) = self.near_kth.select_nth_unstable(k - ca - 1);
         Kth { d2: f32::from_bits((kth >> 32) as u32), index: kth as u32 }
@@ -136,6 +142,14 @@ impl Nearest {
 }
 
 impl PhotonMap {
+    /// The search for `q`'s `q.k` nearest: the walk, and the k-th nearest when at least k
+    /// candidates lie within the radius (`None` otherwise, or for k = 0).
+    pub(super) fn search_nearest(&self, set: CodePath, q: &Lookup, buf: &mut Nearest) -> (Walked, Option<Kth>) {
+        let walked = self.walk_nearest::<false>(set, q, buf, &mut 0);
+        let last = (q.k > 0 && walked.live >= q.k).then(|| buf.kth(set, q.k, walked.live, walked.r2));
+        (walked, last)
+    }
+
     /// Walks toward `q.p` gathering the blocks that hold candidates for its `q.k` nearest into
     /// `buf` (cleared first), adding the photons tested to `tested` when `COUNT`.
     pub(super) fn walk_nearest<const COUNT: bool>(
