@@ -146,7 +146,7 @@ fn fixed_radius_lookups_find_what_a_brute_force_scan_finds() {
                 assert_eq!((e.count, e.rejected), (summed, turned), "query {qi}, r {r}, {set:?}");
                 assert!(e.radiance.is_finite(), "query {qi}, r {r}, {set:?}");
             }
-            assert!(map.photons_tested(&q) >= u64::from(summed + turned), "query {qi}, r {r}");
+            assert!(map.photons_tested(&q, &mut Nearest::default()) >= u64::from(summed + turned), "query {qi}, r {r}");
             checked += summed;
         }
     }

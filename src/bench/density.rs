@@ -149,8 +149,11 @@ pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize,
     let radii: Vec<f64> = scalar_knn.iter().map(|e| f64::from(e.radius)).collect();
     let r_fixed = if radii.is_empty() { r_max } else { median(radii) as f32 };
     let n = queries.len() as f64;
+    // In the lookups' order through one scratch, as a thread runs them (k-nearest searches start
+    // from the last one's radius).
     let tested = |k: usize, r: f32| {
-        queries.iter().map(|&(p, nrm)| map.photons_tested(&lookup(p, nrm, k, r))).sum::<u64>() as f64 / n
+        let mut scratch = Nearest::default();
+        queries.iter().map(|&(p, nrm)| map.photons_tested(&lookup(p, nrm, k, r), &mut scratch)).sum::<u64>() as f64 / n
     };
     let k = settings.k as usize;
     let summed_knn = scalar_knn.iter().map(|e| f64::from(e.count)).sum::<f64>() / n;

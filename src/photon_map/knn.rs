@@ -22,7 +22,7 @@ impl PhotonMap {
     /// [`Self::nearest`] into `scratch.found`, returning how many photons the normal test turned
     /// away (see [`Estimate::rejected`]); both code paths count the same photons.
     pub(super) fn nearest_counted(&self, set: CodePath, q: &Lookup, scratch: &mut Nearest) -> u32 {
-        let (walked, last) = self.search_nearest(set, q, scratch);
+        let (walked, last) = self.search_nearest::<false>(set, q, scratch, &mut 0);
         let mut found = std::mem::take(&mut scratch.found);
         found.clear();
         found.extend(scratch.lanes().filter(|&(d, i)| match last {
@@ -44,7 +44,7 @@ impl PhotonMap {
         if q.k == 0 {
             return Estimate { radius: 0.0, ..Default::default() };
         }
-        let (walked, last) = self.search_nearest(set, q, scratch);
+        let (walked, last) = self.search_nearest::<false>(set, q, scratch, &mut 0);
         let rejected = walked.rejected;
         // The k-th photon defines r and lies on the boundary: the k − 1 before it are summed.
         // With fewer than k within the maximum radius, all of them over that radius.

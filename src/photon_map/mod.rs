@@ -108,9 +108,9 @@ pub struct Estimate {
     pub bias: Vec3,
     /// Photons summed.
     pub count: u32,
-    /// Photons within the search radius (as it stood when each was examined) that the normal
-    /// test of the [`Filter`] turned away: another surface's photons, around a corner or through
-    /// a thin wall.
+    /// Photons within the search radius (a k-nearest lookup's: strictly nearer than the k-th)
+    /// that the normal test of the [`Filter`] turned away: another surface's photons, around a
+    /// corner or through a thin wall.
     pub rejected: u32,
 }
 
