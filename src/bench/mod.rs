@@ -114,7 +114,8 @@ impl RaySets {
             let d = Frame::new(ng).to_world(cosine_hemisphere([s.get(0, 3), s.get(0, 4)]));
             diffuse.push(RayQuery::new(offset_ray_origin(sp.p, sp.p_error, ng, d), d, f32::INFINITY));
         }
-        diffuse.sort_by_key(|r| crate::code_path::coherence_key(r.origin, r.direction, scene.bounds));
+        let grid = crate::code_path::MortonGrid::new(scene.bounds, crate::code_path::COHERENCE_CELLS);
+        diffuse.sort_by_cached_key(|r| crate::code_path::coherence_key(r.origin, r.direction, &grid));
         RaySets { camera, shadow, diffuse, hits }
     }
 }

@@ -6,7 +6,7 @@
 
 use super::queues::PathKind;
 use super::{par_lanes, CameraWork, Maps, Shared, StageStats, GATHER_CHUNK};
-use crate::code_path::morton_code;
+use crate::code_path::MortonGrid;
 use crate::film::Term;
 use crate::material::Bsdf;
 use crate::photon_map::query_packet::PACKET;
@@ -80,11 +80,9 @@ fn estimate_at_diffuse_hits(
         packet.run(&ctx, &mut done);
         // By Morton code, ties in lane order; the low half is the place in `deferred`. (A packet
         // holds lookups of one map: `Packet::add` runs it when the map changes.)
-        let mut order: Vec<u64> = deferred
-            .iter()
-            .enumerate()
-            .map(|(k, (_, q))| u64::from(morton_code(q.lookup.p, ctx.scene.bounds, 1024)) << 32 | k as u64)
-            .collect();
+        let grid = MortonGrid::new(ctx.scene.bounds, 1024);
+        let mut order: Vec<u64> =
+            deferred.iter().enumerate().map(|(k, (_, q))| u64::from(grid.code(q.lookup.p)) << 32 | k as u64).collect();
         order.sort_unstable();
         for o in &order {
             let (slot, q) = deferred[(o & 0xffff_ffff) as usize];
