@@ -30,12 +30,23 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     let d = n.abs().dot(p_error);
     let side = if w.dot(n) < 0.0 { -n } else { n };
     let mut po = p + side * d;
-    // One more ulp away from the surface, so that a zero error bound still moves the origin.
+    // One more ulp away from the surface, so that a zero error bound still moves the origin —
+    // and at least to the smallest normal float: from a coordinate of 0 (a wall on a coordinate
+    // plane, whose error bound along its normal is 0) one ulp is a subnormal, and every box and
+    // triangle test of such a ray took a microcode assist per subnormal operand (14 % of the
+    // packet triangle tests' lanes on cornell-spheres; `intersect_paths` 11 % slower,
+    // BENCHMARKS.md "Subnormal assists in the renderer").
     for i in 0..3 {
         if side[i] > 0.0 {
             po[i] = po[i].next_up();
+            if po[i] > 0.0 && po[i] < f32::MIN_POSITIVE {
+                po[i] = f32::MIN_POSITIVE;
+            }
         } else if side[i] < 0.0 {
             po[i] = po[i].next_down();
+            if po[i] < 0.0 && po[i] > -f32::MIN_POSITIVE {
+                po[i] = -f32::MIN_POSITIVE;
+            }
         }
     }
     po
@@ -56,5 +67,23 @@ mod tests {
             // The offset is tiny relative to the scale.
             assert!(up.z < scale * 1e-5);
         }
+    }
+
+    /// From a point on a coordinate plane with no error along its normal, the origin moves to
+    /// the smallest normal float on the side of `w`, never to a subnormal (which would slow
+    /// every test of the ray), and stays outside the error box elsewhere.
+    #[test]
+    fn offset_from_zero_is_never_subnormal() {
+        let p = Vec3::new(0.25, 0.5, 0.0);
+        let err = barycentric_error([0.2, 0.3, 0.5], Vec3::ZERO, Vec3::X, Vec3::Y);
+        assert_eq!(err.z, 0.0);
+        for (w, z) in [(Vec3::Z, f32::MIN_POSITIVE), (-Vec3::Z, -f32::MIN_POSITIVE)] {
+            let o = offset_ray_origin(p, err, Vec3::Z, w);
+            assert_eq!(o.z, z);
+            assert_eq!((o.x, o.y), (p.x, p.y));
+        }
+        // Already beyond the smallest normal: one ulp, as before.
+        let o = offset_ray_origin(Vec3::new(0.0, 0.0, 1e-30), Vec3::ZERO, Vec3::Z, Vec3::Z);
+        assert_eq!(o.z, 1e-30f32.next_up());
     }
 }
