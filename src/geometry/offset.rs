@@ -39,14 +39,11 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     for i in 0..3 {
         if side[i] > 0.0 {
             po[i] = po[i].next_up();
-            if po[i] > 0.0 && po[i] < f32::MIN_POSITIVE {
-                po[i] = f32::MIN_POSITIVE;
-            }
         } else if side[i] < 0.0 {
             po[i] = po[i].next_down();
-            if po[i] < 0.0 && po[i] > -f32::MIN_POSITIVE {
-                po[i] = -f32::MIN_POSITIVE;
-            }
+        }
+        if side[i] != 0.0 && po[i].abs() < f32::MIN_POSITIVE {
+            po[i] = f32::MIN_POSITIVE.copysign(side[i]);
         }
     }
     po

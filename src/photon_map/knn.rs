@@ -20,8 +20,9 @@ impl PhotonMap {
     }
 
     /// [`Self::nearest`] into `scratch.found`, returning how many photons the normal test turned
-    /// away (see [`Estimate::rejected`]); both code paths count the same photons.
-    pub(super) fn nearest_counted(&self, set: CodePath, q: &Lookup, scratch: &mut Nearest) -> u32 {
+    /// away (see [`Estimate::rejected`]; both code paths count the same photons) and the k-th
+    /// nearest when k were found.
+    pub(super) fn nearest_counted(&self, set: CodePath, q: &Lookup, scratch: &mut Nearest) -> (u32, Option<Kth>) {
         let (walked, last) = self.search_nearest::<false>(set, q, scratch, &mut 0);
         let mut found = std::mem::take(&mut scratch.found);
         found.clear();
@@ -30,7 +31,7 @@ impl PhotonMap {
             None => d < walked.r2,
         }));
         scratch.found = found;
-        walked.rejected
+        (walked.rejected, last)
     }
 
     /// Reflected radiance at `q.p` from its k nearest photons: Σ f(wi_p)·Φ_p·K over the
@@ -112,9 +113,9 @@ impl PhotonMap {
         sum
     }
 
-    /// The squared radius of a k-nearest estimate over `found` (the k-th photon's distance, that
-    /// photon removed: it lies on the boundary; or `q.r_max`² when fewer were found); `None`
-    /// for a zero radius.
+    /// The squared radius of a k-nearest estimate over `found`, a baseline search's candidates
+    /// (the k-th photon's distance, that photon removed: it lies on the boundary; or `q.r_max`²
+    /// when fewer were found); `None` for a zero radius.
     #[inline]
     pub(super) fn knn_radius2(q: &Lookup, found: &mut Vec<(f32, u32)>) -> Option<f32> {
         let (r2, skip) = if found.len() == q.k {
@@ -153,24 +154,28 @@ impl PhotonMap {
         if self.is_empty() {
             return Estimate { radius: q.r_max, ..Default::default() };
         }
-        let (r2, rejected) = if q.k == 0 {
+        let (r2, rejected, last) = if q.k == 0 {
             // Every photon within the fixed radius (a bound no search reaches).
-            let rejected = self.nearest_counted(set, &Lookup { k: usize::MAX, ..*q }, scratch);
+            let (rejected, _) = self.nearest_counted(set, &Lookup { k: usize::MAX, ..*q }, scratch);
             let r2 = q.r_max * q.r_max;
             if !(r2 > 0.0) || !r2.is_finite() {
                 return Estimate { radius: q.r_max, ..Default::default() };
             }
-            (r2, rejected)
+            (r2, rejected, None)
         } else {
-            let rejected = self.nearest_counted(set, q, scratch);
-            let Some(r2) = Self::knn_radius2(q, &mut scratch.found) else {
+            // The k-th photon defines r and lies on the boundary: the k − 1 before it are summed,
+            // as in [`Self::estimate`]; with fewer than k, all of them over the maximum radius.
+            let (rejected, last) = self.nearest_counted(set, q, scratch);
+            let r2 = last.map_or(q.r_max * q.r_max, |kth| kth.d2);
+            if !(r2 > 0.0) {
                 return Estimate { radius: 0.0, rejected, ..Default::default() };
-            };
-            (r2, rejected)
+            }
+            (r2, rejected, last)
         };
-        scratch.found.retain(|&(_, i)| {
+        scratch.found.retain(|&(d, i)| {
             let key = self.key[i as usize];
-            visible(self.position(i as usize), key_normal(key).normalize_or_zero())
+            last.is_none_or(|kth| kth.before(d, i))
+                && visible(self.position(i as usize), key_normal(key).normalize_or_zero())
         });
         Estimate { rejected, ..self.sum_estimate(set, q, r2, f, &scratch.found) }
     }
