@@ -22,6 +22,17 @@ pub fn barycentric_error(b: [f32; 3], p0: Vec3, p1: Vec3, p2: Vec3) -> Vec3 {
     ((b[0] * p0).abs() + (b[1] * p1).abs() + (b[2] * p2).abs()) * gamma(7)
 }
 
+/// The smallest magnitude an offset coordinate moves to: 2⁻⁶³, the square root of the smallest
+/// normal float. From a coordinate of 0 (a wall on a coordinate plane, whose error bound along
+/// its normal is 0) one ulp is a subnormal; the smallest normal float itself is no better, as
+/// every product of it with a factor below 1 (a box test's inverse direction, the triangle test's
+/// shear) is subnormal again. Each subnormal operand or result costs a microcode assist, and
+/// these rays test many boxes and triangles: at 2⁻⁶³ such products, and the product of two such
+/// coordinates, stay normal. (Measured: BENCHMARKS.md "Subnormal assists in the renderer"; the
+/// floor is far below any scene's scale, and an origin further out than its error box is still
+/// on the side of the ray.)
+pub const OFFSET_FLOOR: f32 = 1.084_202_2e-19;
+
 /// The origin for a ray leaving point `p` (error bound `p_error`, geometric normal `n`) toward
 /// direction `w`: outside the error box, on the side of `w`.
 #[inline]
@@ -30,20 +41,16 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     let d = n.abs().dot(p_error);
     let side = if w.dot(n) < 0.0 { -n } else { n };
     let mut po = p + side * d;
-    // One more ulp away from the surface, so that a zero error bound still moves the origin —
-    // and at least to the smallest normal float: from a coordinate of 0 (a wall on a coordinate
-    // plane, whose error bound along its normal is 0) one ulp is a subnormal, and every box and
-    // triangle test of such a ray took a microcode assist per subnormal operand (14 % of the
-    // packet triangle tests' lanes on cornell-spheres; `intersect_paths` 11 % slower,
-    // BENCHMARKS.md "Subnormal assists in the renderer").
+    // One more ulp away from the surface, so that a zero error bound still moves the origin, and
+    // at least to [`OFFSET_FLOOR`].
     for i in 0..3 {
         if side[i] > 0.0 {
             po[i] = po[i].next_up();
         } else if side[i] < 0.0 {
             po[i] = po[i].next_down();
         }
-        if side[i] != 0.0 && po[i].abs() < f32::MIN_POSITIVE {
-            po[i] = f32::MIN_POSITIVE.copysign(side[i]);
+        if side[i] != 0.0 && po[i].abs() < OFFSET_FLOOR {
+            po[i] = OFFSET_FLOOR.copysign(side[i]);
         }
     }
     po
@@ -67,20 +74,24 @@ mod tests {
     }
 
     /// From a point on a coordinate plane with no error along its normal, the origin moves to
-    /// the smallest normal float on the side of `w`, never to a subnormal (which would slow
-    /// every test of the ray), and stays outside the error box elsewhere.
+    /// the floor on the side of `w`, never to a subnormal (which would slow every test of the
+    /// ray), and the floor is such that its products with ordinary factors and with itself are
+    /// normal.
     #[test]
     fn offset_from_zero_is_never_subnormal() {
         let p = Vec3::new(0.25, 0.5, 0.0);
         let err = barycentric_error([0.2, 0.3, 0.5], Vec3::ZERO, Vec3::X, Vec3::Y);
         assert_eq!(err.z, 0.0);
-        for (w, z) in [(Vec3::Z, f32::MIN_POSITIVE), (-Vec3::Z, -f32::MIN_POSITIVE)] {
+        assert_eq!(OFFSET_FLOOR, 2f32.powi(-63));
+        assert!((OFFSET_FLOOR * OFFSET_FLOOR).is_normal());
+        assert!((OFFSET_FLOOR * 1e-18).is_normal() && (OFFSET_FLOOR / 1e18).is_normal());
+        for (w, z) in [(Vec3::Z, OFFSET_FLOOR), (-Vec3::Z, -OFFSET_FLOOR)] {
             let o = offset_ray_origin(p, err, Vec3::Z, w);
             assert_eq!(o.z, z);
             assert_eq!((o.x, o.y), (p.x, p.y));
         }
-        // Already beyond the smallest normal: one ulp, as before.
-        let o = offset_ray_origin(Vec3::new(0.0, 0.0, 1e-30), Vec3::ZERO, Vec3::Z, Vec3::Z);
-        assert_eq!(o.z, 1e-30f32.next_up());
+        // Already beyond the floor: one ulp, as before.
+        let o = offset_ray_origin(Vec3::new(0.0, 0.0, 1e-10), Vec3::ZERO, Vec3::Z, Vec3::Z);
+        assert_eq!(o.z, 1e-10f32.next_up());
     }
 }
