@@ -6,7 +6,8 @@
 //! lookups ([`crate::photon_map::query_packet`], whose twin runs the lookups one at a time). The
 //! twins make the same decisions (same hits, same photons found); sums over photons differ only
 //! in rounding order.
-//! The renderer runs [`CodePath::Simd`] unless `code_path = "scalar"` is set.
+//! The renderer runs [`CodePath::Simd`] unless `code_path = "scalar"` is set; within it,
+//! [`crate::traversal_choice`] picks packets or single rays per ray queue.
 
 use crate::geometry::bvh::{Bvh, Hit, TriangleColumns};
 use crate::geometry::{packet, traverse, RayQuery};

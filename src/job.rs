@@ -7,6 +7,8 @@ use crate::effects::Effects;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
 use crate::settings::Settings;
+use crate::traversal_choice::TraversalChoice;
+use std::sync::Arc;
 
 /// What changes from pass to pass of a progressive render.
 #[derive(Clone, Debug, PartialEq)]
@@ -30,6 +32,8 @@ pub struct Job {
     pub threads: usize,
     /// The pass being rendered.
     pub pass: Pass,
+    /// Packets or single rays per ray queue, chosen in the first pass and kept by the others.
+    pub traversal: Arc<TraversalChoice>,
 }
 
 impl Job {
@@ -42,6 +46,7 @@ impl Job {
             plan,
             threads: settings.thread_count(),
             pass: Pass { seed: settings.seed, radii: None },
+            traversal: Arc::new(TraversalChoice::for_scene(scene.triangle_count())),
         })
     }
 

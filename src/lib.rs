@@ -18,6 +18,7 @@
 //! - [`memory`]: the memory a render needs against what the machine has;
 //! - [`geometry`]: triangles, the BVH, single-ray and 8-wide packet traversal;
 //! - [`code_path`]: the SIMD kernels or their scalar twins, for traversal and photon lookups;
+//! - [`traversal_choice`]: packets or single rays per ray queue, chosen by timing both;
 //!
 //! **Data** — records and their own methods:
 //! - [`texture`]: image textures, bilinear lookups, sRGB decoding;
@@ -97,6 +98,7 @@ pub mod stats;
 pub mod sweep;
 pub mod texture;
 pub mod transport;
+pub mod traversal_choice;
 pub mod wavefront;
 
 pub use error::{Error, Result};

@@ -176,6 +176,10 @@ pub struct RenderStats {
     pub times: PhaseTimes,
     /// Per-system runs, lanes and time (wavefront engine).
     pub stages: Option<StageStats>,
+    /// Traversal kernel per ray queue, where the render chose one by timing (wavefront engine,
+    /// scenes of [`crate::traversal_choice::TRIAL_MIN_TRIANGLES`] triangles or more).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub traversal: Vec<crate::traversal_choice::QueueChoice>,
     /// Mean of the beauty image (RGB).
     pub mean_rgb: [f32; 3],
     /// Progressive passes, radii and budget (progressive renders only).
@@ -199,6 +203,9 @@ impl RenderStats {
         self.caustic_map += &o.caustic_map;
         if let (Some(s), Some(os)) = (self.stages.as_mut(), o.stages.as_ref()) {
             *s += os;
+        }
+        if self.traversal.is_empty() {
+            self.traversal.clone_from(&o.traversal);
         }
     }
 
@@ -331,6 +338,22 @@ impl RenderStats {
         for (name, s) in &stages.0 {
             let rate = if s.seconds > 0.0 { s.items as f64 / s.seconds } else { 0.0 };
             out += &format!("    {name:<18} {:>7} {:>11} {:>8.3} {:>12.0}\n", s.runs, s.items, s.seconds, rate);
+        }
+        if !self.traversal.is_empty() {
+            out += "  traversal per ray queue (chosen by timing both kernels, Mrays/s):\n";
+            let rate = |r: Option<f64>| r.map_or("-".to_string(), |r| format!("{r:.2}"));
+            for c in &self.traversal {
+                let kernel = match c.kernel {
+                    crate::traversal_choice::Kernel::Packets => "packets",
+                    crate::traversal_choice::Kernel::Single => "single rays",
+                };
+                out += &format!(
+                    "    {:<10} {kernel:<12} (packets {}, single rays {})\n",
+                    c.queue,
+                    rate(c.packets_mrays),
+                    rate(c.single_mrays)
+                );
+            }
         }
         out
     }

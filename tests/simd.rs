@@ -357,3 +357,38 @@ fn renders_with_simd_kernels_match_renders_with_scalar_twins() {
         }
     }
 }
+
+/// Packets and single rays find the same hits, so the per-queue choice between them changes
+/// speed only: renders with every queue on packets, every queue on single rays, and with the
+/// timed trials (forced on this small scene, on two threads so that trials run concurrently) are
+/// identical to the bit, and the trials report a choice for each queue that ran one.
+#[test]
+fn the_traversal_choice_never_changes_an_image() {
+    use photonwave::traversal_choice::{Kernel, TraversalChoice, TRIAL_MIN_TRIANGLES};
+    use std::sync::Arc;
+    let loaded = load("cornell-spheres.toml");
+    let settings = Settings {
+        width: 64,
+        height: 64,
+        spp: 2,
+        photons: 20_000,
+        caustic_photons: 10_000,
+        gather_rays: 4,
+        threads: 2,
+        ..Default::default()
+    };
+    let cam = loaded.camera.unwrap().prepare(settings.width, settings.height).unwrap();
+    let scene = Arc::new(loaded.scene);
+    let render = |traversal: TraversalChoice| {
+        let job = photonwave::job::Job { traversal: Arc::new(traversal), ..job(&scene, &settings) };
+        photonwave::wavefront::render_job(scene.clone(), &cam, &job, &photonwave::progress::NoProgress)
+    };
+    let (packets, _) = render(TraversalChoice::fixed(Kernel::Packets));
+    let (single, _) = render(TraversalChoice::fixed(Kernel::Single));
+    let (chosen, stats) = render(TraversalChoice::for_scene(TRIAL_MIN_TRIANGLES));
+    assert!(packets == single, "single rays changed the image");
+    assert!(packets == chosen, "the trials changed the image");
+    let queues: Vec<&str> = stats.traversal.iter().map(|c| c.queue.as_str()).collect();
+    assert_eq!(queues, ["emitted", "photon", "secondary", "shadow"]);
+    assert!(stats.traversal.iter().all(|c| c.packets_mrays.is_some() && c.single_mrays.is_some()));
+}

@@ -59,6 +59,15 @@ pub struct TraversalRow {
     pub embree8_mrays: Option<f64>,
     /// packet ÷ the faster of Embree's two.
     pub ratio_vs_embree: Option<f64>,
+    /// The kernel the renderer's per-queue choice runs on such rays
+    /// ([`crate::traversal_choice`]): packets on camera rays and on scenes under
+    /// [`TRIAL_MIN_TRIANGLES`](crate::traversal_choice::TRIAL_MIN_TRIANGLES) triangles, otherwise the
+    /// faster here of packets and the 8-wide single ray (what its trial picks).
+    pub renderer_kernel: &'static str,
+    /// That kernel's speed here, million rays per second.
+    pub renderer_mrays: f64,
+    /// `renderer_mrays` ÷ the faster of Embree's two.
+    pub renderer_vs_embree: Option<f64>,
     /// Rays Embree reports hit minus rays ours report hit (Embree counts hits at t = 0 and
     /// differs from our watertight test on edges).
     pub embree_extra_hits: Option<i64>,
@@ -193,7 +202,12 @@ pub fn traversal(
             // Not asserted: obvhs's CWBVH traversal loses a few hits (recorded, see BENCHMARKS.md).
             let visits = count_visits(bvh.wide(tris), rays, any);
             let m = rays.len() as f64 * 1e-6;
+            let trial = label != "camera" && scene.triangle_count() >= crate::traversal_choice::TRIAL_MIN_TRIANGLES;
+            let (renderer_kernel, t_renderer) = if trial && tw < tp { ("single", tw) } else { ("packets", tp) };
             rows.push(TraversalRow {
+                renderer_kernel,
+                renderer_mrays: m / t_renderer,
+                renderer_vs_embree: embree.map(|e| e.0.min(e.1) / t_renderer),
                 nodes_per_ray: visits.nodes as f64 / rays.len() as f64,
                 triangles_per_ray: visits.triangles as f64 / rays.len() as f64,
                 scalar_per_ray: visits.scalar as f64 / rays.len() as f64,

@@ -30,8 +30,8 @@ pub struct Hit {
 /// A BVH over triangles stored as three vertex columns.
 pub struct Bvh {
     bvh: Bvh2,
-    /// The same tree collapsed to 8-wide nodes, built on first use (`photonwave bench`; the
-    /// renderer's queues measured faster with packets, BENCHMARKS.md).
+    /// The same tree collapsed to 8-wide nodes, built on first use: by `photonwave bench`, and
+    /// by renders whose ray queues try single rays ([`crate::traversal_choice`]).
     wide: std::sync::OnceLock<Bvh8>,
 }
 

@@ -1,17 +1,18 @@
 //! Intersect: closest hits for every lane of the photon or path queue, and any-hit tests for
-//! the shadow queue, with the configured kernels (8-wide packets by default; path and photon
-//! chunks traced in coherence-key order). Reads rays; writes hit columns (and, for shadow rays, the unblocked
+//! the shadow queue, with the configured kernels: the SIMD set runs packets (chunks traced in
+//! coherence-key order) or single rays, chosen per queue by timing ([`crate::traversal_choice`]). Reads rays; writes hit columns (and, for shadow rays, the unblocked
 //! contributions into the wave's terms, in lane order).
 
 use super::queues::PathKind;
 use super::queues::{HitColumns, RayColumns};
 use super::{par_columns, par_lanes, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
 use crate::geometry::RayQuery;
+use crate::traversal_choice::Queue;
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
-/// Fills `hits` with the closest hits of `rays`, each chunk into its own columns.
-fn closest_hits(shared: &Shared, rays: &RayColumns, hits: &mut HitColumns) {
+/// Fills `hits` with the closest hits of `rays` (of `queue`), each chunk into its own columns.
+fn closest_hits(shared: &Shared, queue: Queue, rays: &RayColumns, hits: &mut HitColumns) {
     let scene = &*shared.scene;
     hits.clear();
     hits.reserve(rays.len());
@@ -23,8 +24,15 @@ fn closest_hits(shared: &Shared, rays: &RayColumns, hits: &mut HitColumns) {
             part.reserve(r.len());
             let queries: Vec<RayQuery> =
                 r.map(|i| RayQuery::new(rays.origin(i), rays.direction(i), f32::INFINITY)).collect();
-            let hits =
-                shared.job.settings.code_path.closest_coherent(scene.bvh(), scene.columns(), &queries, scene.bounds);
+            let job = &shared.job;
+            let hits = job.traversal.closest(
+                queue,
+                job.settings.code_path,
+                scene.bvh(),
+                scene.columns(),
+                &queries,
+                scene.bounds,
+            );
             part.extend(hits.into_iter())
         },
         |part| hits.append(part),
@@ -35,7 +43,9 @@ fn closest_hits(shared: &Shared, rays: &RayColumns, hits: &mut HitColumns) {
 pub fn intersect_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let q = &mut work.queue;
-    closest_hits(&shared, &q.rays, &mut q.hits);
+    // A bounce's queue holds photons of one bounce count.
+    let queue = if q.bounce.first() == Some(&0) { Queue::Emitted } else { Queue::Photons };
+    closest_hits(&shared, queue, &q.rays, &mut q.hits);
     let n = q.len();
     work.rays += n as u64;
     stats.record("intersect_photons", n, t);
@@ -45,7 +55,10 @@ pub fn intersect_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut 
 pub fn intersect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let w = &mut *work;
-    closest_hits(&shared, &w.paths.rays, &mut w.paths.hits);
+    // The first bounce's queue holds the primary rays, and later ones none.
+    let primary = w.paths.kind.first() == Some(&PathKind::Camera) && w.paths.depth.first() == Some(&0);
+    let queue = if primary { Queue::Camera } else { Queue::Secondary };
+    closest_hits(&shared, queue, &w.paths.rays, &mut w.paths.hits);
     for k in &w.paths.kind {
         match k {
             PathKind::Camera => w.rays.camera += 1,
@@ -68,7 +81,15 @@ pub fn trace_shadow_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
         // Shadow rays are queued in camera-lane order, from neighbouring hits toward the same
         // lights: already coherent, and sorting them cost more than it saved (BENCHMARKS.md).
         let mut blocked = vec![false; queries.len()];
-        shared.job.settings.code_path.occluded(scene.bvh(), scene.columns(), &queries, &mut blocked);
+        let job = &shared.job;
+        job.traversal.occluded(
+            Queue::Shadows,
+            job.settings.code_path,
+            scene.bvh(),
+            scene.columns(),
+            &queries,
+            &mut blocked,
+        );
         blocked
     });
     for (i, b) in blocked.into_iter().enumerate() {

@@ -199,6 +199,7 @@ pub fn render_job(scene: Arc<Scene>, camera: &CameraRays, job: &Job, progress: &
         "global map read at first hit (wavefront)".into()
     });
     stats.stages = Some(world.resource::<StageStats>().clone());
+    stats.traversal = job.traversal.report();
     stats.times.total_s = start.elapsed().as_secs_f64();
     stats.mean_rgb = film.mean().to_array();
     (film, stats)
