@@ -46,7 +46,7 @@ impl Job {
             plan,
             threads: settings.thread_count(),
             pass: Pass { seed: settings.seed, radii: None },
-            traversal: Arc::new(TraversalChoice::for_scene(scene.triangle_count())),
+            traversal: Arc::new(TraversalChoice::timed()),
         })
     }
 

@@ -2,14 +2,15 @@
 //!
 //! The SIMD traversal has two kernels that find the same hits: packets of 8 rays through the
 //! BVH2 ([`crate::geometry::packet`]) and single rays through the 8-wide BVH
-//! ([`crate::geometry::wide_traverse`]). Which is faster depends on the scene and the queue, not
-//! on the triangle count alone (BENCHMARKS.md, "Packets or single rays: where the crossover
-//! lies"): packets win on camera rays everywhere and on every queue of small scenes; single rays
-//! win on photon rays and on some shadow and bounce rays of large meshes (photon rays 1.7–1.8×
-//! in renders of the bunny and the ogre, the 1 M sphere's shadow rays 1.36× in the bench). So on scenes of at least [`TRIAL_MIN_TRIANGLES`] triangles each
-//! queue times both kernels on its first chunks, alternating, and keeps the faster per ray for
-//! the rest of the render (every later pass included). Hits are identical either way, so the
-//! choice changes speed only, never an image. Reads chunk timings; writes the choice per queue.
+//! ([`crate::geometry::wide_traverse`]). Which is faster depends on the scene and the queue,
+//! not on the triangle count alone (BENCHMARKS.md, "Packets or single rays, chosen per queue by
+//! timing"): packets win on camera rays everywhere and on the shadow rays of the bundled boxes;
+//! single rays on photon rays in every scene measured (1.3–2.2× in the trials) and on the
+//! final-gather rays of the bundled Cornell boxes (1.2–1.35×, the packets' coherence sort
+//! included). So each queue times both
+//! kernels on its first chunks and keeps the faster for the rest of the render (every later pass
+//! included). Hits are identical either way, so the choice changes speed only, never an image.
+//! Reads chunk timings; writes the choice per queue.
 
 use crate::code_path::CodePath;
 use crate::geometry::bvh::{Bvh, Hit, TriangleColumns};
@@ -18,11 +19,6 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use std::sync::Mutex;
 use std::time::Instant;
-
-/// Scenes with fewer triangles always run packets: below it packets were at least 1.3× faster
-/// on every measured queue (the displaced sphere at 16 384 triangles), and the 8-wide BVH is not
-/// built.
-pub const TRIAL_MIN_TRIANGLES: usize = 16_384;
 
 /// Chunks each queue traces with both kernels before it chooses.
 pub const TRIAL_PAIRS: u32 = 6;
@@ -140,12 +136,10 @@ pub struct TraversalChoice {
 }
 
 impl TraversalChoice {
-    /// Trials on a scene of `triangles` triangles ([`TRIAL_MIN_TRIANGLES`] or more), packets
-    /// only below that.
+    /// Every queue but the camera rays' chooses by its trial (the renderer's default).
     #[must_use]
-    pub fn for_scene(triangles: usize) -> Self {
-        let trials = (triangles >= TRIAL_MIN_TRIANGLES).then(|| Mutex::new([Trial::default(); 5]));
-        TraversalChoice { trials, fixed: Kernel::Packets }
+    pub fn timed() -> Self {
+        TraversalChoice { trials: Some(Mutex::new([Trial::default(); 5])), fixed: Kernel::Packets }
     }
 
     /// Every queue runs `kernel` (tests and benchmarks).
@@ -263,7 +257,7 @@ impl TraversalChoice {
     }
 
     /// Each queue's choice: the kernel and the speeds its trial measured. Queues without a trial
-    /// (camera rays; every queue of a small scene), still in it, or never run are left out.
+    /// (camera rays; every queue of a fixed choice), still in it, or never run are left out.
     #[must_use]
     pub fn report(&self) -> Vec<QueueChoice> {
         let Some(trials) = &self.trials else { return vec![] };
@@ -290,10 +284,10 @@ mod tests {
     /// A trial traces its chunks both ways (packets first, then single rays first, in turn),
     /// leaves short chunks and chunks beyond the trial's count to packets, keeps the kernel with
     /// more rays per second once the pairs are in, and never times again; queues choose apart;
-    /// camera rays and small scenes never try single rays.
+    /// camera rays never try single rays, and a fixed choice never times.
     #[test]
     fn queues_keep_the_faster_kernel() {
-        let c = TraversalChoice::for_scene(TRIAL_MIN_TRIANGLES);
+        let c = TraversalChoice::timed();
         assert_eq!(c.begin(Queue::Shadows, TRIAL_MIN_RAYS - 1), Plan::Run(Kernel::Packets));
         let plans: Vec<Plan> = (0..TRIAL_PAIRS).map(|_| c.begin(Queue::Shadows, 1024)).collect();
         assert_eq!(&plans[..2], &[Plan::Pair(Kernel::Packets), Plan::Pair(Kernel::Single)]);
@@ -313,9 +307,9 @@ mod tests {
         let close = |a: Option<f64>, b: f64| (a.unwrap() - b).abs() < 1e-9;
         assert!(close(r[0].single_mrays, 1024.0) && close(r[0].packets_mrays, 512.0));
 
-        let small = TraversalChoice::for_scene(TRIAL_MIN_TRIANGLES - 1);
-        assert_eq!(small.begin(Queue::Shadows, 1024), Plan::Run(Kernel::Packets));
-        assert!(small.report().is_empty());
+        let packets = TraversalChoice::fixed(Kernel::Packets);
+        assert_eq!(packets.begin(Queue::Shadows, 1024), Plan::Run(Kernel::Packets));
+        assert!(packets.report().is_empty());
         assert_eq!(TraversalChoice::fixed(Kernel::Single).begin(Queue::Camera, 1024), Plan::Run(Kernel::Single));
     }
 
@@ -323,7 +317,7 @@ mod tests {
     /// kernel's result and times both.
     #[test]
     fn ties_keep_packets_and_trials_run_both() {
-        let c = TraversalChoice::for_scene(TRIAL_MIN_TRIANGLES);
+        let c = TraversalChoice::timed();
         for _ in 0..TRIAL_PAIRS {
             assert!(matches!(c.begin(Queue::Emitted, 1024), Plan::Pair(_)));
             c.end(Queue::Emitted, 1024, [1_000, 1_000]);
@@ -334,7 +328,7 @@ mod tests {
         let (p0, p1, p2) = ([Vec3::ZERO], [Vec3::X], [Vec3::Y]);
         let (bvh, _) = Bvh::build(&p0, &p1, &p2);
         let tris = TriangleColumns { p0: &p0, p1: &p1, p2: &p2 };
-        let c = TraversalChoice::for_scene(TRIAL_MIN_TRIANGLES);
+        let c = TraversalChoice::timed();
         let mut ran = vec![];
         let out = c.run(Queue::Secondary, 1024, &bvh, tris, |k| {
             ran.push(k);

@@ -360,11 +360,11 @@ fn renders_with_simd_kernels_match_renders_with_scalar_twins() {
 
 /// Packets and single rays find the same hits, so the per-queue choice between them changes
 /// speed only: renders with every queue on packets, every queue on single rays, and with the
-/// timed trials (forced on this small scene, on two threads so that trials run concurrently) are
+/// timed trials (on two threads, so that trials run concurrently) are
 /// identical to the bit, and the trials report a choice for each queue that ran one.
 #[test]
 fn the_traversal_choice_never_changes_an_image() {
-    use photonwave::traversal_choice::{Kernel, TraversalChoice, TRIAL_MIN_TRIANGLES};
+    use photonwave::traversal_choice::{Kernel, TraversalChoice};
     use std::sync::Arc;
     let loaded = load("cornell-spheres.toml");
     let settings = Settings {
@@ -385,7 +385,7 @@ fn the_traversal_choice_never_changes_an_image() {
     };
     let (packets, _) = render(TraversalChoice::fixed(Kernel::Packets));
     let (single, _) = render(TraversalChoice::fixed(Kernel::Single));
-    let (chosen, stats) = render(TraversalChoice::for_scene(TRIAL_MIN_TRIANGLES));
+    let (chosen, stats) = render(TraversalChoice::timed());
     assert!(packets == single, "single rays changed the image");
     assert!(packets == chosen, "the trials changed the image");
     let queues: Vec<&str> = stats.traversal.iter().map(|c| c.queue.as_str()).collect();

@@ -60,9 +60,8 @@ pub struct TraversalRow {
     /// packet ÷ the faster of Embree's two.
     pub ratio_vs_embree: Option<f64>,
     /// The kernel the renderer's per-queue choice runs on such rays
-    /// ([`crate::traversal_choice`]): packets on camera rays and on scenes under
-    /// [`TRIAL_MIN_TRIANGLES`](crate::traversal_choice::TRIAL_MIN_TRIANGLES) triangles, otherwise the
-    /// faster here of packets and the 8-wide single ray (what its trial picks).
+    /// ([`crate::traversal_choice`]): packets on camera rays, otherwise the faster here of
+    /// packets and the 8-wide single ray (what its trial picks).
     pub renderer_kernel: &'static str,
     /// That kernel's speed here, million rays per second.
     pub renderer_mrays: f64,
@@ -202,8 +201,8 @@ pub fn traversal(
             // Not asserted: obvhs's CWBVH traversal loses a few hits (recorded, see BENCHMARKS.md).
             let visits = count_visits(bvh.wide(tris), rays, any);
             let m = rays.len() as f64 * 1e-6;
-            let trial = label != "camera" && scene.triangle_count() >= crate::traversal_choice::TRIAL_MIN_TRIANGLES;
-            let (renderer_kernel, t_renderer) = if trial && tw < tp { ("single", tw) } else { ("packets", tp) };
+            let (renderer_kernel, t_renderer) =
+                if label != "camera" && tw < tp { ("single", tw) } else { ("packets", tp) };
             rows.push(TraversalRow {
                 renderer_kernel,
                 renderer_mrays: m / t_renderer,
