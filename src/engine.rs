@@ -65,7 +65,7 @@ pub fn render(
 /// Refuses what `job` cannot render with `engine` (progressively or not): a map the plan needs
 /// left empty, more memory than the machine has (before any of it is allocated), diagnostics
 /// from the path tracer.
-pub fn check_planned(job: &Job, engine: Engine, progressive: bool) -> Result<()> {
+pub fn check_planned(job: &Job, scene: &Scene, engine: Engine, progressive: bool) -> Result<()> {
     let settings = &job.settings;
     if engine != Engine::Path {
         job.plan.check(settings)?;
@@ -79,7 +79,13 @@ pub fn check_planned(job: &Job, engine: Engine, progressive: bool) -> Result<()>
                 + u64::from(settings.caustic_photons) * u64::from(job.plan.caustic_map.on)
         };
         let per_pixel = crate::memory::bytes_per_pixel(progressive);
-        crate::memory::check(settings.width, settings.height, per_pixel, photons, available, total)?;
+        // The wavefront engine's SIMD traversal builds the 8-wide BVH for single rays.
+        let wide_bvh = if engine == Engine::Wavefront && settings.code_path == crate::code_path::CodePath::Simd {
+            scene.triangle_count() as u64 * crate::memory::WIDE_BVH_BYTES_PER_TRIANGLE
+        } else {
+            0
+        };
+        crate::memory::check(settings.width, settings.height, per_pixel, photons, wide_bvh, available, total)?;
     }
     if engine == Engine::Path && settings.diagnostics {
         return Err(Error::setting(
@@ -102,7 +108,7 @@ pub fn render_planned(
     budget: Option<Budget>,
     progress: &dyn Progress,
 ) -> Result<(Film, RenderStats)> {
-    check_planned(job, engine, is_progressive(&job.settings, budget))?;
+    check_planned(job, scene, engine, is_progressive(&job.settings, budget))?;
     let settings = &job.settings;
     if !is_progressive(settings, budget) {
         let (mut film, mut stats) = render_job(scene, rays, job, engine, progress);

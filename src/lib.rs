@@ -44,7 +44,7 @@
 //!
 //! **Engines** — loops over the transport core:
 //! - [`reference`]: the scalar oracle, one ray at a time, that every fast path is tested against;
-//! - [`wavefront`]: bevy_ecs systems over structure-of-arrays queues, SIMD packets;
+//! - [`wavefront`]: bevy_ecs systems over structure-of-arrays queues, SIMD kernels;
 //! - [`path`]: an unbiased path tracer for checking energy;
 //!
 //! **Drivers and tools**:

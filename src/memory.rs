@@ -28,11 +28,17 @@ pub fn bytes_per_pixel(progressive: bool) -> u64 {
 /// Bytes of everything else (measured 12 MiB; the scene itself is already loaded).
 pub const BASE_BYTES: u64 = 16 << 20;
 
+/// Bytes per triangle of the 8-wide BVH the SIMD traversal builds for single rays (measured
+/// 91–93 on the bunny, the ogre and the 1 M-triangle sphere, BENCHMARKS.md issue 18): built
+/// during the render, so it counts against the machine's memory.
+pub const WIDE_BVH_BYTES_PER_TRIANGLE: u64 = 96;
+
 /// A render's estimated peak memory, in bytes: a `width × height` image at `per_pixel` bytes a
-/// pixel ([`bytes_per_pixel`]) and `photons` stored in all its maps together.
+/// pixel ([`bytes_per_pixel`]), `photons` stored in all its maps together, and `scene_bytes` of
+/// structures built over the scene during the render (the 8-wide BVH).
 #[must_use]
-pub fn estimate(width: u32, height: u32, per_pixel: u64, photons: u64) -> u64 {
-    BASE_BYTES + u64::from(width) * u64::from(height) * per_pixel + photons * BYTES_PER_PHOTON
+pub fn estimate(width: u32, height: u32, per_pixel: u64, photons: u64, scene_bytes: u64) -> u64 {
+    BASE_BYTES + u64::from(width) * u64::from(height) * per_pixel + photons * BYTES_PER_PHOTON + scene_bytes
 }
 
 /// The machine's memory available to a new allocation and in all (Linux `/proc/meminfo`'s
@@ -50,8 +56,16 @@ pub fn machine() -> Option<(u64, u64)> {
 
 /// Refuses a render whose estimate exceeds `available` bytes (of `total`), saying what it would
 /// need, what the machine has, and what to lower.
-pub fn check(width: u32, height: u32, per_pixel: u64, photons: u64, available: u64, total: u64) -> Result<()> {
-    let need = estimate(width, height, per_pixel, photons);
+pub fn check(
+    width: u32,
+    height: u32,
+    per_pixel: u64,
+    photons: u64,
+    scene_bytes: u64,
+    available: u64,
+    total: u64,
+) -> Result<()> {
+    let need = estimate(width, height, per_pixel, photons, scene_bytes);
     if need <= available {
         return Ok(());
     }
@@ -60,9 +74,10 @@ pub fn check(width: u32, height: u32, per_pixel: u64, photons: u64, available: u
         if pixels * per_pixel >= photons * BYTES_PER_PHOTON { "width" } else { "photons" },
         format!(
             "this render needs about {} ({width}×{height} pixels at ~{per_pixel} B, {photons} photons at \
-             ~{BYTES_PER_PHOTON} B), but the machine has {} available of {}; lower the image size or \
-             the photon counts (README, \"Limits\")",
+             ~{BYTES_PER_PHOTON} B, {} for the scene's 8-wide BVH), but the machine has {} available of \
+             {}; lower the image size or the photon counts (README, \"Limits\")",
             bytes(need),
+            bytes(scene_bytes),
             bytes(available),
             bytes(total)
         ),
@@ -75,14 +90,20 @@ mod tests {
 
     #[test]
     fn a_huge_image_is_refused_with_the_estimate_and_the_machine() {
-        let e = check(16384, 16384, BYTES_PER_PIXEL, 200_000, 20 << 30, 24 << 30).unwrap_err().to_string();
+        let e = check(16384, 16384, BYTES_PER_PIXEL, 200_000, 0, 20 << 30, 24 << 30).unwrap_err().to_string();
         assert!(
             e.starts_with("setting `width`") && e.contains("40.0 GiB") && e.contains("20.0 GiB available of 24.0 GiB"),
             "{e}"
         );
-        check(320, 320, BYTES_PER_PIXEL, 300_000, 1 << 30, 1 << 30).unwrap();
-        let e = check(320, 320, BYTES_PER_PIXEL, 200_000_000, 8 << 30, 8 << 30).unwrap_err().to_string();
+        check(320, 320, BYTES_PER_PIXEL, 300_000, 0, 1 << 30, 1 << 30).unwrap();
+        let e = check(320, 320, BYTES_PER_PIXEL, 200_000_000, 0, 8 << 30, 8 << 30).unwrap_err().to_string();
         assert!(e.starts_with("setting `photons`") && e.contains("200000000 photons"), "{e}");
+        // A scene of 10 M triangles: its 8-wide BVH (~0.9 GiB) tips a render that fits without it.
+        let wide = 10_000_000 * WIDE_BVH_BYTES_PER_TRIANGLE;
+        let without = estimate(320, 320, BYTES_PER_PIXEL, 300_000, 0);
+        check(320, 320, BYTES_PER_PIXEL, 300_000, 0, without + (1 << 20), 8 << 30).unwrap();
+        let e = check(320, 320, BYTES_PER_PIXEL, 300_000, wide, without + (1 << 20), 8 << 30).unwrap_err().to_string();
+        assert!(e.contains("915.5 MiB for the scene's 8-wide BVH"), "{e}");
     }
 
     #[test]

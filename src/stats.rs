@@ -341,17 +341,14 @@ impl RenderStats {
         }
         if !self.traversal.is_empty() {
             out += "  traversal per ray queue (chosen by timing both kernels, Mrays/s):\n";
-            let rate = |r: Option<f64>| r.map_or("-".to_string(), |r| format!("{r:.2}"));
             for c in &self.traversal {
                 let kernel = match c.kernel {
                     crate::traversal_choice::Kernel::Packets => "packets",
                     crate::traversal_choice::Kernel::Single => "single rays",
                 };
                 out += &format!(
-                    "    {:<10} {kernel:<12} (packets {}, single rays {})\n",
-                    c.queue,
-                    rate(c.packets_mrays),
-                    rate(c.single_mrays)
+                    "    {:<16} {kernel:<12} (packets {:.2}, single rays {:.2})\n",
+                    c.queue, c.packets_mrays, c.single_mrays
                 );
             }
         }

@@ -6,7 +6,7 @@
 //! not on the triangle count alone (BENCHMARKS.md, "Packets or single rays, chosen per queue by
 //! timing"): packets win on camera rays everywhere and on the shadow rays of the bundled boxes;
 //! single rays on photon rays in every scene measured (1.3–2.2× in the trials) and on the
-//! final-gather rays of the bundled Cornell boxes (1.2–1.35×, the packets' coherence sort
+//! final-gather rays of the bundled Cornell boxes (1.19–1.35×, the packets' coherence sort
 //! included). So each queue times both
 //! kernels on its first chunks and keeps the faster for the rest of the render (every later pass
 //! included). Hits are identical either way, so the choice changes speed only, never an image.
@@ -50,12 +50,17 @@ impl Kernel {
 /// The ray queues that choose apart.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Queue {
-    /// Photons leaving the lights (their first segment: from a few points or one direction).
+    /// Global photons leaving the lights (their first segment: from a few points or one
+    /// direction).
     Emitted,
-    /// Photons' later segments, from surfaces.
+    /// Global photons' later segments, from surfaces.
     Photons,
+    /// Caustic photons leaving the lights, aimed at mirrors and glass (coherent).
+    CausticEmitted,
+    /// Caustic photons' later segments.
+    CausticPhotons,
     /// Primary rays: always packets, which were faster on the camera rays of every measured
-    /// scene (0.37–0.77× for single rays, from the Cornell boxes to the 1 M sphere; BENCHMARKS.md),
+    /// scene (0.29–0.88× for single rays, from the Cornell boxes to the 1 M sphere; BENCHMARKS.md),
     /// and whose first chunks (the image's top rows, often sky) would not tell.
     Camera,
     /// Camera paths' later segments: final-gather, glossy and specular rays.
@@ -65,7 +70,15 @@ pub enum Queue {
 }
 
 impl Queue {
-    const ALL: [Queue; 5] = [Queue::Emitted, Queue::Photons, Queue::Camera, Queue::Secondary, Queue::Shadows];
+    const ALL: [Queue; 7] = [
+        Queue::Emitted,
+        Queue::Photons,
+        Queue::CausticEmitted,
+        Queue::CausticPhotons,
+        Queue::Camera,
+        Queue::Secondary,
+        Queue::Shadows,
+    ];
 
     /// Its name in stats.
     #[must_use]
@@ -73,6 +86,8 @@ impl Queue {
         match self {
             Queue::Emitted => "emitted",
             Queue::Photons => "photon",
+            Queue::CausticEmitted => "caustic emitted",
+            Queue::CausticPhotons => "caustic photon",
             Queue::Camera => "camera",
             Queue::Secondary => "secondary",
             Queue::Shadows => "shadow",
@@ -92,10 +107,10 @@ struct Trial {
 }
 
 impl Trial {
-    /// Million rays per second of kernel `k` over the trial's chunks.
-    fn rate(&self, k: Kernel) -> Option<f64> {
-        let ns = self.nanos[k as usize];
-        (ns > 0).then(|| self.rays as f64 * 1e3 / ns as f64)
+    /// Million rays per second of kernel `k` over the trial's chunks (each chunk's time counts
+    /// at least 1 ns, so once a chunk is in this is finite).
+    fn rate(&self, k: Kernel) -> f64 {
+        self.rays as f64 * 1e3 / self.nanos[k as usize].max(1) as f64
     }
 }
 
@@ -109,17 +124,17 @@ enum Plan {
 }
 
 /// What a queue chose, and the speeds it measured (million rays per second over its trial
-/// chunks; `None` where that kernel was not timed).
+/// chunks).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct QueueChoice {
-    /// Queue name: photon, camera, secondary or shadow.
+    /// Queue name ([`Queue::name`]).
     pub queue: String,
     /// The kernel it runs.
     pub kernel: Kernel,
     /// Packets' speed in the trial.
-    pub packets_mrays: Option<f64>,
+    pub packets_mrays: f64,
     /// Single rays' speed in the trial.
-    pub single_mrays: Option<f64>,
+    pub single_mrays: f64,
 }
 
 /// The per-queue choice of one render (shared by its passes).
@@ -131,7 +146,7 @@ pub struct QueueChoice {
 #[derive(Debug)]
 pub struct TraversalChoice {
     /// `None`: every queue runs `fixed`.
-    trials: Option<Mutex<[Trial; 5]>>,
+    trials: Option<Mutex<[Trial; 7]>>,
     fixed: Kernel,
 }
 
@@ -139,10 +154,10 @@ impl TraversalChoice {
     /// Every queue but the camera rays' chooses by its trial (the renderer's default).
     #[must_use]
     pub fn timed() -> Self {
-        TraversalChoice { trials: Some(Mutex::new([Trial::default(); 5])), fixed: Kernel::Packets }
+        TraversalChoice { trials: Some(Mutex::new([Trial::default(); 7])), fixed: Kernel::Packets }
     }
 
-    /// Every queue runs `kernel` (tests and benchmarks).
+    /// Every queue runs `kernel` (tests).
     #[must_use]
     pub fn fixed(kernel: Kernel) -> Self {
         TraversalChoice { trials: None, fixed: kernel }
@@ -181,10 +196,10 @@ impl TraversalChoice {
         }
     }
 
-    /// Traces a chunk of `rays` rays of `queue` with `trace(kernel)`: with the queue's kernel,
-    /// or in a trial with both (keeping the first's result; the two are identical). The 8-wide
-    /// BVH is built (once) before any timer starts.
-    fn run<T>(
+    /// Traces a chunk of `rays` rays of `queue` with `trace(kernel)`: with the queue's kernel, or
+    /// in a trial with both, keeping the packets' result whichever ran first (the two are
+    /// identical; debug builds check it). The 8-wide BVH is built (once) before any timer starts.
+    fn run<T: PartialEq + std::fmt::Debug>(
         &self,
         queue: Queue,
         rays: usize,
@@ -200,16 +215,18 @@ impl TraversalChoice {
             Plan::Run(k) => return trace(k),
             Plan::Pair(k) => k,
         };
-        let timed = |trace: &mut dyn FnMut(Kernel) -> T, k: Kernel| {
+        let mut timed = |k: Kernel| {
             let start = Instant::now();
             let out = trace(k);
             (out, u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX))
         };
-        let (out, ns_first) = timed(&mut trace, first);
-        let (_, ns_second) = timed(&mut trace, first.other());
-        let nanos = if first == Kernel::Packets { [ns_first, ns_second] } else { [ns_second, ns_first] };
-        self.end(queue, rays, nanos);
-        out
+        let a = timed(first);
+        let b = timed(first.other());
+        let ((packets, ns_packets), (single, ns_single)) = if first == Kernel::Packets { (a, b) } else { (b, a) };
+        debug_assert_eq!(packets, single, "packets and single rays disagree");
+        drop(single);
+        self.end(queue, rays, [ns_packets, ns_single]);
+        packets
     }
 
     /// Closest hits of a chunk of `queue` (in input order). The scalar code path runs the
@@ -250,10 +267,15 @@ impl TraversalChoice {
         if set == CodePath::Scalar {
             return set.occluded(bvh, tris, rays, out);
         }
-        self.run(queue, rays.len(), bvh, tris, |k| match k {
-            Kernel::Packets => set.occluded(bvh, tris, rays, out),
-            Kernel::Single => wide_traverse::occluded_rays::<true>(bvh.wide(tris), rays, out),
+        let blocked = self.run(queue, rays.len(), bvh, tris, |k| {
+            let mut blocked = vec![false; rays.len()];
+            match k {
+                Kernel::Packets => set.occluded(bvh, tris, rays, &mut blocked),
+                Kernel::Single => wide_traverse::occluded_rays::<true>(bvh.wide(tris), rays, &mut blocked),
+            }
+            blocked
         });
+        out.copy_from_slice(&blocked);
     }
 
     /// Each queue's choice: the kernel and the speeds its trial measured. Queues without a trial
@@ -304,7 +326,7 @@ mod tests {
         let r = c.report();
         assert_eq!(r.len(), 1);
         assert_eq!((r[0].queue.as_str(), r[0].kernel), ("shadow", Kernel::Single));
-        let close = |a: Option<f64>, b: f64| (a.unwrap() - b).abs() < 1e-9;
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
         assert!(close(r[0].single_mrays, 1024.0) && close(r[0].packets_mrays, 512.0));
 
         let packets = TraversalChoice::fixed(Kernel::Packets);
@@ -313,8 +335,8 @@ mod tests {
         assert_eq!(TraversalChoice::fixed(Kernel::Single).begin(Queue::Camera, 1024), Plan::Run(Kernel::Single));
     }
 
-    /// Equal times keep packets, the renderer's long-standing default; `run` returns the first
-    /// kernel's result and times both.
+    /// Equal times keep packets, the renderer's long-standing default; a trial's `run` traces
+    /// with both kernels, in turn first, and returns the result.
     #[test]
     fn ties_keep_packets_and_trials_run_both() {
         let c = TraversalChoice::timed();
@@ -332,8 +354,15 @@ mod tests {
         let mut ran = vec![];
         let out = c.run(Queue::Secondary, 1024, &bvh, tris, |k| {
             ran.push(k);
-            k
+            1024
         });
-        assert_eq!((out, ran), (Kernel::Packets, vec![Kernel::Packets, Kernel::Single]));
+        assert_eq!((out, ran), (1024, vec![Kernel::Packets, Kernel::Single]));
+        // The second pair runs single rays first.
+        let mut ran = vec![];
+        let out = c.run(Queue::Secondary, 1024, &bvh, tris, |k| {
+            ran.push(k);
+            7
+        });
+        assert_eq!((out, ran), (7, vec![Kernel::Single, Kernel::Packets]));
     }
 }

@@ -389,6 +389,10 @@ fn the_traversal_choice_never_changes_an_image() {
     assert!(packets == single, "single rays changed the image");
     assert!(packets == chosen, "the trials changed the image");
     let queues: Vec<&str> = stats.traversal.iter().map(|c| c.queue.as_str()).collect();
-    assert_eq!(queues, ["emitted", "photon", "secondary", "shadow"]);
-    assert!(stats.traversal.iter().all(|c| c.packets_mrays.is_some() && c.single_mrays.is_some()));
+    for q in ["emitted", "photon", "secondary", "shadow"] {
+        assert!(queues.contains(&q), "{q} not in {queues:?}");
+    }
+    assert!(!queues.contains(&"camera"), "camera rays have no trial: {queues:?}");
+    let speed = |v: f64| v.is_finite() && v > 0.0;
+    assert!(stats.traversal.iter().all(|c| speed(c.packets_mrays) && speed(c.single_mrays)), "{:?}", stats.traversal);
 }

@@ -292,7 +292,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     };
     let settings = &job.settings;
     let (film, mut stats, signal) = if progressive {
-        photonwave::engine::check_planned(&job, args.engine, true)?;
+        photonwave::engine::check_planned(&job, &scene, args.engine, true)?;
         let lights: Vec<String> = args.light.iter().map(|l| format!("{l:?}")).collect();
         let identity = Identity::new(
             &loaded.inputs,

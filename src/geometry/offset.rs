@@ -3,7 +3,10 @@
 //! The hit point is computed from barycentrics, whose rounding error is bounded by
 //! γ₇·(|b0·p0| + |b1·p1| + |b2·p2|) per axis (pbrt-v4 §6.8.6). The new origin is pushed along the
 //! geometric normal just past that error box, then one ulp further away from the surface, so the
-//! offset scales with the scene: a Cornell box at 1e-4 or 1e5 units behaves the same.
+//! offset scales with the scene: a Cornell box at 1e-4 or 1e5 units behaves the same. The one
+//! absolute length is a floor of 2⁻⁶³ ≈ 1.1·10⁻¹⁹ on a coordinate that would otherwise stay at
+//! or near 0 ([`OFFSET_FLOOR`]): it matters only to geometry within 10⁻¹⁹ of a coordinate plane,
+//! that is, to scenes whose units are below ~10⁻¹².
 
 use glam::Vec3;
 
@@ -27,10 +30,11 @@ pub fn barycentric_error(b: [f32; 3], p0: Vec3, p1: Vec3, p2: Vec3) -> Vec3 {
 /// its normal is 0) one ulp is a subnormal; the smallest normal float itself is no better, as
 /// every product of it with a factor below 1 (a box test's inverse direction, the triangle test's
 /// shear) is subnormal again. Each subnormal operand or result costs a microcode assist, and
-/// these rays test many boxes and triangles: at 2⁻⁶³ such products, and the product of two such
-/// coordinates, stay normal. (Measured: BENCHMARKS.md "Subnormal assists in the renderer"; the
-/// floor is far below any scene's scale, and an origin further out than its error box is still
-/// on the side of the ray.)
+/// these rays test many boxes and triangles: at 2⁻⁶³ the products with factors down to 2⁻⁶³
+/// stay normal (the product of two floored coordinates, 2⁻¹²⁶, is the smallest normal float, so
+/// a third small factor can still underflow: a cost in speed only, and rare). Measured:
+/// BENCHMARKS.md "The origin floor at 2⁻⁶³". An origin further out than its error box is still
+/// on the side of the ray.
 pub const OFFSET_FLOOR: f32 = 1.084_202_2e-19;
 
 /// The origin for a ray leaving point `p` (error bound `p_error`, geometric normal `n`) toward

@@ -1,12 +1,14 @@
 //! Intersect: closest hits for every lane of the photon or path queue, and any-hit tests for
 //! the shadow queue, with the configured kernels: the SIMD set runs packets (chunks traced in
-//! coherence-key order) or single rays, chosen per queue by timing ([`crate::traversal_choice`]). Reads rays; writes hit columns (and, for shadow rays, the unblocked
-//! contributions into the wave's terms, in lane order).
+//! coherence-key order) or single rays, chosen per queue by timing
+//! ([`crate::traversal_choice`]). Reads rays; writes hit columns (and, for shadow rays, the
+//! unblocked contributions into the wave's terms, in lane order).
 
 use super::queues::PathKind;
 use super::queues::{HitColumns, RayColumns};
 use super::{par_columns, par_lanes, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
 use crate::geometry::RayQuery;
+use crate::rng::Domain;
 use crate::traversal_choice::Queue;
 use bevy_ecs::prelude::*;
 use std::time::Instant;
@@ -42,9 +44,16 @@ fn closest_hits(shared: &Shared, queue: Queue, rays: &RayColumns, hits: &mut Hit
 /// Closest hits of the photon queue.
 pub fn intersect_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
+    let domain = work.domain;
     let q = &mut work.queue;
-    // A bounce's queue holds photons of one bounce count.
-    let queue = if q.bounce.first() == Some(&0) { Queue::Emitted } else { Queue::Photons };
+    // A bounce's queue holds photons of one map and one bounce count.
+    let emitted = q.bounce.first() == Some(&0);
+    let queue = match (domain, emitted) {
+        (Some(Domain::CausticPhoton), true) => Queue::CausticEmitted,
+        (Some(Domain::CausticPhoton), false) => Queue::CausticPhotons,
+        (_, true) => Queue::Emitted,
+        (_, false) => Queue::Photons,
+    };
     closest_hits(&shared, queue, &q.rays, &mut q.hits);
     let n = q.len();
     work.rays += n as u64;
