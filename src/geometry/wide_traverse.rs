@@ -182,8 +182,9 @@ pub fn closest_counted<const SIMD: bool, const COUNT: bool>(
     let nodes = bvh.nodes();
     let mut best = Best::new(ray.t_max);
     stack.clear();
-    stack.push((0, 0, 0.0));
-    while let Some((c, count, tc)) = stack.pop() {
+    // The nearest entered child is visited next without a trip through the stack.
+    let mut next = Some((0, 0, 0.0));
+    while let Some((c, count, tc)) = next.take().or_else(|| stack.pop()) {
         if tc > best.t {
             continue;
         }
@@ -203,10 +204,15 @@ pub fn closest_counted<const SIMD: bool, const COUNT: bool>(
         }
         let node = &nodes[c as usize];
         let (keys, n) = entered::<SIMD>(node, &r, o, inv, best.t);
-        for &key in keys[..n].iter().rev() {
+        if n == 0 {
+            continue;
+        }
+        for &key in keys[1..n].iter().rev() {
             let (i, t) = unkey(key);
             stack.push((node.child[i], u32::from(node.count[i]), t));
         }
+        let (i, t) = unkey(keys[0]);
+        next = Some((node.child[i], u32::from(node.count[i]), t));
     }
     best.hit()
 }
@@ -237,8 +243,9 @@ pub fn occluded_counted<const SIMD: bool, const COUNT: bool>(
         any_leaf(blocks, &sheared, t_max, &mut visits.scalar)
     };
     stack.clear();
-    stack.push((0, 0, 0.0));
-    while let Some((c, count, _)) = stack.pop() {
+    // The nearest entered inner child is visited next without a trip through the stack.
+    let mut next = Some((0, 0, 0.0));
+    while let Some((c, count, _)) = next.take().or_else(|| stack.pop()) {
         if count > 0 {
             if leaf_hit(c, count, visits) {
                 return true;
@@ -250,7 +257,8 @@ pub fn occluded_counted<const SIMD: bool, const COUNT: bool>(
             visits.nodes += 1;
         }
         let (keys, n) = entered::<SIMD>(node, &r, o, inv, t_max);
-        // Leaf children first, nearest first; then the inner children, nearest on top.
+        // Leaf children first, nearest first; then the inner children: the nearest next, the
+        // others on the stack, nearer on top.
         for &key in &keys[..n] {
             let (i, _) = unkey(key);
             if node.count[i] > 0 && leaf_hit(node.child[i], u32::from(node.count[i]), visits) {
@@ -260,7 +268,9 @@ pub fn occluded_counted<const SIMD: bool, const COUNT: bool>(
         for &key in keys[..n].iter().rev() {
             let (i, t) = unkey(key);
             if node.count[i] == 0 {
-                stack.push((node.child[i], 0, t));
+                if let Some(farther) = next.replace((node.child[i], 0, t)) {
+                    stack.push(farther);
+                }
             }
         }
     }
