@@ -104,8 +104,25 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
         // functions' error, and the bound can exceed a t of 1 — two slivers sharing an edge
         // would both refuse a ray through it, and a closed mesh would leak. Decide in f64.
         F32Test::Unproven(h) => positive_t_f64(o, d, [p0, p1, p2]).then_some(h),
+        // Coordinates so small (≲ 10⁻¹³ of the ray's length scale) that f32's products for t
+        // underflow: t and the barycentrics in f64, the edges' f32 decision kept.
+        F32Test::Tiny => {
+            let (t, delta_t, b) = t_f64(o, d, [p0, p1, p2])?;
+            let t32 = t as f32;
+            let b = b.map(|v| v as f32);
+            (t > delta_t && t32 < t_max && t32 > 0.0 && b.iter().all(|v| v.is_finite()))
+                .then_some(TriangleHit { t: t32, b })
+        }
     }
 }
+
+/// Below this, the product of the determinant (for a ray inside the edges, one to three times
+/// the largest edge function) and the largest scaled z — about the largest term of t's
+/// numerator — comes so near f32's subnormal range that t (or its error bound) underflows: such
+/// a test is decided in f64 ([`F32Test::Tiny`]). Reached only by triangles
+/// and origins ~10⁻¹³ apart or less, far below any scene's features; the SIMD tests hand such
+/// lanes to the scalar test.
+pub const TINY_T_TERM: f32 = 7.888_609e-31;
 
 /// What the f32 test decided.
 enum F32Test {
@@ -113,6 +130,8 @@ enum F32Test {
     Miss,
     /// Inside the edges at 0 < t < t_max, but t does not exceed the bound on its error.
     Unproven(TriangleHit),
+    /// Inside the edges, with magnitudes too small for t in f32 ([`TINY_T_TERM`]).
+    Tiny,
 }
 
 #[inline(always)]
@@ -172,6 +191,11 @@ fn intersect_f32(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> 
     // ray aimed at a light point (|d| = the distance) in a scene 1e-4 units across then rejects
     // true hits as "not provably positive" and light leaks through closed objects.
     let max_z_len = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
+    // Rounding is monotonic, so this is the largest scaled |z| exactly, one product cheaper.
+    let max_zt = max_z_len * sz.abs();
+    if det.abs() * max_zt < TINY_T_TERM {
+        return F32Test::Tiny;
+    }
     p0t.z *= sz;
     p1t.z *= sz;
     p2t.z *= sz;
@@ -190,8 +214,6 @@ fn intersect_f32(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> 
     }
 
     // Reject hits whose t is not provably positive (pbrt-v4 eq. 6.8.4 bounds).
-    // Rounding is monotonic, so this is the largest scaled |z| exactly, one product cheaper.
-    let max_zt = max_z_len * sz.abs();
     let delta_z = gamma(3) * max_zt;
     let max_xt = p0t.x.abs().max(p1t.x.abs()).max(p2t.x.abs());
     let max_yt = p0t.y.abs().max(p1t.y.abs()).max(p2t.y.abs());
@@ -222,6 +244,15 @@ fn gamma64(n: f64) -> f64 {
 #[cold]
 #[inline(never)]
 fn positive_t_f64(o: Vec3, d: Vec3, p: [Vec3; 3]) -> bool {
+    t_f64(o, d, p).is_some_and(|(t, delta_t, _)| t > delta_t)
+}
+
+/// t of the ray's meeting with the triangle's plane, the bound on its error, and the
+/// barycentrics, by the steps of [`intersect_triangle`] in f64; `None` where the plane is
+/// parallel to the ray.
+#[cold]
+#[inline(never)]
+fn t_f64(o: Vec3, d: Vec3, p: [Vec3; 3]) -> Option<(f64, f64, [f64; 3])> {
     let kz = dominant_axis(d);
     let perm = |v: Vec3| {
         let v = permute(v, kz);
@@ -250,7 +281,7 @@ fn positive_t_f64(o: Vec3, d: Vec3, p: [Vec3; 3]) -> bool {
     let delta_e = 2.0 * (gamma64(2.0) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
     let max_e = e[0].abs().max(e[1].abs()).max(e[2].abs());
     let delta_t = 3.0 * (gamma64(3.0) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) / det.abs();
-    det != 0.0 && t > delta_t
+    (det != 0.0).then_some((t, delta_t, e.map(|v| v / det)))
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@
 //! positive; lanes where either happens are handed back for the scalar test to decide.
 
 use super::offset::gamma;
-use super::triangle::{dominant_axis, intersect_triangle, is_degenerate};
+use super::triangle::{dominant_axis, intersect_triangle, is_degenerate, TINY_T_TERM};
 use glam::Vec3;
 use wide::f32x8;
 
@@ -47,20 +47,24 @@ pub(super) fn watertight8(
     let det = e0 + e1 + e2;
     // The shear's error is in length units: it takes z before the scaling to ray parameters.
     let max_z_len = z0.abs().max(z1.abs()).max(z2.abs());
+    // Rounding is monotonic, so this is the largest scaled |z| exactly, as the scalar test has it.
+    let max_zt = max_z_len * sz.abs();
+    let plane = edges & det.simd_ne(zero) & det.is_finite();
+    // Magnitudes too small for t in f32: the scalar test decides in f64.
+    let tiny = plane & (det.abs() * max_zt).simd_lt(f32x8::splat(TINY_T_TERM));
+    let fallback = fallback | (bits(tiny) & lanes);
     let (z0, z1, z2) = (z0 * sz, z1 * sz, z2 * sz);
     let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
     let bound = t_max * det;
     let det_neg = det.simd_lt(zero) & (t_scaled.simd_ge(zero) | t_scaled.simd_lt(bound));
     let det_pos = det.simd_gt(zero) & (t_scaled.simd_le(zero) | t_scaled.simd_gt(bound));
-    let in_range = edges & det.simd_ne(zero) & det.is_finite() & !det_neg & !det_pos;
+    let in_range = plane & !det_neg & !det_pos;
     if bits(in_range) & lanes | fallback == 0 {
         return none;
     }
     let inv_det = f32x8::ONE / det;
     let t = t_scaled * inv_det;
     // pbrt-v4's bound on t's error; t must exceed it.
-    // Rounding is monotonic, so this is the largest scaled |z| exactly, as the scalar test has it.
-    let max_zt = max_z_len * sz.abs();
     let delta_z = f32x8::splat(gamma(3)) * max_zt;
     let max_xt = x0.abs().max(x1.abs()).max(x2.abs());
     let max_yt = y0.abs().max(y1.abs()).max(y2.abs());
