@@ -100,13 +100,14 @@ pub fn coherence_key(o: Vec3, d: Vec3, grid: &MortonGrid) -> u32 {
 }
 
 /// Traces `rays` in coherence-key order (packets of 8 that start close together and point
-/// alike) and returns the results in the input order. The SIMD kernels' results do not depend on
-/// the order (each lane's hit is the scalar twin's), so sorting changes speed only.
+/// alike) and writes the results into `out` in the input order. The SIMD kernels' results do not
+/// depend on the order (each lane's hit is the scalar twin's), so sorting changes speed only.
 fn in_coherent_order<T: Copy + Default>(
     rays: &[RayQuery],
     bounds: (Vec3, Vec3),
+    out: &mut [T],
     trace: impl FnOnce(&[RayQuery], &mut [T]),
-) -> Vec<T> {
+) {
     let grid = MortonGrid::new(bounds, COHERENCE_CELLS);
     let mut order: Vec<(u32, u32)> =
         rays.iter().enumerate().map(|(i, r)| (coherence_key(r.origin, r.direction, &grid), i as u32)).collect();
@@ -114,30 +115,25 @@ fn in_coherent_order<T: Copy + Default>(
     let sorted: Vec<RayQuery> = order.iter().map(|&(_, i)| rays[i as usize]).collect();
     let mut traced = vec![T::default(); rays.len()];
     trace(&sorted, &mut traced);
-    let mut out = vec![T::default(); rays.len()];
     for (&(_, i), t) in order.iter().zip(traced) {
         out[i as usize] = t;
     }
-    out
 }
 
 impl CodePath {
-    /// Closest hits of `rays` (in input order); the SIMD set traces them sorted for coherence.
-    #[must_use]
+    /// Closest hits of `rays` into `out` (in input order); the SIMD set traces them sorted for
+    /// coherence.
     pub fn closest_coherent(
         self,
         bvh: &Bvh,
         tris: TriangleColumns<'_>,
         rays: &[RayQuery],
         bounds: (Vec3, Vec3),
-    ) -> Vec<Option<Hit>> {
+        out: &mut [Option<Hit>],
+    ) {
         match self {
-            CodePath::Simd => in_coherent_order(rays, bounds, |r, o| packet::closest_packets(bvh, tris, r, o)),
-            CodePath::Scalar => {
-                let mut out = vec![None; rays.len()];
-                traverse::closest_rays(bvh, tris, rays, &mut out);
-                out
-            }
+            CodePath::Simd => in_coherent_order(rays, bounds, out, |r, o| packet::closest_packets(bvh, tris, r, o)),
+            CodePath::Scalar => traverse::closest_rays(bvh, tris, rays, out),
         }
     }
 }

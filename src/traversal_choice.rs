@@ -144,28 +144,36 @@ pub struct QueueChoice {
 /// so the comparison does not depend on how chunks differ (sky or mesh, near or far). The queue
 /// then keeps the kernel with more rays per second over those chunks; ties keep packets.
 #[derive(Debug)]
-pub struct TraversalChoice {
-    /// `None`: every queue runs `fixed`.
-    trials: Option<Mutex<[Trial; 7]>>,
-    fixed: Kernel,
+pub struct TraversalChoice(Mode);
+
+/// Trials or a fixed kernel.
+#[derive(Debug)]
+enum Mode {
+    /// Each queue's trial (the camera rays' slot unused).
+    Timed(Box<Mutex<[Trial; 7]>>),
+    /// Every queue runs this kernel.
+    Fixed(Kernel),
 }
 
 impl TraversalChoice {
     /// Every queue but the camera rays' chooses by its trial (the renderer's default).
     #[must_use]
     pub fn timed() -> Self {
-        TraversalChoice { trials: Some(Mutex::new([Trial::default(); 7])), fixed: Kernel::Packets }
+        TraversalChoice(Mode::Timed(Box::new(Mutex::new([Trial::default(); 7]))))
     }
 
     /// Every queue runs `kernel` (tests).
     #[must_use]
     pub fn fixed(kernel: Kernel) -> Self {
-        TraversalChoice { trials: None, fixed: kernel }
+        TraversalChoice(Mode::Fixed(kernel))
     }
 
     /// How to trace a chunk of `rays` rays of `queue`.
     fn begin(&self, queue: Queue, rays: usize) -> Plan {
-        let Some(trials) = &self.trials else { return Plan::Run(self.fixed) };
+        let trials = match &self.0 {
+            Mode::Timed(trials) => trials,
+            Mode::Fixed(k) => return Plan::Run(*k),
+        };
         if queue == Queue::Camera {
             return Plan::Run(Kernel::Packets);
         }
@@ -184,7 +192,7 @@ impl TraversalChoice {
     /// Records a chunk of `rays` rays traced both ways in `nanos` (packets, single rays); after
     /// the last pair the queue chooses.
     fn end(&self, queue: Queue, rays: usize, nanos: [u64; 2]) {
-        let Some(trials) = &self.trials else { return };
+        let Mode::Timed(trials) = &self.0 else { return };
         let mut trials = trials.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         let t = &mut trials[queue as usize];
         t.finished += 1;
@@ -196,37 +204,32 @@ impl TraversalChoice {
         }
     }
 
-    /// Traces a chunk of `rays` rays of `queue` with `trace(kernel)`: with the queue's kernel, or
-    /// in a trial with both, keeping the packets' result whichever ran first (the two are
+    /// Traces a chunk of `queue` into `out` with `trace(kernel, out)`: with the queue's kernel,
+    /// or in a trial with both, keeping the packets' result whichever ran first (the two are
     /// identical; debug builds check it). The 8-wide BVH is built (once) before any timer starts.
-    fn run<T: PartialEq + std::fmt::Debug>(
+    fn run<T: Clone + PartialEq + std::fmt::Debug>(
         &self,
         queue: Queue,
-        rays: usize,
         bvh: &Bvh,
         tris: TriangleColumns<'_>,
-        mut trace: impl FnMut(Kernel) -> T,
-    ) -> T {
-        let plan = self.begin(queue, rays);
-        if matches!(plan, Plan::Pair(_) | Plan::Run(Kernel::Single)) {
-            let _ = bvh.wide(tris);
-        }
-        let first = match plan {
-            Plan::Run(k) => return trace(k),
+        out: &mut [T],
+        mut trace: impl FnMut(Kernel, &mut [T]),
+    ) {
+        let first = match self.begin(queue, out.len()) {
+            Plan::Run(k) => return trace(k, out),
             Plan::Pair(k) => k,
         };
-        let mut timed = |k: Kernel| {
+        let _ = bvh.wide(tris);
+        let mut single = out.to_vec();
+        let mut nanos = [0u64; 2];
+        for k in [first, first.other()] {
+            let into = if k == Kernel::Packets { &mut *out } else { &mut single[..] };
             let start = Instant::now();
-            let out = trace(k);
-            (out, u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX))
-        };
-        let a = timed(first);
-        let b = timed(first.other());
-        let ((packets, ns_packets), (single, ns_single)) = if first == Kernel::Packets { (a, b) } else { (b, a) };
-        debug_assert_eq!(packets, single, "packets and single rays disagree");
-        drop(single);
-        self.end(queue, rays, [ns_packets, ns_single]);
-        packets
+            trace(k, into);
+            nanos[k as usize] = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        }
+        debug_assert_eq!(*out, single[..], "packets and single rays disagree");
+        self.end(queue, out.len(), nanos);
     }
 
     /// Closest hits of a chunk of `queue` (in input order). The scalar code path runs the
@@ -241,17 +244,16 @@ impl TraversalChoice {
         rays: &[RayQuery],
         bounds: (Vec3, Vec3),
     ) -> Vec<Option<Hit>> {
+        let mut out = vec![None; rays.len()];
         if set == CodePath::Scalar {
-            return set.closest_coherent(bvh, tris, rays, bounds);
+            set.closest_coherent(bvh, tris, rays, bounds, &mut out);
+            return out;
         }
-        self.run(queue, rays.len(), bvh, tris, |k| match k {
-            Kernel::Packets => set.closest_coherent(bvh, tris, rays, bounds),
-            Kernel::Single => {
-                let mut out = vec![None; rays.len()];
-                wide_traverse::closest_rays::<true>(bvh.wide(tris), rays, &mut out);
-                out
-            }
-        })
+        self.run(queue, bvh, tris, &mut out, |k, o| match k {
+            Kernel::Packets => set.closest_coherent(bvh, tris, rays, bounds, o),
+            Kernel::Single => wide_traverse::closest_rays::<true>(bvh.wide(tris), rays, o),
+        });
+        out
     }
 
     /// Any-hit tests of a chunk of `queue` into `out`.
@@ -267,22 +269,17 @@ impl TraversalChoice {
         if set == CodePath::Scalar {
             return set.occluded(bvh, tris, rays, out);
         }
-        let blocked = self.run(queue, rays.len(), bvh, tris, |k| {
-            let mut blocked = vec![false; rays.len()];
-            match k {
-                Kernel::Packets => set.occluded(bvh, tris, rays, &mut blocked),
-                Kernel::Single => wide_traverse::occluded_rays::<true>(bvh.wide(tris), rays, &mut blocked),
-            }
-            blocked
+        self.run(queue, bvh, tris, out, |k, o| match k {
+            Kernel::Packets => set.occluded(bvh, tris, rays, o),
+            Kernel::Single => wide_traverse::occluded_rays::<true>(bvh.wide(tris), rays, o),
         });
-        out.copy_from_slice(&blocked);
     }
 
     /// Each queue's choice: the kernel and the speeds its trial measured. Queues without a trial
     /// (camera rays; every queue of a fixed choice), still in it, or never run are left out.
     #[must_use]
     pub fn report(&self) -> Vec<QueueChoice> {
-        let Some(trials) = &self.trials else { return vec![] };
+        let Mode::Timed(trials) = &self.0 else { return vec![] };
         let trials = *trials.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         Queue::ALL
             .iter()
@@ -352,17 +349,18 @@ mod tests {
         let tris = TriangleColumns { p0: &p0, p1: &p1, p2: &p2 };
         let c = TraversalChoice::timed();
         let mut ran = vec![];
-        let out = c.run(Queue::Secondary, 1024, &bvh, tris, |k| {
+        let mut out = [0u32; 1024];
+        c.run(Queue::Secondary, &bvh, tris, &mut out, |k, o| {
             ran.push(k);
-            1024
+            o.fill(1024);
         });
-        assert_eq!((out, ran), (1024, vec![Kernel::Packets, Kernel::Single]));
+        assert_eq!((out[0], ran), (1024, vec![Kernel::Packets, Kernel::Single]));
         // The second pair runs single rays first.
         let mut ran = vec![];
-        let out = c.run(Queue::Secondary, 1024, &bvh, tris, |k| {
+        c.run(Queue::Secondary, &bvh, tris, &mut out, |k, o| {
             ran.push(k);
-            7
+            o.fill(7);
         });
-        assert_eq!((out, ran), (7, vec![Kernel::Single, Kernel::Packets]));
+        assert_eq!((out[0], ran), (7, vec![Kernel::Single, Kernel::Packets]));
     }
 }
