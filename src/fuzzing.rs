@@ -142,13 +142,6 @@ fn well_conditioned(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3, target: Vec3)
     if v.length() < 0.1 * dist || len < 256.0 * f32::EPSILON * (o.length() + dist) {
         return false;
     }
-    // Nor may the edge be short against the f32 rounding of the wings' own coordinates. Not a
-    // fixed case but an open one, found by the fuzzer: an edge 6.9e-6 long between wings 4.2e6
-    // and 4.3e9 away lets a ray from the origin through its middle (BENCHMARKS.md, issue 18,
-    // seventh part); until the triangle test is mended there, the property is claimed only here.
-    if len < 256.0 * f32::EPSILON * (c1.length() + c2.length()) {
-        return false;
-    }
     // v, like u1 and u2, is perpendicular to the edge: v = α u1 + β u2 with α, β clearly positive.
     let g = u1.dot(u2);
     let (x, y) = (v.dot(u1), v.dot(u2));

@@ -4,7 +4,8 @@
 //! The ray is translated to the origin and sheared so that it runs along +z; the edge functions
 //! are then 2-D cross products that agree in sign along shared edges, so a ray through an edge
 //! or vertex hits at least one of the triangles that share it. Edge functions that round to
-//! exactly zero are recomputed in f64.
+//! exactly zero are recomputed in f64. Where the f32 bound cannot prove t > 0, or t's products
+//! underflow, t's sign is decided in f64 with a bound taken term by term ([`t_f64`]).
 
 use super::offset::gamma;
 use glam::Vec3;
@@ -107,11 +108,10 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
         // Coordinates so small (≲ 10⁻¹³ of the ray's length scale) that f32's products for t
         // underflow: t and the barycentrics in f64, the edges' f32 decision kept.
         F32Test::Tiny => {
-            let (t, delta_t, b) = t_f64(o, d, [p0, p1, p2])?;
+            let (t, proven, b) = t_f64(o, d, [p0, p1, p2])?;
             let t32 = t as f32;
             let b = b.map(|v| v as f32);
-            (t > delta_t && t32 < t_max && t32 > 0.0 && b.iter().all(|v| v.is_finite()))
-                .then_some(TriangleHit { t: t32, b })
+            (proven && t32 < t_max && t32 > 0.0 && b.iter().all(|v| v.is_finite())).then_some(TriangleHit { t: t32, b })
         }
     }
 }
@@ -237,22 +237,38 @@ fn gamma64(n: f64) -> f64 {
     n * e / (1.0 - n * e)
 }
 
-/// Whether the ray provably meets the triangle's plane at t > 0, by the same steps and error
-/// bound as [`intersect_triangle`] in f64 (where the bound is 2²⁹ times tighter). Only the sign
-/// of t is decided here: the hit, t and barycentrics stay the f32 ones, so neighbouring
-/// triangles still agree on which of them an edge belongs to.
+/// Whether the ray provably meets the triangle's plane at t > 0, by the same steps as
+/// [`intersect_triangle`] in f64 with the error bound of [`t_f64`]. Only the sign of t is decided
+/// here: the hit, t and barycentrics stay the f32 ones, so neighbouring triangles still agree on
+/// which of them an edge belongs to.
 #[cold]
 #[inline(never)]
 fn positive_t_f64(o: Vec3, d: Vec3, p: [Vec3; 3]) -> bool {
-    t_f64(o, d, p).is_some_and(|(t, delta_t, _)| t > delta_t)
+    t_f64(o, d, p).is_some_and(|(_, proven, _)| proven)
 }
 
-/// t of the ray's meeting with the triangle's plane, the bound on its error, and the
+/// t of the ray's meeting with the triangle's plane, whether t > 0 is proven, and the
 /// barycentrics, by the steps of [`intersect_triangle`] in f64; `None` where the plane is
 /// parallel to the ray.
+///
+/// The proof bounds the rounding error of every vertex, edge function and term of t's numerator
+/// on its own, where pbrt-v4's bound (the f32 test's) takes the largest coordinate, edge function
+/// and z for all three. The two differ on a sliver whose third vertex is far away: its shear
+/// error then weighs on the two short vertices' edge function as if it were theirs. The fuzzer
+/// found a ray through an edge 6.9·10⁻⁶ long between wings 4.2·10⁶ and 4.3·10⁹ away, at t = 6·10⁻⁶,
+/// that both triangles refused because that bound was 3·10¹⁰ even in f64; per term it is 10⁻¹⁰
+/// of t (fuzz/regressions/edge_rays/sliver-edge-between-far-wings).
+///
+/// The bound, with γₙ = nε/(1 − nε): a sheared coordinate x = (v.x − o.x) + sx·(v.z − o.z), |sx| ≤ 1,
+/// is off by at most δx = γ₅(|x| + |z|) (z in length units), likewise y; the scaled z by γ₃|z·sz|.
+/// The edge function e = xᵢyⱼ − yᵢxⱼ is off by γ₂(|xᵢyⱼ| + |yᵢxⱼ|) from its rounded inputs plus
+/// δxᵢ|yⱼ| + |xᵢ|δyⱼ + δyᵢ|xⱼ| + |yᵢ|δxⱼ + δxᵢδyⱼ + δyᵢδxⱼ from their errors, all widened by
+/// (1 + γ₂). t's numerator Σ eₖ zₖ is off by γ₃Σ|eₖzₖ| + Σ(δeₖ|zₖ| + |eₖ|δzₖ + δeₖδzₖ), the
+/// determinant Σ eₖ by γ₂Σ|eₖ| + Σδeₖ. t > 0 is proven when both exceed their bounds and share
+/// their sign.
 #[cold]
 #[inline(never)]
-fn t_f64(o: Vec3, d: Vec3, p: [Vec3; 3]) -> Option<(f64, f64, [f64; 3])> {
+fn t_f64(o: Vec3, d: Vec3, p: [Vec3; 3]) -> Option<(f64, bool, [f64; 3])> {
     let kz = dominant_axis(d);
     let perm = |v: Vec3| {
         let v = permute(v, kz);
@@ -265,23 +281,33 @@ fn t_f64(o: Vec3, d: Vec3, p: [Vec3; 3]) -> Option<(f64, f64, [f64; 3])> {
         let z = v[2] - o[2];
         [v[0] - o[0] + sx * z, v[1] - o[1] + sy * z, z]
     });
-    let e = [
-        q[1][0] * q[2][1] - q[1][1] * q[2][0],
-        q[2][0] * q[0][1] - q[2][1] * q[0][0],
-        q[0][0] * q[1][1] - q[0][1] * q[1][0],
-    ];
+    // Edge k is opposite vertex k: it joins vertices k + 1 and k + 2.
+    let ends = |k: usize| (q[(k + 1) % 3], q[(k + 2) % 3]);
+    let e = [0, 1, 2].map(|k| {
+        let (a, b) = ends(k);
+        a[0] * b[1] - a[1] * b[0]
+    });
     let det = e[0] + e[1] + e[2];
-    let t = (e[0] * q[0][2] * sz + e[1] * q[1][2] * sz + e[2] * q[2][2] * sz) / det;
-    let max = |k: usize| q[0][k].abs().max(q[1][k].abs()).max(q[2][k].abs());
-    let (max_xt, max_yt, max_z_len) = (max(0), max(1), max(2));
-    let max_zt = max_z_len * sz.abs();
-    let delta_z = gamma64(3.0) * max_zt;
-    let delta_x = gamma64(5.0) * (max_xt + max_z_len);
-    let delta_y = gamma64(5.0) * (max_yt + max_z_len);
-    let delta_e = 2.0 * (gamma64(2.0) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-    let max_e = e[0].abs().max(e[1].abs()).max(e[2].abs());
-    let delta_t = 3.0 * (gamma64(3.0) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) / det.abs();
-    (det != 0.0).then_some((t, delta_t, e.map(|v| v / det)))
+    let zt = q.map(|v| v[2] * sz);
+    let num = e[0] * zt[0] + e[1] * zt[1] + e[2] * zt[2];
+
+    let (g2, g3, g5) = (gamma64(2.0), gamma64(3.0), gamma64(5.0));
+    let dx = |v: [f64; 3]| g5 * (v[0].abs() + v[2].abs());
+    let dy = |v: [f64; 3]| g5 * (v[1].abs() + v[2].abs());
+    let de = [0, 1, 2].map(|k| {
+        let (a, b) = ends(k);
+        let (ax, ay, bx, by) = (a[0].abs(), a[1].abs(), b[0].abs(), b[1].abs());
+        let (dax, day, dbx, dby) = (dx(a), dy(a), dx(b), dy(b));
+        (1.0 + g2) * (g2 * (ax * by + ay * bx) + dax * by + ax * dby + day * bx + ay * dbx + dax * dby + day * dbx)
+    });
+    let mut num_err = 0.0;
+    for k in 0..3 {
+        let (ek, zk, dz) = (e[k].abs(), zt[k].abs(), g3 * zt[k].abs());
+        num_err += g3 * ek * zk + de[k] * zk + ek * dz + de[k] * dz;
+    }
+    let det_err = g2 * (e[0].abs() + e[1].abs() + e[2].abs()) + de[0] + de[1] + de[2];
+    let proven = num.abs() > num_err && det.abs() > det_err && (num > 0.0) == (det > 0.0);
+    (det != 0.0).then_some((num / det, proven, e.map(|v| v / det)))
 }
 
 #[cfg(test)]
@@ -303,6 +329,25 @@ mod tests {
             .filter_map(|p| intersect_triangle(Vec3::ZERO, d, f32::INFINITY, p[0], p[1], p[2]))
             .collect();
         assert!(!hits.is_empty() && hits.iter().all(|h| (h.t - 1.0).abs() < 1e-6), "{hits:?}");
+    }
+
+    /// An edge 6.9·10⁻⁶ long whose two wings reach 4.2·10⁶ and 4.3·10⁹ away, and a ray from
+    /// the origin through its middle (found by the fuzzer). The f32 test puts the ray inside one
+    /// of the two; bounding t's error with the largest coordinates, as pbrt-v4 does, gave 3·10¹⁰
+    /// even in f64 against t = 6·10⁻⁶, so neither accepted the ray. Per term the bound proves t > 0.
+    #[test]
+    fn a_ray_through_a_sliver_edge_between_far_wings_hits() {
+        let a = Vec3::new(6.866_657_3e-6, 0.0, 3.700_852_6e-16);
+        let b = Vec3::new(0.0, 6.866_495e-6, 6.866_657_7e-6);
+        let c1 = Vec3::new(0.0, -4_227_069.0, 0.0);
+        let c2 = Vec3::new(0.0, 0.0, -4_295_094_300.0);
+        let d = (a + (b - a) * 0.503_894_75).normalize();
+        let hits: Vec<_> = [[a, b, c1], [b, a, c2]]
+            .iter()
+            .filter_map(|p| intersect_triangle(Vec3::ZERO, d, f32::INFINITY, p[0], p[1], p[2]))
+            .collect();
+        let want = (a + (b - a) * 0.503_894_75).length();
+        assert!(!hits.is_empty() && hits.iter().all(|h| (h.t - want).abs() < 1e-5 * want), "{hits:?}");
     }
 
     /// A shadow ray's direction is the vector to the light point, so its length is a distance in
