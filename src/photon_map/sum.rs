@@ -7,18 +7,21 @@ use crate::code_path::CodePath;
 use glam::Vec3;
 use wide::{f32x8, u32x8};
 
-/// The powers of 8 photons, decoded, and their incoming directions, decoded when first asked for.
+/// The powers of 8 photons, decoded, and their incoming directions, decoded when first asked for,
+/// with the last hemisphere test made of them (queries of a packet mostly share their normal).
 pub(super) struct Decoded8 {
     key: u32x8,
     power: [f32x8; 3],
     wi: Option<[f32x8; 3]>,
+    /// The bits of the last normal given to [`Self::above`], and its answer.
+    above: Option<([u32; 3], f32x8)>,
 }
 
 impl Decoded8 {
     /// The 8 photons of the `key` and `power` columns.
     #[inline]
     pub(super) fn new(key: u32x8, power: u32x8) -> Self {
-        Decoded8 { key, power: rgbe_decode8(power), wi: None }
+        Decoded8 { key, power: rgbe_decode8(power), wi: None, above: None }
     }
 
     /// Their incoming directions (octahedral decode, not normalised).
@@ -31,6 +34,24 @@ impl Decoded8 {
                 dequantise8(key >> 24_u32, DIR_STEPS),
             )
         })
+    }
+}
+
+impl Decoded8 {
+    /// All-ones in the lanes whose incoming direction lies above the plane of `ng` (ωᵢ·n > 0);
+    /// computed once for a run of queries with the same normal (same bits).
+    #[inline]
+    fn above(&mut self, ng: Vec3) -> f32x8 {
+        let n = ng.to_array().map(f32::to_bits);
+        if let Some((last, up)) = self.above {
+            if last == n {
+                return up;
+            }
+        }
+        let [wx, wy, wz] = self.wi();
+        let up = (wx * f32x8::splat(ng.x) + wy * f32x8::splat(ng.y) + wz * f32x8::splat(ng.z)).simd_gt(f32x8::ZERO);
+        self.above = Some((n, up));
+        up
     }
 }
 
@@ -162,9 +183,7 @@ impl PhotonMap {
                 weighted.map(|(pr, pg, pb)| [pr * f32x8::splat(v.x), pg * f32x8::splat(v.y), pb * f32x8::splat(v.z)])
             }
             Reflectance::Hemisphere { value, ng } => {
-                let [wx, wy, wz] = photons.wi();
-                let up =
-                    (wx * f32x8::splat(ng.x) + wy * f32x8::splat(ng.y) + wz * f32x8::splat(ng.z)).simd_gt(f32x8::ZERO);
+                let up = photons.above(ng);
                 let zero = f32x8::ZERO;
                 weighted.map(|(pr, pg, pb)| {
                     [
