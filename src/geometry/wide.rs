@@ -101,7 +101,11 @@ impl WideRay {
     #[inline]
     #[must_use]
     pub fn new(o: Vec3, inv: Vec3) -> Self {
-        let near = [0, 1, 2].map(|a| if inv[a] >= 0.0 { a } else { a + 3 });
+        // Written out, not with array maps, which the compiler sometimes left out of line (a call
+        // per ray; see `wide_traverse::closest_leaf`).
+        let side = |a: usize| if inv[a] >= 0.0 { a } else { a + 3 };
+        let near = [side(0), side(1), side(2)];
+        let opposite = |k: usize| if k < 3 { k + 3 } else { k - 3 };
         WideRay {
             ox: f32x8::splat(o.x),
             oy: f32x8::splat(o.y),
@@ -110,7 +114,7 @@ impl WideRay {
             iy: f32x8::splat(inv.y),
             iz: f32x8::splat(inv.z),
             near,
-            far: near.map(|k| if k < 3 { k + 3 } else { k - 3 }),
+            far: [opposite(near[0]), opposite(near[1]), opposite(near[2])],
         }
     }
 }
