@@ -101,8 +101,8 @@ impl WideRay {
     #[inline]
     #[must_use]
     pub fn new(o: Vec3, inv: Vec3) -> Self {
-        // Written out, not with array maps, which the compiler sometimes left out of line (a call
-        // per ray; see `wide_traverse::closest_leaf`).
+        // Written out, not with array maps: one build left this map out of line, a call per ray
+        // that made every single-ray bench row 7–26 % slower (BENCHMARKS.md, issue 18, eighth part).
         let side = |a: usize| if inv[a] >= 0.0 { a } else { a + 3 };
         let near = [side(0), side(1), side(2)];
         let opposite = |k: usize| if k < 3 { k + 3 } else { k - 3 };

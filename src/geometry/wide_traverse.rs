@@ -68,9 +68,10 @@ fn closest_leaf(blocks: &[TriBlock], r: &ShearedRay, best: &mut Best) -> u64 {
         if todo == 0 {
             continue;
         }
-        // Written out, not `bary.map(..)`: whether the compiler inlined that array map depended on
-        // how it split the crate into codegen units, and an out-of-line call here made the whole
-        // single-ray kernel 7–12 % slower in the builds where it stayed one.
+        // Written out, not `bary.map(..)`: array maps on the single ray's path were left out of
+        // line in some builds, depending on how the compiler split the crate into codegen units
+        // (one in `WideRay::new`, a call per ray, made every single-ray bench row 7–26 % slower:
+        // BENCHMARKS.md, issue 18, eighth part).
         let (t, bary) = (t.to_array(), [bary[0].to_array(), bary[1].to_array(), bary[2].to_array()]);
         while todo != 0 {
             let l = todo.trailing_zeros() as usize;

@@ -68,8 +68,8 @@ pub fn run_packet(ctx: &Context, lookups: &[FixedLookup<'_>], out: &mut [Estimat
     assert!(lookups.iter().all(|q| std::ptr::eq(q.map, first.map)), "one packet, one map");
     let at = |j: usize| lookups.get(j).unwrap_or(first);
     // The cuts are written in place and the queries built from plain arrays: building them from
-    // arrays of `Option<([Cut; 4], usize)>` moved each query's cuts twice and cost 7 % of
-    // `gather_global`, most of it loads stalled on the stores just made.
+    // arrays of `Option<([Cut; 4], usize)>` moved each query's cuts twice and took 7 % of
+    // `gather_global`'s samples, most of them loads stalled on the stores just made.
     let mut cuts = [[Cut::default(); MAX_EXTRA_CUTS]; PACKET];
     let mut lens = [None; PACKET];
     for (j, q) in lookups.iter().enumerate().filter(|(_, q)| q.corrected) {
