@@ -35,9 +35,7 @@ impl Decoded8 {
             )
         })
     }
-}
 
-impl Decoded8 {
     /// All-ones in the lanes whose incoming direction lies above the plane of `ng` (ωᵢ·n > 0);
     /// computed once for a run of queries with the same normal (same bits).
     #[inline]

@@ -5,11 +5,10 @@
 //! lane list, hits and maps; writes the wave's terms in lane order.
 
 use super::queues::PathKind;
-use super::{CameraWork, Maps, Shared, StageStats, GATHER_CHUNK};
+use super::{par_lanes, CameraWork, Maps, Shared, StageStats, GATHER_CHUNK};
 use crate::code_path::MortonGrid;
 use crate::film::Term;
 use crate::material::Bsdf;
-use crate::parallel::map_chunks;
 use crate::photon_map::query_packet::PACKET;
 use crate::photon_map::{Estimate, Nearest};
 use crate::scene::SurfacePoint;
@@ -51,66 +50,54 @@ fn estimate_at_diffuse_hits(
     // (16 384 points over a Cornell box lie ~1 cm apart), small enough to stay in cache, and at
     // least four a thread.
     let chunk = lanes.len().div_ceil(4 * threads.max(1)).clamp(GATHER_CHUNK, SORTED_CHUNK);
-    // Each chunk's lanes are added to the samples straight from its own vector: flattening them
-    // into one (`par_lanes`) took 7 % of `gather_global`, most of it fresh pages for a vector of
-    // ~10⁶ lanes every bounce.
-    let chunks: Vec<Vec<Lane>> = map_chunks(
-        lanes.len(),
-        chunk,
-        threads,
-        |r| {
-            let mut scratch = Nearest::default();
-            let mut done: Vec<Lane> = Vec::with_capacity(r.len());
-            // Lookups deferred to the sorted packets, with the index of their lane in `done`.
-            let mut deferred: Vec<(u32, FixedLookup)> = Vec::with_capacity(r.len());
-            let mut packet = Packet::default();
-            for j in r {
-                let i = lanes[j] as usize;
-                let Some(hit) = w.paths.hits.get(i) else { continue };
-                let sp = ctx.scene.surface(&hit);
-                let bsdf = &ctx.scene.bsdf(&sp);
-                let kind = w.paths.kind[i];
-                let pixel = (kind == PathKind::Camera)
-                    .then(|| ((w.first_sample + u64::from(w.paths.sample[i])) / spp) as usize);
-                let planned = estimate(&ctx, &sp, bsdf, -w.paths.rays.direction(i), kind, pixel, &mut scratch);
-                let term = match kind {
-                    PathKind::Camera => own.seen(w.paths.through_specular[i]),
-                    _ => w.paths.term[i],
-                };
-                let e = if let Planned::Done(e) = planned { e } else { Estimate::default() };
-                done.push(Lane {
-                    sample: w.paths.sample[i],
-                    term,
-                    beta: w.paths.beta[i],
-                    radiance: e.radiance,
-                    bias: e.bias,
-                });
-                match planned {
-                    Planned::Done(_) => {}
-                    Planned::Fixed(q) if kind.reads_maps() => deferred.push((done.len() as u32 - 1, q)),
-                    Planned::Fixed(q) => packet.add(&ctx, q, done.len() - 1, &mut done),
-                }
+    let done = par_lanes(lanes.len(), chunk, threads, |r| {
+        let mut scratch = Nearest::default();
+        let mut done: Vec<Lane> = Vec::with_capacity(r.len());
+        // Lookups deferred to the sorted packets, with the index of their lane in `done`.
+        let mut deferred: Vec<(u32, FixedLookup)> = Vec::with_capacity(r.len());
+        let mut packet = Packet::default();
+        for j in r {
+            let i = lanes[j] as usize;
+            let Some(hit) = w.paths.hits.get(i) else { continue };
+            let sp = ctx.scene.surface(&hit);
+            let bsdf = &ctx.scene.bsdf(&sp);
+            let kind = w.paths.kind[i];
+            let pixel =
+                (kind == PathKind::Camera).then(|| ((w.first_sample + u64::from(w.paths.sample[i])) / spp) as usize);
+            let planned = estimate(&ctx, &sp, bsdf, -w.paths.rays.direction(i), kind, pixel, &mut scratch);
+            let term = match kind {
+                PathKind::Camera => own.seen(w.paths.through_specular[i]),
+                _ => w.paths.term[i],
+            };
+            let e = if let Planned::Done(e) = planned { e } else { Estimate::default() };
+            done.push(Lane {
+                sample: w.paths.sample[i],
+                term,
+                beta: w.paths.beta[i],
+                radiance: e.radiance,
+                bias: e.bias,
+            });
+            match planned {
+                Planned::Done(_) => {}
+                Planned::Fixed(q) if kind.reads_maps() => deferred.push((done.len() as u32 - 1, q)),
+                Planned::Fixed(q) => packet.add(&ctx, q, done.len() - 1, &mut done),
             }
-            packet.run(&ctx, &mut done);
-            // By Morton code, ties in lane order; the low half is the place in `deferred`. (A packet
-            // holds lookups of one map: `Packet::add` runs it when the map changes.)
-            let grid = MortonGrid::new(ctx.scene.bounds, 1024);
-            let mut order: Vec<u64> = deferred
-                .iter()
-                .enumerate()
-                .map(|(k, (_, q))| u64::from(grid.code(q.lookup.p)) << 32 | k as u64)
-                .collect();
-            order.sort_unstable();
-            for o in &order {
-                let (slot, q) = deferred[(o & 0xffff_ffff) as usize];
-                packet.add(&ctx, q, slot as usize, &mut done);
-            }
-            packet.run(&ctx, &mut done);
-            done
-        },
-        |_| {},
-    );
-    for lane in chunks.into_iter().flatten() {
+        }
+        packet.run(&ctx, &mut done);
+        // By Morton code, ties in lane order; the low half is the place in `deferred`. (A packet
+        // holds lookups of one map: `Packet::add` runs it when the map changes.)
+        let grid = MortonGrid::new(ctx.scene.bounds, 1024);
+        let mut order: Vec<u64> =
+            deferred.iter().enumerate().map(|(k, (_, q))| u64::from(grid.code(q.lookup.p)) << 32 | k as u64).collect();
+        order.sort_unstable();
+        for o in &order {
+            let (slot, q) = deferred[(o & 0xffff_ffff) as usize];
+            packet.add(&ctx, q, slot as usize, &mut done);
+        }
+        packet.run(&ctx, &mut done);
+        done
+    });
+    for lane in done {
         let t = &mut work.terms[lane.sample as usize];
         t.add(lane.term, lane.beta * lane.radiance);
         t.bias += lane.beta * lane.bias;
