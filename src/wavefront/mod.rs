@@ -100,6 +100,34 @@ pub fn par_columns<T: Send + Default>(
     }
 }
 
+/// Runs `f` over `0..n` in chunks on `threads` threads, chunk `c` with `pieces[c]` (lanes
+/// `c·chunk..` of some columns, split as [`queues::HitColumns::pieces`] splits them): each chunk
+/// writes its own lanes in place, so nothing is appended or copied afterwards.
+///
+/// # Panics
+/// If there are fewer pieces than chunks.
+pub fn par_pieces<P: Send>(
+    n: usize,
+    chunk: usize,
+    threads: usize,
+    pieces: Vec<P>,
+    f: impl Fn(std::ops::Range<usize>, &mut P) + Sync,
+) {
+    let chunk = chunk.max(1);
+    assert!(pieces.len() >= n.div_ceil(chunk), "a piece for every chunk");
+    let slots: Vec<std::sync::Mutex<Option<P>>> = pieces.into_iter().map(|p| std::sync::Mutex::new(Some(p))).collect();
+    map_chunks(
+        n,
+        chunk,
+        threads,
+        |r| {
+            let piece = slots[r.start / chunk].lock().unwrap_or_else(std::sync::PoisonError::into_inner).take();
+            f(r, &mut piece.expect("each chunk runs once"));
+        },
+        |_| {},
+    );
+}
+
 /// Runs `f` over `0..n` in chunks on `threads` threads; results in lane order, read from each
 /// chunk's own vector (collecting them into one new vector cost `gather_global` 7 % of its
 /// samples, most of them fresh pages for ~10⁶ lanes every bounce).
