@@ -107,6 +107,8 @@ pub struct HitColumns {
 impl HitColumns {
     /// Marks an escaped lane.
     pub const MISS: u32 = u32::MAX;
+    /// What an escaped lane's columns hold.
+    const ESCAPED: Hit = Hit { tri: Self::MISS, t: f32::INFINITY, b: [0.0; 3] };
 
     /// Removes every lane.
     pub fn clear(&mut self) {
@@ -117,32 +119,15 @@ impl HitColumns {
         self.b2.clear();
     }
 
-    /// Reserves room for `n` more lanes.
-    pub fn reserve(&mut self, n: usize) {
-        self.tri.reserve(n);
-        self.t.reserve(n);
-        self.b0.reserve(n);
-        self.b1.reserve(n);
-        self.b2.reserve(n);
-    }
-
-    /// Moves `other`'s lanes to the end (column copies).
-    pub fn append(&mut self, other: &mut HitColumns) {
-        self.tri.append(&mut other.tri);
-        self.t.append(&mut other.t);
-        self.b0.append(&mut other.b0);
-        self.b1.append(&mut other.b1);
-        self.b2.append(&mut other.b2);
-    }
-
     /// Resizes every column to `n` lanes (new lanes escaped) and splits them into pieces of
     /// `chunk` lanes, in lane order: each piece can be written by its own thread.
     pub fn pieces(&mut self, n: usize, chunk: usize) -> Vec<HitPiece<'_>> {
         let chunk = chunk.max(1);
-        self.tri.resize(n, Self::MISS);
-        self.t.resize(n, f32::INFINITY);
-        for c in [&mut self.b0, &mut self.b1, &mut self.b2] {
-            c.resize(n, 0.0);
+        let e = Self::ESCAPED;
+        self.tri.resize(n, e.tri);
+        self.t.resize(n, e.t);
+        for (c, b) in [&mut self.b0, &mut self.b1, &mut self.b2].into_iter().zip(e.b) {
+            c.resize(n, b);
         }
         let mut b0 = self.b0.chunks_mut(chunk);
         let mut b1 = self.b1.chunks_mut(chunk);
@@ -186,13 +171,14 @@ impl HitPiece<'_> {
     pub fn is_empty(&self) -> bool {
         self.tri.is_empty()
     }
-    /// Writes `hits` into the piece's lanes, in order (`None`: escaped).
+    /// Writes `hits`, one per lane of the piece, in order (`None`: escaped).
     pub fn write(&mut self, hits: &[Option<Hit>]) {
+        debug_assert_eq!(hits.len(), self.len(), "one hit per lane");
         let n = self.len().min(hits.len());
         let (tri, t) = (&mut self.tri[..n], &mut self.t[..n]);
         let (b0, b1, b2) = (&mut self.b0[..n], &mut self.b1[..n], &mut self.b2[..n]);
         for (k, h) in hits[..n].iter().enumerate() {
-            let h = h.unwrap_or(Hit { tri: HitColumns::MISS, t: f32::INFINITY, b: [0.0; 3] });
+            let h = h.unwrap_or(HitColumns::ESCAPED);
             (tri[k], t[k]) = (h.tri, h.t);
             (b0[k], b1[k], b2[k]) = (h.b[0], h.b[1], h.b[2]);
         }
