@@ -106,21 +106,24 @@ impl PhotonMap {
             top -= 1;
             let (index, qmask) = stack[top];
             let node = &self.nodes[index as usize];
-            let reach = Self::node_reach(node, queries, &r2, qmask);
+            let (reach, reached) = Self::node_reach(node, queries, &r2, qmask);
             // Leaves first, in slot order; inner children pushed last slot first, so that they are
-            // popped in slot order: the order of a single fixed-radius walk.
-            for (c, (&qs, &child)) in reach.iter().zip(&node.child).enumerate() {
-                if qs != 0 && node.leaves >> c & 1 == 1 {
-                    let (lo, _) = self.block(child);
-                    self.packet_block::<BIAS>(lo, queries, &r2, qs, &mut sums);
-                }
+            // popped in slot order: the order of a single fixed-radius walk. (Loops over the set
+            // bits of the reached children: testing all eight slots mispredicted more.)
+            let mut leaves = reached & node.leaves;
+            while leaves != 0 {
+                let c = leaves.trailing_zeros() as usize;
+                leaves &= leaves - 1;
+                let (lo, _) = self.block(node.child[c]);
+                self.packet_block::<BIAS>(lo, queries, &r2, reach[c], &mut sums);
             }
-            for c in (0..8).rev() {
-                if reach[c] != 0 && node.leaves >> c & 1 == 0 {
-                    debug_assert_eq!(node.child[c] & LEAF, 0);
-                    stack[top] = (node.child[c], reach[c]);
-                    top += 1;
-                }
+            let mut inner = reached & !node.leaves;
+            while inner != 0 {
+                let c = 7 - inner.leading_zeros() as usize;
+                inner &= !(1 << c);
+                debug_assert_eq!(node.child[c] & LEAF, 0);
+                stack[top] = (node.child[c], reach[c]);
+                top += 1;
             }
         }
         for (j, q) in queries.iter().enumerate() {
@@ -129,22 +132,27 @@ impl PhotonMap {
     }
 
     /// For each of `node`'s 8 children, the queries of `qmask` whose sphere reaches its box, as
-    /// bits (child `c`'s in byte `c`).
+    /// bits (child `c`'s in byte `c`), and the children some query reaches, as bits.
     #[inline]
-    fn node_reach(node: &Node, queries: &[RadiusQuery<'_>], r2: &[f32; PACKET], qmask: u8) -> [u8; 8] {
-        let mut reach = 0u64;
+    fn node_reach(node: &Node, queries: &[RadiusQuery<'_>], r2: &[f32; PACKET], qmask: u8) -> ([u8; 8], u8) {
+        let (mut reach, mut reached) = (0u64, 0u32);
         let mut left = qmask;
         while left != 0 {
             let j = left.trailing_zeros() as usize;
             left &= left - 1;
             let (_, hits) = node.distances8(queries[j].lookup.p, r2[j]);
             reach |= SPREAD[hits as usize] << j;
+            reached |= hits;
         }
-        reach.to_le_bytes()
+        (reach.to_le_bytes(), reached as u8)
     }
 
     /// Tests the block of 8 photons from `lo` against the queries of `qmask` and adds what each
-    /// accepts to its sums: the photons are decoded once, for the first query that finds one.
+    /// accepts to its sums: the photons are decoded once, for all of them.
+    ///
+    /// A query that finds no photon of the block runs on and adds zeros (a sum plus +0 is the
+    /// same sum, to the bit): skipping it was a branch mispredicted often enough to cost 4 % of
+    /// `gather_global` on cornell-spheres (BENCHMARKS.md, issue 18, tenth part).
     #[inline]
     fn packet_block<const BIAS: bool>(
         &self,
@@ -156,7 +164,8 @@ impl PhotonMap {
     ) {
         let load = |c: &[f32]| f32x8::from(<[f32; 8]>::try_from(&c[lo..lo + 8]).expect("padded column"));
         let (x, y, z) = (load(&self.x), load(&self.y), load(&self.z));
-        let mut decoded: Option<(Normals8, Decoded8)> = None;
+        let key = self.key8(lo);
+        let (mut normals, mut photons) = (Normals8::decode(key), Decoded8::new(key, self.power8(lo)));
         let mut left = qmask;
         while left != 0 {
             let j = left.trailing_zeros() as usize;
@@ -165,14 +174,7 @@ impl PhotonMap {
             let (dx, dy, dz) = (x - f32x8::splat(q.p.x), y - f32x8::splat(q.p.y), z - f32x8::splat(q.p.z));
             let d2 = dx * dx + dy * dy + dz * dz;
             let near = d2.simd_lt(f32x8::splat(r2[j]));
-            if !near.any() {
-                continue;
-            }
-            let (normals, photons) = decoded.get_or_insert_with(|| {
-                let key = self.key8(lo);
-                (Normals8::decode(key), Decoded8::new(key, self.power8(lo)))
-            });
-            let (inside, turned) = Self::filter8(normals, near, &q.filter);
+            let (inside, turned) = Self::filter8(&mut normals, near, &q.filter);
             let s = &mut sums[j];
             s.rejected += turned.count_ones();
             if queries[j].edges.is_some() {
@@ -185,14 +187,11 @@ impl PhotonMap {
                 }
             }
             let bits = inside.to_bitmask();
-            if bits == 0 {
-                continue;
-            }
             s.count += bits.count_ones();
             let r2_8 = f32x8::splat(r2[j]);
             if BIAS {
                 let weights = [q.kernel.weight8(d2, r2_8), Kernel::bias_weight8(d2, r2_8)];
-                let [c, b] = Self::contributions8_decoded(photons, inside, weights, queries[j].f);
+                let [c, b] = Self::contributions8_decoded(&mut photons, inside, weights, queries[j].f);
                 for (s, v) in s.radiance.iter_mut().zip(c) {
                     *s += v;
                 }
@@ -200,7 +199,8 @@ impl PhotonMap {
                     *s += v;
                 }
             } else {
-                let [c] = Self::contributions8_decoded(photons, inside, [q.kernel.weight8(d2, r2_8)], queries[j].f);
+                let [c] =
+                    Self::contributions8_decoded(&mut photons, inside, [q.kernel.weight8(d2, r2_8)], queries[j].f);
                 for (s, v) in s.radiance.iter_mut().zip(c) {
                     *s += v;
                 }
