@@ -129,7 +129,13 @@ fn entered<const SIMD: bool>(node: &Node8, r: &WideRay, o: Vec3, inv: Vec3, t_ma
         keys[n] = u64::from(t[i].to_bits()) << 32 | i as u64;
         n += 1;
     }
-    // Insertion sort: at most eight keys, usually two or three.
+    // Two keys (the most common case past one) by min and max, without a branch on their
+    // order; more by insertion sort: at most eight keys, usually two or three.
+    if n == 2 {
+        let (a, b) = (keys[0], keys[1]);
+        (keys[0], keys[1]) = (a.min(b), a.max(b));
+        return (keys, n);
+    }
     for j in 1..n {
         let k = keys[j];
         let mut m = j;
