@@ -129,11 +129,21 @@ fn entered<const SIMD: bool>(node: &Node8, r: &WideRay, o: Vec3, inv: Vec3, t_ma
         keys[n] = u64::from(t[i].to_bits()) << 32 | i as u64;
         n += 1;
     }
-    // Two keys (the most common case past one) by min and max, without a branch on their
-    // order; more by insertion sort: at most eight keys, usually two or three.
+    // Two or three keys (the usual counts) by a network of min and max, without a branch on
+    // their order (the insertion sort's compares go either way with the ray: BENCHMARKS.md,
+    // issue 18, tenth part); more by insertion sort (at most eight keys). Keys are distinct:
+    // each holds its slot.
     if n == 2 {
         let (a, b) = (keys[0], keys[1]);
         (keys[0], keys[1]) = (a.min(b), a.max(b));
+        return (keys, n);
+    }
+    if n == 3 {
+        let (a, b, c) = (keys[0], keys[1], keys[2]);
+        let (a, b) = (a.min(b), a.max(b));
+        let (b, c) = (b.min(c), b.max(c));
+        let (a, b) = (a.min(b), a.max(b));
+        (keys[0], keys[1], keys[2]) = (a, b, c);
         return (keys, n);
     }
     for j in 1..n {
