@@ -1,5 +1,6 @@
 //! Single-ray traversal of the 8-wide BVH ([`super::wide`]): at each node one ray meets all
-//! eight child boxes in one `f32x8` test, and the children it enters are visited nearest first.
+//! eight child boxes in one `f32x8` test; closest-hit traversal visits the children it enters
+//! nearest first.
 //! Reads rays and the [`Bvh8`]; writes hits or occlusion flags.
 //!
 //! The kernel is generic over the child test: `SIMD = true` runs [`Node8::entries`], `false` its
@@ -8,9 +9,11 @@
 //! the lower triangle index), so the closest hit is the same triangle, t and barycentrics as
 //! every other traversal's, whatever order the leaves are met in; tests/packet.rs checks it.
 //!
-//! Any-hit traversal tests a node's leaf children as soon as the node is reached, nearest
-//! first, before entering any inner child (as the BVH2 traversals do: a leaf is cheap and often
-//! ends the ray).
+//! Any-hit traversal tests a node's leaf children as soon as the node is reached, before
+//! entering any inner child (as the BVH2 traversals do: a leaf is cheap and often ends the ray).
+//! It takes the entered children in slot order, unsorted: any occluder ends the ray, and the
+//! sort cost more than the order saved (any-hit bench rows 1.02–1.15×: BENCHMARKS.md, issue 18,
+//! tenth part).
 
 use super::bvh::Hit;
 use super::slab::inverse_direction;
@@ -110,11 +113,17 @@ fn any_leaf(blocks: &[TriBlock], r: &ShearedRay, t_max: f32, scalar: &mut u64) -
     })
 }
 
-/// The children of `node` that the ray enters within `t_max`, as (t bits, slot) keys sorted
-/// nearest first, and their number. Entry distances are ≥ 0 and never NaN, so their bit
-/// patterns order as the values do.
+/// The children of `node` that the ray enters within `t_max`, as (t bits, slot) keys, and their
+/// number: sorted nearest first if `SORT`, else in slot order. Entry distances are ≥ 0 and never
+/// NaN, so their bit patterns order as the values do.
 #[inline(always)]
-fn entered<const SIMD: bool>(node: &Node8, r: &WideRay, o: Vec3, inv: Vec3, t_max: f32) -> ([u64; WIDTH], usize) {
+fn entered<const SIMD: bool, const SORT: bool>(
+    node: &Node8,
+    r: &WideRay,
+    o: Vec3,
+    inv: Vec3,
+    t_max: f32,
+) -> ([u64; WIDTH], usize) {
     let (mut mask, t) = if SIMD {
         let (m, t) = node.entries(r, t_max);
         (m, t.to_array())
@@ -133,6 +142,9 @@ fn entered<const SIMD: bool>(node: &Node8, r: &WideRay, o: Vec3, inv: Vec3, t_ma
     // their order (the insertion sort's compares go either way with the ray: BENCHMARKS.md,
     // issue 18, tenth part); more by insertion sort (at most eight keys). Keys are distinct:
     // each holds its slot.
+    if !SORT {
+        return (keys, n);
+    }
     if n == 2 {
         let (a, b) = (keys[0], keys[1]);
         (keys[0], keys[1]) = (a.min(b), a.max(b));
@@ -223,7 +235,7 @@ pub fn closest_counted<const SIMD: bool, const COUNT: bool>(
             visits.nodes += 1;
         }
         let node = &nodes[c as usize];
-        let (keys, n) = entered::<SIMD>(node, &r, o, inv, best.t);
+        let (keys, n) = entered::<SIMD, true>(node, &r, o, inv, best.t);
         if n == 0 {
             continue;
         }
@@ -276,9 +288,9 @@ pub fn occluded_counted<const SIMD: bool, const COUNT: bool>(
         if COUNT {
             visits.nodes += 1;
         }
-        let (keys, n) = entered::<SIMD>(node, &r, o, inv, t_max);
-        // Leaf children first, nearest first; then the inner children: the nearest next, the
-        // others on the stack, nearer on top.
+        let (keys, n) = entered::<SIMD, false>(node, &r, o, inv, t_max);
+        // Leaf children first; then the inner children: the first in slot order next, the
+        // others on the stack, earlier slots on top.
         for &key in &keys[..n] {
             let (i, _) = unkey(key);
             if node.count[i] > 0 && leaf_hit(node.child[i], u32::from(node.count[i]), visits) {
