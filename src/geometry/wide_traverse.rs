@@ -12,8 +12,8 @@
 //! Any-hit traversal tests a node's leaf children as soon as the node is reached, before
 //! entering any inner child (as the BVH2 traversals do: a leaf is cheap and often ends the ray).
 //! It takes the entered children in slot order, unsorted: any occluder ends the ray, and the
-//! sort cost more than the order saved (any-hit bench rows 1.02–1.15×: BENCHMARKS.md, issue 18,
-//! tenth part).
+//! sort cost more than the order saved (any-hit bench rows 0.97–1.15×, all but one faster:
+//! BENCHMARKS.md, issue 18, tenth part).
 
 use super::bvh::Hit;
 use super::slab::inverse_direction;
@@ -138,13 +138,13 @@ fn entered<const SIMD: bool, const SORT: bool>(
         keys[n] = u64::from(t[i].to_bits()) << 32 | i as u64;
         n += 1;
     }
+    if !SORT {
+        return (keys, n);
+    }
     // Two or three keys (the usual counts) by a network of min and max, without a branch on
     // their order (the insertion sort's compares go either way with the ray: BENCHMARKS.md,
     // issue 18, tenth part); more by insertion sort (at most eight keys). Keys are distinct:
     // each holds its slot.
-    if !SORT {
-        return (keys, n);
-    }
     if n == 2 {
         let (a, b) = (keys[0], keys[1]);
         (keys[0], keys[1]) = (a.min(b), a.max(b));

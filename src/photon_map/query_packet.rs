@@ -108,8 +108,9 @@ impl PhotonMap {
             let node = &self.nodes[index as usize];
             let (reach, reached) = Self::node_reach(node, queries, &r2, qmask);
             // Leaves first, in slot order; inner children pushed last slot first, so that they are
-            // popped in slot order: the order of a single fixed-radius walk. (Loops over the set
-            // bits of the reached children: testing all eight slots mispredicted more.)
+            // popped in slot order: the order of a single fixed-radius walk. (The set bits of the
+            // reached children, not a test of every slot: `gather_global` on cornell-spheres
+            // 1.60–1.63 → 1.50–1.58 s.)
             let mut leaves = reached & node.leaves;
             while leaves != 0 {
                 let c = leaves.trailing_zeros() as usize;
