@@ -8,6 +8,7 @@ pub mod traverse;
 pub mod triangle;
 pub mod triangle8;
 pub mod wide;
+pub mod wide_collapse;
 pub mod wide_packet;
 pub mod wide_traverse;
 

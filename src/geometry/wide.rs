@@ -3,10 +3,14 @@
 //! (Wald et al. 2008, "Getting rid of packets"; Benthin et al. 2012). Reads the BVH2 nodes;
 //! writes [`Node8`]s with the six box planes of the children as SoA columns.
 //!
-//! Collapse: starting from a BVH2 node's two children, the inner child of largest surface area
-//! is replaced by its two children until there are eight or only leaves remain (the usual
-//! greedy collapse; BVH2 leaves, ≤ 8 triangles from obvhs's build, stay leaves). Triangle
-//! indices are unchanged, so leaves address the same BVH-ordered columns as the BVH2.
+//! Collapse: [`super::wide_collapse`] chooses, by the surface area heuristic over the whole
+//! tree, which BVH2 nodes become 8-wide nodes, which become leaves (several small BVH2 leaves
+//! may share one, up to eight triangles) and which dissolve into their parent's slots; this
+//! module builds that shape. Triangle indices are unchanged (blocks list them lane by lane), so
+//! leaves address the same BVH-ordered columns as the BVH2. Against the greedy collapse it
+//! replaced (the inner child of largest area opened until eight), the bunny's tree has half the
+//! nodes (4 887 → 2 406, 4.3 → 6.4 children each) and bounce rays visit 7.1 nodes instead of 7.7
+//! (BENCHMARKS.md, issue 18, eleventh part).
 //!
 //! The box test is [`box_entry`]'s, lane by lane: the same conservative slab test (far
 //! distance grown by 1 + 2γ₃), the same operations in the same order. Taking the near plane by
@@ -16,6 +20,7 @@
 
 use super::slab::{box_entry, FAR_GROWTH};
 use super::triangle8::TriBlock;
+use super::wide_collapse::{triangles_under, Layout};
 use glam::{Vec3, Vec3A};
 use obvhs::bvh2::node::Bvh2Node;
 use wide::f32x8;
@@ -129,19 +134,21 @@ pub struct Bvh8 {
 
 impl Bvh8 {
     /// Collapses the BVH2 `nodes` (root first; children of an inner node at `first_index` and
-    /// the next) whose leaves hold the triangles `tri(id)` (BVH order).
+    /// the next) whose leaves hold the triangles `tri(id)` (BVH order), in the shape
+    /// [`Layout::choose`] finds cheapest.
     #[must_use]
     pub fn collapse(nodes: &[Bvh2Node], tri: impl Fn(u32) -> [Vec3; 3]) -> Self {
         if nodes.is_empty() {
             return Bvh8::default();
         }
+        let layout = Layout::choose(nodes);
         let mut out = vec![Node8::EMPTY];
         let mut blocks = Vec::new();
-        // (BVH2 node, index of the Node8 that takes its children); a root leaf becomes the one
-        // child of the root.
+        // (BVH2 node, index of the Node8 that takes its children); a root that is best a leaf
+        // becomes the one child of the root.
         let mut work = vec![(0usize, 0usize)];
         while let Some((n2, at)) = work.pop() {
-            let kids = gather_children(nodes, n2);
+            let kids = if layout.is_leaf(nodes, n2) { vec![n2] } else { layout.children(nodes, n2) };
             let mut node = Node8::EMPTY;
             for (slot, &k) in kids.iter().enumerate() {
                 let b = &nodes[k];
@@ -150,12 +157,14 @@ impl Bvh8 {
                     node.planes[a][slot] = lo[a];
                     node.planes[a + 3][slot] = hi[a];
                 }
-                if b.prim_count > 0 {
-                    // obvhs caps leaves at 255 primitives.
-                    let count = b.prim_count.min(255);
+                if layout.is_leaf(nodes, k) {
+                    let mut ids = triangles_under(nodes, k);
+                    // obvhs caps its leaves at 255 primitives, and merged leaves hold at most
+                    // MAX_LEAF.
+                    ids.truncate(255);
                     node.child[slot] = blocks.len() as u32;
-                    node.count[slot] = count as u8;
-                    TriBlock::push_leaf(&mut blocks, b.first_index, count, &tri);
+                    node.count[slot] = ids.len() as u8;
+                    TriBlock::push_leaf(&mut blocks, &ids, &tri);
                 } else {
                     node.child[slot] = out.len() as u32;
                     work.push((k, out.len()));
@@ -185,33 +194,6 @@ impl Bvh8 {
     pub fn bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<Node8>() + self.blocks.len() * std::mem::size_of::<TriBlock>()
     }
-}
-
-/// Up to eight BVH2 nodes under `n2` whose boxes cover its subtree: its two children, with the
-/// inner one of largest surface area replaced by its children while fewer than eight; `[n2]`
-/// for a leaf.
-fn gather_children(nodes: &[Bvh2Node], n2: usize) -> Vec<usize> {
-    let node = &nodes[n2];
-    if node.prim_count > 0 {
-        return vec![n2];
-    }
-    let mut kids = vec![node.first_index as usize, node.first_index as usize + 1];
-    while kids.len() < WIDTH {
-        let area = |k: usize| {
-            let e = nodes[k].aabb.max - nodes[k].aabb.min;
-            e.x * e.y + e.y * e.z + e.z * e.x
-        };
-        let Some(pos) = (0..kids.len())
-            .filter(|&i| nodes[kids[i]].prim_count == 0)
-            .max_by(|&a, &b| area(kids[a]).total_cmp(&area(kids[b])))
-        else {
-            break;
-        };
-        let first = nodes[kids[pos]].first_index as usize;
-        kids[pos] = first;
-        kids.push(first + 1);
-    }
-    kids
 }
 
 #[cfg(test)]
