@@ -35,14 +35,19 @@ fn agree(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery]) -> Vec<Option<
             assert_eq!(x, y, "{label}: closest hit differs for ray {i}: {:?}", rays[i]);
         }
     }
-    // Packets of 8 through the 8-wide BVH.
-    let mut wp = vec![None; rays.len()];
-    wide_packet::closest_packets8(bvh.wide(tris), tris, rays, &mut wp);
-    for (i, (x, y)) in a.iter().zip(&wp).enumerate() {
-        assert_eq!(x, y, "8-wide packets: closest hit differs for ray {i}: {:?}", rays[i]);
+    // Packets of 8 through the 8-wide BVH: never handing lanes over to single rays, at the
+    // default, and handing over at every node (each lane walks alone from the root).
+    let mut ops = vec![];
+    for thin in [0, wide_packet::THIN_LANES, 8] {
+        let mut wp = vec![None; rays.len()];
+        wide_packet::closest_packets8(bvh.wide(tris), tris, rays, &mut wp, thin);
+        for (i, (x, y)) in a.iter().zip(&wp).enumerate() {
+            assert_eq!(x, y, "8-wide packets (thin {thin}): closest hit differs for ray {i}: {:?}", rays[i]);
+        }
+        let mut op = vec![false; rays.len()];
+        wide_packet::occluded_packets8(bvh.wide(tris), tris, rays, &mut op, thin);
+        ops.push((thin, op));
     }
-    let mut op = vec![false; rays.len()];
-    wide_packet::occluded_packets8(bvh.wide(tris), tris, rays, &mut op);
     let mut oa = vec![false; rays.len()];
     let mut ob = vec![false; rays.len()];
     let mut ow = vec![false; rays.len()];
@@ -55,7 +60,9 @@ fn agree(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery]) -> Vec<Option<
         assert_eq!(*x, ob[i], "packet: any hit differs for ray {i}: {:?}", rays[i]);
         assert_eq!(*x, ow[i], "8-wide: any hit differs for ray {i}: {:?}", rays[i]);
         assert_eq!(*x, os[i], "8-wide scalar: any hit differs for ray {i}: {:?}", rays[i]);
-        assert_eq!(*x, op[i], "8-wide packets: any hit differs for ray {i}: {:?}", rays[i]);
+        for (thin, op) in &ops {
+            assert_eq!(*x, op[i], "8-wide packets (thin {thin}): any hit differs for ray {i}: {:?}", rays[i]);
+        }
         // Any hit and closest hit agree on whether something is in (0, t_max).
         assert_eq!(*x, a[i].is_some(), "any vs closest for ray {i}");
     }

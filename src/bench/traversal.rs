@@ -162,11 +162,11 @@ pub fn traversal(
                 use crate::geometry::wide_packet as w;
                 if any {
                     let mut out = vec![false; c.len()];
-                    w::occluded_packets8(bvh.wide(tris), tris, c, &mut out);
+                    w::occluded_packets8(bvh.wide(tris), tris, c, &mut out, w::THIN_LANES);
                     out.iter().filter(|&&b| b).count()
                 } else {
                     let mut out = vec![None; c.len()];
-                    w::closest_packets8(bvh.wide(tris), tris, c, &mut out);
+                    w::closest_packets8(bvh.wide(tris), tris, c, &mut out, w::THIN_LANES);
                     out.iter().filter(|h| h.is_some()).count()
                 }
             };

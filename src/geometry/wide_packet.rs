@@ -10,12 +10,19 @@
 //! are visited nearest first by the entry distance of the first lane that enters them. Any-hit
 //! traversal tests a node's leaf children as soon as the node is reached, before entering any
 //! inner child, as the other traversals do.
+//!
+//! Hand-over (Embree's hybrid traversal, Benthin et al. 2012): a stack entry reached by at most
+//! [`THIN_LANES`] active lanes is finished by each of those lanes alone, with the 8-wide single
+//! ray's own loop ([`super::wide_traverse`]) started at that node and the lane's best hit so far.
+//! A lane's hit does not depend on the order its leaves are met in, so the hits are the same as
+//! without hand-over; tests/packet.rs checks 0, the default and 8 (every lane alone from the root).
 
 use super::bvh::{Hit, TriangleColumns};
 use super::packet::{any_leaf, best_ts, closest_leaf, limits, Packet, LANES};
 use super::traverse::{Best, RayQuery, Stack};
 use super::triangle8::bits;
 use super::wide::{Bvh8, Node8, WIDTH};
+use super::wide_traverse::{any_walk, closest_walk, Entry as SingleEntry, Prepared, Visits};
 use wide::f32x8;
 
 /// A child waiting on the stack: node index or first block of a leaf, its triangle count (0 for
@@ -76,8 +83,11 @@ fn closest8(
     tris: TriangleColumns<'_>,
     rays: &[RayQuery],
     out: &mut [Option<Hit>],
-    stack: &mut Stack<Entry>,
+    stacks: &mut Stacks,
+    thin: u32,
 ) {
+    let Stacks { packet: stack, single } = stacks;
+    let mut prepared: [Option<Prepared>; LANES] = Default::default();
     let nodes = bvh.nodes();
     let p = Packet::load(rays);
     let mut best: [Best; LANES] = std::array::from_fn(|l| Best::new(rays.get(l).map_or(0.0, |r| r.t_max)));
@@ -93,6 +103,27 @@ fn closest8(
         // invalid lane holds a stand-in ray that must never be traced.
         let mask = bits(e.t.simd_le(t_best)) & e.lanes;
         if mask == 0 {
+            continue;
+        }
+        if mask.count_ones() <= thin {
+            // Few lanes left: each walks the subtree alone.
+            let t = e.t.to_array();
+            let mut m = mask;
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let ray = prepared[l].get_or_insert_with(|| Prepared::new(&rays[l]));
+                closest_walk::<true, false>(
+                    bvh,
+                    ray,
+                    (e.child, e.count, t[l]),
+                    &mut best[l],
+                    single,
+                    &mut Visits::default(),
+                );
+            }
+            t_best = best_ts(&best);
+            limit = limits(&best);
             continue;
         }
         if e.count > 0 {
@@ -114,7 +145,16 @@ fn closest8(
 }
 
 /// Any-hit tests of 8 rays.
-fn occluded8(bvh: &Bvh8, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [bool], stack: &mut Stack<Entry>) {
+fn occluded8(
+    bvh: &Bvh8,
+    tris: TriangleColumns<'_>,
+    rays: &[RayQuery],
+    out: &mut [bool],
+    stacks: &mut Stacks,
+    thin: u32,
+) {
+    let Stacks { packet: stack, single } = stacks;
+    let mut prepared: [Option<Prepared>; LANES] = Default::default();
     let nodes = bvh.nodes();
     let p = Packet::load(rays);
     let t_max = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| rays.get(l).map_or(0.0, |r| r.t_max)));
@@ -127,6 +167,23 @@ fn occluded8(bvh: &Bvh8, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut
     'walk: while let Some(e) = stack.pop() {
         let mask = e.lanes & !blocked;
         if mask == 0 {
+            continue;
+        }
+        if mask.count_ones() <= thin {
+            // Few lanes left: each walks the subtree alone.
+            let mut m = mask;
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let ray = prepared[l].get_or_insert_with(|| Prepared::new(&rays[l]));
+                if any_walk::<true, false>(bvh, ray, (e.child, e.count, 0.0), t_arr[l], single, &mut Visits::default())
+                {
+                    blocked |= 1 << l;
+                }
+            }
+            if blocked & p.valid == p.valid {
+                break;
+            }
             continue;
         }
         if e.count > 0 {
@@ -162,19 +219,38 @@ fn occluded8(bvh: &Bvh8, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut
     }
 }
 
-/// Closest hits of `rays` into `out`, 8 at a time through the 8-wide BVH (`tris`: the
-/// BVH-ordered columns its leaves address).
-pub fn closest_packets8(bvh: &Bvh8, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [Option<Hit>]) {
-    let mut stack = Stack::new();
-    for (r, o) in rays.chunks(LANES).zip(out.chunks_mut(LANES)) {
-        closest8(bvh, tris, r, o, &mut stack);
+/// Active lanes at or below which a stack entry is finished by each lane alone. 4 measured best
+/// or within noise of the best on the bunny's and the ogre's rays (`thin` 0–8, BENCHMARKS.md,
+/// issue 18, eleventh part): bunny camera rays 19.0 → 21.6 Mrays/s against none.
+pub const THIN_LANES: u32 = 4;
+
+/// The two stacks of a packet walk: the packet's, and the single ray's for lanes handed over.
+struct Stacks {
+    packet: Stack<Entry>,
+    single: Stack<SingleEntry>,
+}
+
+impl Stacks {
+    fn new() -> Self {
+        Stacks { packet: Stack::new(), single: Stack::new() }
     }
 }
 
-/// Any-hit tests of `rays` into `out`, 8 at a time through the 8-wide BVH.
-pub fn occluded_packets8(bvh: &Bvh8, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [bool]) {
-    let mut stack = Stack::new();
+/// Closest hits of `rays` into `out`, 8 at a time through the 8-wide BVH (`tris`: the
+/// BVH-ordered columns its leaves address), a node reached by at most `thin` lanes finished by
+/// each lane alone.
+pub fn closest_packets8(bvh: &Bvh8, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [Option<Hit>], thin: u32) {
+    let mut stacks = Stacks::new();
     for (r, o) in rays.chunks(LANES).zip(out.chunks_mut(LANES)) {
-        occluded8(bvh, tris, r, o, &mut stack);
+        closest8(bvh, tris, r, o, &mut stacks, thin);
+    }
+}
+
+/// Any-hit tests of `rays` into `out`, 8 at a time through the 8-wide BVH (`thin` as in
+/// [`closest_packets8`]).
+pub fn occluded_packets8(bvh: &Bvh8, tris: TriangleColumns<'_>, rays: &[RayQuery], out: &mut [bool], thin: u32) {
+    let mut stacks = Stacks::new();
+    for (r, o) in rays.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        occluded8(bvh, tris, r, o, &mut stacks, thin);
     }
 }

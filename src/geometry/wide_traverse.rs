@@ -24,7 +24,7 @@ use glam::Vec3;
 
 /// A stack entry: child (node index, or first block of a leaf), leaf triangle count (0 for a
 /// node) and entry distance.
-type Entry = (u32, u32, f32);
+pub(super) type Entry = (u32, u32, f32);
 
 /// Work one traversal did: nodes whose child boxes were tested, triangle blocks and triangles
 /// (live lanes of those blocks) tested.
@@ -172,11 +172,21 @@ fn entered<const SIMD: bool, const SORT: bool>(
 
 /// One ray as both tests want it: origin, inverse direction, splatted for the child test and
 /// sheared for the triangle test.
-struct Prepared {
+pub(super) struct Prepared {
     o: Vec3,
     inv: Vec3,
     wide: WideRay,
     sheared: ShearedRay,
+}
+
+impl Prepared {
+    /// `ray` prepared (a valid ray: [`RayQuery::is_valid`]).
+    #[inline(always)]
+    pub(super) fn new(ray: &RayQuery) -> Self {
+        let (o, d) = (ray.origin, ray.direction);
+        let inv = inverse_direction(d);
+        Prepared { o, inv, wide: WideRay::new(o, inv), sheared: ShearedRay::new(o, d) }
+    }
 }
 
 /// The ray prepared, or `None` when there is nothing to trace (no nodes, or an invalid ray).
@@ -185,9 +195,7 @@ fn prepare(bvh: &Bvh8, ray: &RayQuery) -> Option<Prepared> {
     if bvh.nodes().is_empty() || !ray.is_valid() {
         return None;
     }
-    let (o, d) = (ray.origin, ray.direction);
-    let inv = inverse_direction(d);
-    Some(Prepared { o, inv, wide: WideRay::new(o, inv), sheared: ShearedRay::new(o, d) })
+    Some(Prepared::new(ray))
 }
 
 /// The slot and entry distance of a key from [`entered`].
@@ -210,12 +218,30 @@ pub fn closest_counted<const SIMD: bool, const COUNT: bool>(
     stack: &mut Stack<Entry>,
     visits: &mut Visits,
 ) -> Option<Hit> {
-    let Prepared { o, inv, wide: r, sheared } = prepare(bvh, ray)?;
-    let nodes = bvh.nodes();
+    let prepared = prepare(bvh, ray)?;
     let mut best = Best::new(ray.t_max);
+    closest_walk::<SIMD, COUNT>(bvh, &prepared, (0, 0, 0.0), &mut best, stack, visits);
+    best.hit()
+}
+
+/// Walks the subtree of `start` (a node, or a leaf; entered at its distance) for the closest
+/// hit of a prepared ray, improving `best`: the single ray's loop, also run by the 8-wide
+/// packets for lanes they hand over.
+#[inline(always)]
+pub(super) fn closest_walk<const SIMD: bool, const COUNT: bool>(
+    bvh: &Bvh8,
+    prepared: &Prepared,
+    start: Entry,
+    best: &mut Best,
+    stack: &mut Stack<Entry>,
+    visits: &mut Visits,
+) {
+    let Prepared { o, inv, wide: r, sheared } = prepared;
+    let (o, inv) = (*o, *inv);
+    let nodes = bvh.nodes();
     stack.clear();
     // The nearest entered child is visited next without a trip through the stack.
-    let mut next = Some((0, 0, 0.0));
+    let mut next = Some(start);
     while let Some((c, count, tc)) = next.take().or_else(|| stack.pop()) {
         if tc > best.t {
             continue;
@@ -225,7 +251,7 @@ pub fn closest_counted<const SIMD: bool, const COUNT: bool>(
             if COUNT {
                 visits.leaf(blocks);
             }
-            let scalar = closest_leaf(blocks, &sheared, &mut best);
+            let scalar = closest_leaf(blocks, sheared, best);
             if COUNT {
                 visits.scalar += scalar;
             }
@@ -235,7 +261,7 @@ pub fn closest_counted<const SIMD: bool, const COUNT: bool>(
             visits.nodes += 1;
         }
         let node = &nodes[c as usize];
-        let (keys, n) = entered::<SIMD, true>(node, &r, o, inv, best.t);
+        let (keys, n) = entered::<SIMD, true>(node, r, o, inv, best.t);
         if n == 0 {
             continue;
         }
@@ -246,7 +272,6 @@ pub fn closest_counted<const SIMD: bool, const COUNT: bool>(
         let (i, t) = unkey(keys[0]);
         next = Some((node.child[i], u32::from(node.count[i]), t));
     }
-    best.hit()
 }
 
 /// True if anything is hit in (0, t_max), with a caller's stack.
@@ -263,20 +288,37 @@ pub fn occluded_counted<const SIMD: bool, const COUNT: bool>(
     stack: &mut Stack<Entry>,
     visits: &mut Visits,
 ) -> bool {
-    let Some(Prepared { o, inv, wide: r, sheared }) = prepare(bvh, ray) else {
+    let Some(prepared) = prepare(bvh, ray) else {
         return false;
     };
-    let (nodes, t_max) = (bvh.nodes(), ray.t_max);
+    any_walk::<SIMD, COUNT>(bvh, &prepared, (0, 0, 0.0), ray.t_max, stack, visits)
+}
+
+/// Whether the subtree of `start` (a node or a leaf) holds a hit of a prepared ray within
+/// (0, `t_max`): the single ray's any-hit loop, also run by the 8-wide packets for lanes they
+/// hand over.
+#[inline(always)]
+pub(super) fn any_walk<const SIMD: bool, const COUNT: bool>(
+    bvh: &Bvh8,
+    prepared: &Prepared,
+    start: Entry,
+    t_max: f32,
+    stack: &mut Stack<Entry>,
+    visits: &mut Visits,
+) -> bool {
+    let Prepared { o, inv, wide: r, sheared } = prepared;
+    let (o, inv) = (*o, *inv);
+    let nodes = bvh.nodes();
     let leaf_hit = |first: u32, count: u32, visits: &mut Visits| {
         let blocks = leaf(bvh, first, count);
         if COUNT {
             visits.leaf(blocks);
         }
-        any_leaf(blocks, &sheared, t_max, &mut visits.scalar)
+        any_leaf(blocks, sheared, t_max, &mut visits.scalar)
     };
     stack.clear();
     // The nearest entered inner child is visited next without a trip through the stack.
-    let mut next = Some((0, 0, 0.0));
+    let mut next = Some(start);
     while let Some((c, count, _)) = next.take().or_else(|| stack.pop()) {
         if count > 0 {
             if leaf_hit(c, count, visits) {
@@ -288,7 +330,7 @@ pub fn occluded_counted<const SIMD: bool, const COUNT: bool>(
         if COUNT {
             visits.nodes += 1;
         }
-        let (keys, n) = entered::<SIMD, false>(node, &r, o, inv, t_max);
+        let (keys, n) = entered::<SIMD, false>(node, r, o, inv, t_max);
         // Leaf children first; then the inner children: the first in slot order next, the
         // others on the stack, earlier slots on top.
         for &key in &keys[..n] {
