@@ -192,7 +192,7 @@ fn ordered_children(p: &Packet, nodes: &[Bvh2Node], node: &Bvh2Node, t: f32x8, m
 pub(super) fn closest_leaf(
     p: &Packet,
     tris: TriangleColumns<'_>,
-    ids: impl IntoIterator<Item = u32>,
+    ids: std::ops::Range<u32>,
     lanes: u32,
     best: &mut [Best; LANES],
     limit: &mut f32x8,
@@ -289,7 +289,7 @@ fn leaf_ids(node: &Bvh2Node) -> std::ops::Range<u32> {
 pub(super) fn any_leaf(
     p: &Packet,
     tris: TriangleColumns<'_>,
-    ids: impl IntoIterator<Item = u32>,
+    ids: std::ops::Range<u32>,
     lanes: u32,
     t_max: f32x8,
     t_arr: &[f32; LANES],

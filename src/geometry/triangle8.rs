@@ -91,25 +91,24 @@ pub(super) fn bits(m: f32x8) -> u32 {
 }
 
 /// Up to eight triangles of one leaf as SoA columns: vertex k's axis a in `v[3k + a]`; lane l is
-/// triangle `ids[l]`.
+/// triangle `first + l`.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
 pub struct TriBlock {
     /// Vertex columns: p0.x, p0.y, p0.z, p1.x, …, p2.z.
     pub v: [[f32; 8]; 9],
-    /// Triangle index (BVH order) of each lane (0 on padding lanes).
-    pub ids: [u32; 8],
+    /// Triangle index (BVH order) of lane 0.
+    pub first: u32,
     /// Lanes holding a triangle that can be hit (not padding, not degenerate).
     pub live: u8,
 }
 
 impl TriBlock {
-    /// Blocks for the triangles `ids` of the BVH-ordered vertices `tri(id)`, eight to a block.
-    pub fn push_leaf(out: &mut Vec<TriBlock>, ids: &[u32], tri: impl Fn(u32) -> [Vec3; 3]) {
-        for chunk in ids.chunks(8) {
-            let mut b = TriBlock { v: [[0.0; 8]; 9], ids: [0; 8], live: 0 };
-            for (l, &id) in chunk.iter().enumerate() {
-                b.ids[l] = id;
+    /// Blocks for the `count` triangles from `first` of the BVH-ordered vertices `tri(id)`.
+    pub fn push_leaf(out: &mut Vec<TriBlock>, first: u32, count: u32, tri: impl Fn(u32) -> [Vec3; 3]) {
+        for start in (first..first + count).step_by(8) {
+            let mut b = TriBlock { v: [[0.0; 8]; 9], first: start, live: 0 };
+            for (l, id) in (start..(start + 8).min(first + count)).enumerate() {
                 let p = tri(id);
                 for (k, v) in p.iter().enumerate() {
                     for a in 0..3 {

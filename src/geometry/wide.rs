@@ -4,13 +4,13 @@
 //! writes [`Node8`]s with the six box planes of the children as SoA columns.
 //!
 //! Collapse: [`super::wide_collapse`] chooses, by the surface area heuristic over the whole
-//! tree, which BVH2 nodes become 8-wide nodes, which become leaves (several small BVH2 leaves
-//! may share one, up to eight triangles) and which dissolve into their parent's slots; this
-//! module builds that shape. Triangle indices are unchanged (blocks list them lane by lane), so
-//! leaves address the same BVH-ordered columns as the BVH2. Against the greedy collapse it
-//! replaced (the inner child of largest area opened until eight), the bunny's tree has half the
-//! nodes (4 887 → 2 406, 4.3 → 6.4 children each) and bounce rays visit 7.1 nodes instead of 7.7
-//! (BENCHMARKS.md, issue 18, eleventh part).
+//! tree, which inner BVH2 nodes become 8-wide nodes and which dissolve into their parent's
+//! slots; this module builds that shape. BVH2 leaves (≤ 8 triangles from obvhs's build) stay
+//! leaves with their boxes, so every traversal prunes a triangle exactly when the BVH2 does.
+//! Triangle indices are unchanged, so leaves address the same BVH-ordered columns as the BVH2.
+//! Against the greedy collapse it replaced (the inner child of largest area opened until eight),
+//! the bunny's tree has a third fewer nodes (4 887 → 3 289, 4.3 → 5.8 children each) and bounce
+//! rays visit 7.4 nodes instead of 7.7 (BENCHMARKS.md, issue 18, eleventh part).
 //!
 //! The box test is [`box_entry`]'s, lane by lane: the same conservative slab test (far
 //! distance grown by 1 + 2γ₃), the same operations in the same order. Taking the near plane by
@@ -20,7 +20,7 @@
 
 use super::slab::{box_entry, FAR_GROWTH};
 use super::triangle8::TriBlock;
-use super::wide_collapse::{triangles_under, Layout};
+use super::wide_collapse::Layout;
 use glam::{Vec3, Vec3A};
 use obvhs::bvh2::node::Bvh2Node;
 use wide::f32x8;
@@ -144,11 +144,11 @@ impl Bvh8 {
         let layout = Layout::choose(nodes);
         let mut out = vec![Node8::EMPTY];
         let mut blocks = Vec::new();
-        // (BVH2 node, index of the Node8 that takes its children); a root that is best a leaf
-        // becomes the one child of the root.
+        // (BVH2 node, index of the Node8 that takes its children); a root leaf becomes the one
+        // child of the root.
         let mut work = vec![(0usize, 0usize)];
         while let Some((n2, at)) = work.pop() {
-            let kids = if layout.is_leaf(nodes, n2) { vec![n2] } else { layout.children(nodes, n2) };
+            let kids = if nodes[n2].prim_count > 0 { vec![n2] } else { layout.children(nodes, n2) };
             let mut node = Node8::EMPTY;
             for (slot, &k) in kids.iter().enumerate() {
                 let b = &nodes[k];
@@ -157,14 +157,12 @@ impl Bvh8 {
                     node.planes[a][slot] = lo[a];
                     node.planes[a + 3][slot] = hi[a];
                 }
-                if layout.is_leaf(nodes, k) {
-                    let mut ids = triangles_under(nodes, k);
-                    // obvhs caps its leaves at 255 primitives, and merged leaves hold at most
-                    // MAX_LEAF.
-                    ids.truncate(255);
+                if b.prim_count > 0 {
+                    // obvhs caps leaves at 255 primitives.
+                    let count = b.prim_count.min(255);
                     node.child[slot] = blocks.len() as u32;
-                    node.count[slot] = ids.len() as u8;
-                    TriBlock::push_leaf(&mut blocks, &ids, &tri);
+                    node.count[slot] = count as u8;
+                    TriBlock::push_leaf(&mut blocks, b.first_index, count, &tri);
                 } else {
                     node.child[slot] = out.len() as u32;
                     work.push((k, out.len()));

@@ -1,30 +1,33 @@
-//! How the BVH2 becomes 8-wide: which BVH2 nodes turn into 8-wide nodes, which into leaves, and
-//! which disappear into their parent's child slots — chosen by the surface area heuristic over
-//! the whole tree, by dynamic programming (Ylitie, Karras and Laine 2017, "Efficient incoherent
-//! ray traversal on GPUs through compressed wide BVHs", §4). Reads the BVH2 nodes; writes a
-//! [`Layout`] that [`super::wide::Bvh8::collapse`] turns into nodes and triangle blocks.
+//! How the BVH2 becomes 8-wide: which inner BVH2 nodes turn into 8-wide nodes and which
+//! dissolve into their parent's child slots — chosen by the surface area heuristic over the whole
+//! tree, by dynamic programming (after Ylitie, Karras and Laine 2017, "Efficient incoherent ray
+//! traversal on GPUs through compressed wide BVHs", §4). Reads the BVH2 nodes; writes a
+//! [`Layout`] that [`super::wide::Bvh8::collapse`] turns into nodes.
 //!
 //! For a BVH2 node n with box area A(n) (the chance, up to a constant, that a ray meets it) and
 //! j = 1..8, C(n, j) is the least cost of the subtree under n spread over at most j child slots:
 //!
-//! - C(n, 1): n as one slot, a leaf (A(n) · block cost · blocks of 8 triangles, if n holds at
-//!   most [`MAX_LEAF`] triangles) or an 8-wide node (A(n) · node cost + the least cost of its two
-//!   children spread over 8 slots: min over k of C(left, k) + C(right, 8 − k));
+//! - C(n, 1): n as one slot: a leaf's A(n) · blocks of 8 triangles · [`BLOCK_COST`], or an inner
+//!   node's A(n) + min over k of C(left, k) + C(right, 8 − k) (an 8-wide node over both
+//!   children's slots);
 //! - C(n, j ≥ 2): the better of C(n, j − 1) and min over k of C(left, k) + C(right, j − k).
 //!
-//! BVH2 leaves (≤ 8 triangles from obvhs's build) are never split, but siblings may share one
-//! leaf slot: a leaf's triangles need not be one index range, so blocks list their triangles.
+//! BVH2 leaves stay leaves, with their own boxes. Letting small sibling leaves share one leaf
+//! (as Ylitie et al. do) ran 4 % faster still, but the union box prunes differently: the
+//! `edge_rays` fuzz target found a ray, 4 000 scene diagonals from two micron-sized triangles,
+//! whose entry into one leaf's box rounded past a hit tied in t with the other, so the BVH2
+//! found one triangle and the merged leaf the other. With the BVH2's leaf boxes, every traversal
+//! prunes a triangle exactly when the BVH2 does (an ancestor's box passes whenever its leaf's
+//! does: the slab test is monotonic in the planes), and every kernel returns the same hit.
 //!
-//! The costs are this machine's (bunny bounce rays, perf): testing a block of 8 triangles costs
-//! about 1.4 visits of a node (its eight boxes, child order and stack).
+//! The block cost is this machine's (the bunny's bounce rays, perf): testing a block of 8
+//! triangles costs about 1.4 visits of a node (its eight boxes, child order and stack); the
+//! tree changed little between 0.5 and 3.
 
 use obvhs::bvh2::node::Bvh2Node;
 
 /// Children per 8-wide node.
 const WIDTH: usize = 8;
-
-/// Most triangles one leaf slot may hold.
-pub const MAX_LEAF: u32 = 8;
 
 /// Cost of visiting an 8-wide node, in the unit of the costs below.
 const NODE_COST: f32 = 1.0;
@@ -33,7 +36,7 @@ const NODE_COST: f32 = 1.0;
 const BLOCK_COST: f32 = 1.4;
 
 /// What one BVH2 node becomes: per number of slots j (index j − 1), the least cost and how it is
-/// reached. `split[0]`: 0 for a leaf, else the slots its left child gets as an 8-wide node;
+/// reached. `split[0]`: the slots its left child gets when it is an 8-wide node (0 for a leaf);
 /// `split[j − 1]` for j ≥ 2: 0 to spread over j − 1 slots instead, else the left child's slots.
 #[derive(Clone, Copy)]
 struct Choice {
@@ -58,13 +61,11 @@ impl Layout {
     #[must_use]
     pub fn choose(nodes: &[Bvh2Node]) -> Self {
         let mut choice = vec![Choice { cost: [0.0; WIDTH], split: [0; WIDTH] }; nodes.len()];
-        let mut tris = vec![0u32; nodes.len()];
         // Post order: a node is decided after both its children.
         let mut work = vec![(0usize, false)];
         while let Some((n, children_done)) = work.pop() {
             let node = &nodes[n];
             if node.prim_count > 0 {
-                tris[n] = node.prim_count;
                 let leaf = area(node) * BLOCK_COST * node.prim_count.div_ceil(8) as f32;
                 choice[n] = Choice { cost: [leaf; WIDTH], split: [0; WIDTH] };
                 continue;
@@ -74,7 +75,6 @@ impl Layout {
                 work.extend([(n, true), (l, false), (r, false)]);
                 continue;
             }
-            tris[n] = tris[l] + tris[r];
             let (cl, cr) = (&choice[l].cost, &choice[r].cost);
             // The best split of j slots between the children, j = 2..8: (cost, left's slots).
             let spread = |j: usize| {
@@ -82,10 +82,8 @@ impl Layout {
             };
             let a = area(node);
             let (inner, k) = spread(WIDTH);
-            let inner = a * NODE_COST + inner;
-            let leaf = if tris[n] <= MAX_LEAF { a * BLOCK_COST * tris[n].div_ceil(8) as f32 } else { f32::INFINITY };
             let mut c = Choice { cost: [0.0; WIDTH], split: [0; WIDTH] };
-            (c.cost[0], c.split[0]) = if leaf <= inner { (leaf, 0) } else { (inner, k) };
+            (c.cost[0], c.split[0]) = (a * NODE_COST + inner, k);
             for j in 2..=WIDTH {
                 let (s, k) = spread(j);
                 (c.cost[j - 1], c.split[j - 1]) = if s < c.cost[j - 2] { (s, k) } else { (c.cost[j - 2], 0) };
@@ -95,14 +93,8 @@ impl Layout {
         Layout { choice }
     }
 
-    /// Whether BVH2 node `n`, taken as one slot, is a leaf (else an 8-wide node).
-    #[must_use]
-    pub fn is_leaf(&self, nodes: &[Bvh2Node], n: usize) -> bool {
-        nodes[n].prim_count > 0 || self.choice[n].split[0] == 0
-    }
-
-    /// The child slots of BVH2 node `n` taken as an 8-wide node (not a leaf): BVH2 nodes whose
-    /// subtrees together cover n's.
+    /// The child slots of inner BVH2 node `n` as an 8-wide node: BVH2 nodes whose subtrees
+    /// together cover n's.
     #[must_use]
     pub fn children(&self, nodes: &[Bvh2Node], n: usize) -> Vec<usize> {
         let mut out = Vec::with_capacity(WIDTH);
@@ -130,22 +122,6 @@ impl Layout {
     }
 }
 
-/// The triangle indices under BVH2 node `n` (its leaves' ranges, left to right).
-#[must_use]
-pub fn triangles_under(nodes: &[Bvh2Node], n: usize) -> Vec<u32> {
-    let mut out = Vec::new();
-    let mut work = vec![n];
-    while let Some(m) = work.pop() {
-        let node = &nodes[m];
-        if node.prim_count > 0 {
-            out.extend(node.first_index..node.first_index + node.prim_count);
-        } else {
-            work.extend([node.first_index as usize + 1, node.first_index as usize]);
-        }
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -171,32 +147,18 @@ mod tests {
         nodes
     }
 
-    /// Four leaves of two triangles in one box: one leaf of eight costs 1.4·A, a node over four
-    /// leaves 1·A + 4·1.4·A. One leaf it is, holding all eight in order.
-    #[test]
-    fn overlapping_small_leaves_merge_into_one() {
-        let unit = ([0.0; 3], [1.0; 3]);
-        let nodes = two_level([unit; 4], 2);
-        let layout = Layout::choose(&nodes);
-        assert!(layout.is_leaf(&nodes, 0));
-        assert_eq!(triangles_under(&nodes, 0), (0..8).collect::<Vec<u32>>());
-    }
-
-    /// Four leaves of four triangles (sixteen: more than one leaf may hold) in small boxes far
-    /// apart: the root becomes a node whose four slots are the four BVH2 leaves, the two inner
-    /// BVH2 nodes between them dissolved.
+    /// Four leaves in small boxes far apart: the root's node takes the four BVH2 leaves as its
+    /// slots, the two inner BVH2 nodes between them dissolved (each would cost its area).
     #[test]
     fn distant_leaves_become_the_slots_of_one_node() {
         let at = |x: f32| ([x, 0.0, 0.0], [x + 0.1, 0.1, 0.1]);
         let nodes = two_level([at(0.0), at(10.0), at(20.0), at(30.0)], 4);
         let layout = Layout::choose(&nodes);
-        assert!(!layout.is_leaf(&nodes, 0));
         assert_eq!(layout.children(&nodes, 0), vec![3, 4, 5, 6]);
-        assert!((3..7).all(|n| layout.is_leaf(&nodes, n)));
     }
 
-    /// Sixteen leaves under a balanced tree need two levels of 8-wide nodes: the root's slots
-    /// cover every leaf exactly once, and none of them is more than eight.
+    /// Sixteen leaves under a balanced tree need two levels of 8-wide nodes: the nodes reached
+    /// from the root have at most eight slots and cover every leaf exactly once.
     #[test]
     fn slots_cover_the_tree_once() {
         // A complete BVH2 of depth 4: node i's children at 2i + 1 and 2i + 2, leaves 15–30.
@@ -218,15 +180,13 @@ mod tests {
             let kids = layout.children(&nodes, n);
             assert!(kids.len() <= 8);
             for k in kids {
-                if layout.is_leaf(&nodes, k) {
-                    for t in triangles_under(&nodes, k) {
-                        seen[(t / 8) as usize] += 1;
-                    }
+                if nodes[k].prim_count > 0 {
+                    seen[(nodes[k].first_index / 8) as usize] += 1;
                 } else {
                     work.push(k);
                 }
             }
         }
-        assert!(seen[..16].iter().all(|&c| c == 8), "{seen:?}");
+        assert!(seen[..16].iter().all(|&c| c == 1), "{seen:?}");
     }
 }

@@ -42,11 +42,11 @@ impl Default for Entry {
     }
 }
 
-/// The triangles of a leaf child: the ids of the `count` lanes from its first block.
+/// The triangles of a leaf child: `count` from its first block's first triangle.
 #[inline(always)]
-fn leaf_ids(bvh: &Bvh8, first_block: u32, count: u32) -> impl Iterator<Item = u32> + '_ {
-    let blocks = &bvh.blocks()[first_block as usize..first_block as usize + count.div_ceil(8) as usize];
-    blocks.iter().flat_map(|b| b.ids).take(count as usize)
+fn leaf_ids(bvh: &Bvh8, first_block: u32, count: u32) -> std::ops::Range<u32> {
+    let first = bvh.blocks()[first_block as usize].first;
+    first..first + count
 }
 
 /// The children of `node` that lanes of `mask` enter within `t`, nearest first: their keys (the

@@ -79,7 +79,7 @@ fn closest_leaf(blocks: &[TriBlock], r: &ShearedRay, best: &mut Best) -> u64 {
         while todo != 0 {
             let l = todo.trailing_zeros() as usize;
             todo &= todo - 1;
-            let id = b.ids[l];
+            let id = b.first + l as u32;
             if hit >> l & 1 == 1 && best.limit().to_bits() == limit.to_bits() {
                 best.offer(t[l], id, [bary[0][l], bary[1][l], bary[2][l]]);
             } else {
