@@ -260,7 +260,9 @@ fn bench_lights_a_bare_mesh_and_measures_one_half() {
         assert!(row["count"].as_u64().unwrap() > 0, "{row}");
     }
     for row in traversal {
-        assert_eq!(row["embree1_mrays"].is_null(), !cfg!(feature = "embree"), "{row}");
+        for field in ["embree1_mrays", "embree_robust1_mrays", "renderer_vs_embree_robust"] {
+            assert_eq!(row[field].is_null(), !cfg!(feature = "embree"), "{field}: {row}");
+        }
     }
     // The other half alone.
     let v =

@@ -112,6 +112,7 @@ extern "C" {
     fn rtcNewScene(device: Handle) -> Handle;
     fn rtcReleaseScene(scene: Handle);
     fn rtcSetSceneBuildQuality(scene: Handle, quality: u32);
+    fn rtcSetSceneFlags(scene: Handle, flags: u32);
     fn rtcNewGeometry(device: Handle, kind: u32) -> Handle;
     fn rtcSetGeometryBuildQuality(geometry: Handle, quality: u32);
     fn rtcSetNewGeometryBuffer(
@@ -132,6 +133,9 @@ extern "C" {
     fn rtcOccluded8(valid: *const i32, scene: Handle, context: *mut Context, ray: *mut Ray8);
 }
 
+/// `RTC_SCENE_FLAG_ROBUST`: traversal and triangle test without the optimisations that lose
+/// accuracy (Embree's watertight mode).
+const SCENE_FLAG_ROBUST: u32 = 1 << 2;
 /// `RTC_BUILD_QUALITY_HIGH`: SAH with spatial splits.
 const BUILD_QUALITY_HIGH: u32 = 2;
 /// `RTC_GEOMETRY_TYPE_TRIANGLE`.
@@ -156,8 +160,9 @@ unsafe impl Send for EmbreeScene {}
 unsafe impl Sync for EmbreeScene {}
 
 impl EmbreeScene {
-    /// Builds Embree's BVH over `tris` at HIGH quality; an error names Embree's error code.
-    pub fn build(tris: TriangleColumns<'_>) -> Result<Self, String> {
+    /// Builds Embree's BVH over `tris` at HIGH quality, in its robust (watertight) mode if
+    /// `robust`; an error names Embree's error code.
+    pub fn build(tris: TriangleColumns<'_>, robust: bool) -> Result<Self, String> {
         let n = tris.p0.len();
         if n == 0 {
             return Err("Embree: the scene has no triangles".into());
@@ -183,6 +188,9 @@ impl EmbreeScene {
                 Err(format!("Embree: {what} (error {code})"))
             };
             rtcSetSceneBuildQuality(scene, BUILD_QUALITY_HIGH);
+            if robust {
+                rtcSetSceneFlags(scene, SCENE_FLAG_ROBUST);
+            }
             let geometry = rtcNewGeometry(device, GEOMETRY_TRIANGLE);
             if geometry.is_null() {
                 return fail("rtcNewGeometry failed");
@@ -319,17 +327,19 @@ mod tests {
     }
 
     #[test]
-    fn one_triangle_is_hit_through_its_middle_and_missed_beside_it() {
+    fn one_triangle_is_hit_through_its_middle_and_missed_beside_it_in_both_modes() {
         let (p0, p1, p2) = ([Vec3::new(0.0, 0.0, 1.0)], [Vec3::new(1.0, 0.0, 1.0)], [Vec3::new(0.0, 1.0, 1.0)]);
-        let e = EmbreeScene::build(TriangleColumns { p0: &p0, p1: &p1, p2: &p2 }).unwrap();
-        let rays = [
-            RayQuery::new(Vec3::new(0.25, 0.25, 0.0), Vec3::Z, f32::INFINITY),
-            RayQuery::new(Vec3::new(0.9, 0.9, 0.0), Vec3::Z, f32::INFINITY),
-            RayQuery::new(Vec3::new(0.25, 0.25, 0.0), Vec3::Z, 0.5),
-        ];
-        for any in [false, true] {
-            assert_eq!(e.count_single(&rays, any), 1);
-            assert_eq!(e.count_packets(&rays, any), 1);
+        for robust in [false, true] {
+            let e = EmbreeScene::build(TriangleColumns { p0: &p0, p1: &p1, p2: &p2 }, robust).unwrap();
+            let rays = [
+                RayQuery::new(Vec3::new(0.25, 0.25, 0.0), Vec3::Z, f32::INFINITY),
+                RayQuery::new(Vec3::new(0.9, 0.9, 0.0), Vec3::Z, f32::INFINITY),
+                RayQuery::new(Vec3::new(0.25, 0.25, 0.0), Vec3::Z, 0.5),
+            ];
+            for any in [false, true] {
+                assert_eq!(e.count_single(&rays, any), 1);
+                assert_eq!(e.count_packets(&rays, any), 1);
+            }
         }
     }
 }

@@ -245,8 +245,11 @@ pub fn table(traversal: &[TraversalRow], density: &[DensityRow]) -> String {
             r.rays, r.query, r.count, r.packet_mrays, r.wide_packet_mrays, r.wide_mrays, r.nodes_per_ray, r.triangles_per_ray, r.scalar_per_ray, r.renderer_kernel, r.renderer_mrays, r.single_mrays, r.ratio, r.twin_mrays, r.cwbvh_mrays, r.cwbvh_lost_hits,
             match (r.embree1_mrays, r.embree8_mrays, r.ratio_vs_embree, r.renderer_vs_embree, r.embree_extra_hits) {
                 (Some(e1), Some(e8), Some(x), Some(y), Some(d)) => format!(
-                    "1-ray {e1:.2}, 8-ray {e8:.2} Mrays/s, packet ×{x:.2}, renderer's {} ×{y:.2} ({d:+} hits)",
-                    r.renderer_kernel
+                    "1-ray {e1:.2}, 8-ray {e8:.2} Mrays/s, packet ×{x:.2}, renderer's {} ×{y:.2} ({d:+} hits); robust 1-ray {:.2}, 8-ray {:.2}, renderer's ×{:.2}",
+                    r.renderer_kernel,
+                    r.embree_robust1_mrays.unwrap_or(f64::NAN),
+                    r.embree_robust8_mrays.unwrap_or(f64::NAN),
+                    r.renderer_vs_embree_robust.unwrap_or(f64::NAN),
                 ),
                 _ => "– (build with --features embree)".to_string(),
             }

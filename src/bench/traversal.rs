@@ -70,6 +70,14 @@ pub struct TraversalRow {
     /// Rays Embree reports hit minus rays ours report hit (Embree counts hits at t = 0 and
     /// differs from our watertight test on edges).
     pub embree_extra_hits: Option<i64>,
+    /// Embree's single rays with `RTC_SCENE_FLAG_ROBUST` (its watertight triangle test and
+    /// conservative box test, as ours always are), million rays per second; `null` without
+    /// `--features embree`.
+    pub embree_robust1_mrays: Option<f64>,
+    /// Embree's 8-ray packets in robust mode, million rays per second.
+    pub embree_robust8_mrays: Option<f64>,
+    /// `renderer_mrays` ÷ the faster of robust Embree's two: the comparison at equal accuracy.
+    pub renderer_vs_embree_robust: Option<f64>,
 }
 
 /// A per-ray kernel as a chunk counter for [`count_hits`].
@@ -99,7 +107,10 @@ pub fn traversal(
     let cw = crate::geometry::bvh::CwBaseline::build(scene.columns());
     #[cfg(feature = "embree")]
     let embree_scene =
-        super::embree::EmbreeScene::build(scene.columns()).map_err(|message| Error::Scene { message })?;
+        super::embree::EmbreeScene::build(scene.columns(), false).map_err(|message| Error::Scene { message })?;
+    #[cfg(feature = "embree")]
+    let embree_robust =
+        super::embree::EmbreeScene::build(scene.columns(), true).map_err(|message| Error::Scene { message })?;
     let (bvh, tris) = (scene.bvh(), scene.columns());
     let mut rows = vec![];
     for (label, rays) in [("camera", &sets.camera), ("shadow", &sets.shadow), ("diffuse", &sets.diffuse)] {
@@ -175,23 +186,33 @@ pub fn traversal(
             let mut kernels: Vec<&mut dyn FnMut()> =
                 vec![&mut run_packet, &mut run_obvhs, &mut run_wide, &mut run_wide_packet];
             #[cfg(feature = "embree")]
-            let (mut h1, mut h8) = (0, 0);
+            let (mut h1, mut h8, mut hr1, mut hr8) = (0, 0, 0, 0);
             #[cfg(feature = "embree")]
             let mut run_embree1 = || h1 = count_hits(rays, threads, |c| embree_scene.count_single(c, any));
             #[cfg(feature = "embree")]
             let mut run_embree8 = || h8 = count_hits(rays, threads, |c| embree_scene.count_packets(c, any));
             #[cfg(feature = "embree")]
-            kernels.extend([&mut run_embree1 as &mut dyn FnMut(), &mut run_embree8]);
+            let mut run_robust1 = || hr1 = count_hits(rays, threads, |c| embree_robust.count_single(c, any));
+            #[cfg(feature = "embree")]
+            let mut run_robust8 = || hr8 = count_hits(rays, threads, |c| embree_robust.count_packets(c, any));
+            #[cfg(feature = "embree")]
+            kernels.extend([
+                &mut run_embree1 as &mut dyn FnMut(),
+                &mut run_embree8,
+                &mut run_robust1,
+                &mut run_robust8,
+            ]);
             let t = time_each(reps, &mut kernels);
             drop(kernels);
             let (tp, ts, tw, twp) = (t[0], t[1], t[2], t[3]);
             #[cfg(feature = "embree")]
             let embree = {
                 assert_eq!(h1, h8, "{name} {label} {query}: Embree's single rays and packets disagree");
-                Some((t[4], t[5], h1 as i64 - hp as i64))
+                assert_eq!(hr1, hr8, "{name} {label} {query}: robust Embree's single rays and packets disagree");
+                Some((t[4], t[5], h1 as i64 - hp as i64, t[6], t[7]))
             };
             #[cfg(not(feature = "embree"))]
-            let embree: Option<(f64, f64, i64)> = None;
+            let embree: Option<(f64, f64, i64, f64, f64)> = None;
             assert_eq!(hp, hs, "{name} {label} {query}: packet and single-ray hit counts differ");
             assert_eq!(hw, hs, "{name} {label} {query}: 8-wide and obvhs hit counts differ");
             assert_eq!(hwp, hs, "{name} {label} {query}: 8-wide packets and obvhs hit counts differ");
@@ -226,6 +247,9 @@ pub fn traversal(
                 embree8_mrays: embree.map(|e| m / e.1),
                 ratio_vs_embree: embree.map(|e| e.0.min(e.1) / tp),
                 embree_extra_hits: embree.map(|e| e.2),
+                embree_robust1_mrays: embree.map(|e| m / e.3),
+                embree_robust8_mrays: embree.map(|e| m / e.4),
+                renderer_vs_embree_robust: embree.map(|e| e.3.min(e.4) / t_renderer),
             });
         }
     }
