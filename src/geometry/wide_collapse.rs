@@ -4,36 +4,28 @@
 //! traversal on GPUs through compressed wide BVHs", §4). Reads the BVH2 nodes; writes a
 //! [`Layout`] that [`super::wide::Bvh8::collapse`] turns into nodes.
 //!
-//! For a BVH2 node n with box area A(n) (the chance, up to a constant, that a ray meets it) and
-//! j = 1..8, C(n, j) is the least cost of the subtree under n spread over at most j child slots:
+//! The cost of a tree is the expected number of 8-wide nodes a ray visits: the sum of their box
+//! areas (a ray meets a box with a chance proportional to its area). Every BVH2 leaf takes one
+//! slot whatever the shape, so its tests cost the same in every tree and are left out. For a
+//! BVH2 node n with box area A(n) and j = 1..8, C(n, j) is the least cost of the subtree under n
+//! spread over at most j child slots:
 //!
-//! - C(n, 1): n as one slot: a leaf's A(n) · blocks of 8 triangles · [`BLOCK_COST`], or an inner
-//!   node's A(n) + min over k of C(left, k) + C(right, 8 − k) (an 8-wide node over both
-//!   children's slots);
+//! - C(n, 1): n as one slot: 0 for a leaf; for an inner node an 8-wide node of its own,
+//!   A(n) + min over k of C(left, k) + C(right, 8 − k);
 //! - C(n, j ≥ 2): the better of C(n, j − 1) and min over k of C(left, k) + C(right, j − k).
 //!
 //! BVH2 leaves stay leaves, with their own boxes. Letting small sibling leaves share one leaf
-//! (as Ylitie et al. do) ran 4 % faster still, but the union box prunes differently: the
+//! (as Ylitie et al. do) ran 3–5 % faster still, but the union box prunes differently: the
 //! `edge_rays` fuzz target found a ray, 4 000 scene diagonals from two micron-sized triangles,
 //! whose entry into one leaf's box rounded past a hit tied in t with the other, so the BVH2
 //! found one triangle and the merged leaf the other. With the BVH2's leaf boxes, every traversal
 //! prunes a triangle exactly when the BVH2 does (an ancestor's box passes whenever its leaf's
 //! does: the slab test is monotonic in the planes), and every kernel returns the same hit.
-//!
-//! The block cost is this machine's (the bunny's bounce rays, perf): testing a block of 8
-//! triangles costs about 1.4 visits of a node (its eight boxes, child order and stack); the
-//! tree changed little between 0.5 and 3.
 
 use obvhs::bvh2::node::Bvh2Node;
 
 /// Children per 8-wide node.
 const WIDTH: usize = 8;
-
-/// Cost of visiting an 8-wide node, in the unit of the costs below.
-const NODE_COST: f32 = 1.0;
-
-/// Cost of testing one block of up to 8 triangles.
-const BLOCK_COST: f32 = 1.4;
 
 /// What one BVH2 node becomes: per number of slots j (index j − 1), the least cost and how it is
 /// reached. `split[0]`: the slots its left child gets when it is an 8-wide node (0 for a leaf);
@@ -66,8 +58,6 @@ impl Layout {
         while let Some((n, children_done)) = work.pop() {
             let node = &nodes[n];
             if node.prim_count > 0 {
-                let leaf = area(node) * BLOCK_COST * node.prim_count.div_ceil(8) as f32;
-                choice[n] = Choice { cost: [leaf; WIDTH], split: [0; WIDTH] };
                 continue;
             }
             let (l, r) = (node.first_index as usize, node.first_index as usize + 1);
@@ -80,10 +70,10 @@ impl Layout {
             let spread = |j: usize| {
                 (1..j).map(|k| (cl[k - 1] + cr[j - k - 1], k as u8)).min_by(|a, b| a.0.total_cmp(&b.0)).unwrap()
             };
-            let a = area(node);
             let (inner, k) = spread(WIDTH);
+            let a = area(node);
             let mut c = Choice { cost: [0.0; WIDTH], split: [0; WIDTH] };
-            (c.cost[0], c.split[0]) = (a * NODE_COST + inner, k);
+            (c.cost[0], c.split[0]) = (a + inner, k);
             for j in 2..=WIDTH {
                 let (s, k) = spread(j);
                 (c.cost[j - 1], c.split[j - 1]) = if s < c.cost[j - 2] { (s, k) } else { (c.cost[j - 2], 0) };
