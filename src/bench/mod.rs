@@ -243,13 +243,13 @@ pub fn table(traversal: &[TraversalRow], density: &[DensityRow]) -> String {
             s,
             "  traversal {:<8} {:<8} {:>8} rays  packet {:>7.2} Mrays/s  8-wide packets {:>7.2}  wide {:>7.2} ({:.1} nodes, {:.1} tris, {:.2} scalar)  renderer's {} {:.2}  obvhs single {:>7.2} Mrays/s  ×{:.2}  (scalar twin {:.2}, obvhs CWBVH {:.2}, {} hits lost)  embree {}",
             r.rays, r.query, r.count, r.packet_mrays, r.wide_packet_mrays, r.wide_mrays, r.nodes_per_ray, r.triangles_per_ray, r.scalar_per_ray, r.renderer_kernel, r.renderer_mrays, r.single_mrays, r.ratio, r.twin_mrays, r.cwbvh_mrays, r.cwbvh_lost_hits,
-            match (r.embree1_mrays, r.embree8_mrays, r.ratio_vs_embree, r.renderer_vs_embree, r.embree_extra_hits) {
-                (Some(e1), Some(e8), Some(x), Some(y), Some(d)) => format!(
-                    "1-ray {e1:.2}, 8-ray {e8:.2} Mrays/s, packet ×{x:.2}, renderer's {} ×{y:.2} ({d:+} hits); robust 1-ray {:.2}, 8-ray {:.2}, renderer's ×{:.2}",
-                    r.renderer_kernel,
-                    r.embree_robust1_mrays.unwrap_or(f64::NAN),
-                    r.embree_robust8_mrays.unwrap_or(f64::NAN),
-                    r.renderer_vs_embree_robust.unwrap_or(f64::NAN),
+            match (
+                (r.embree1_mrays, r.embree8_mrays, r.ratio_vs_embree, r.renderer_vs_embree, r.embree_extra_hits),
+                (r.embree_robust1_mrays, r.embree_robust8_mrays, r.renderer_vs_embree_robust),
+            ) {
+                ((Some(e1), Some(e8), Some(x), Some(y), Some(d)), (Some(r1), Some(r8), Some(ry))) => format!(
+                    "1-ray {e1:.2}, 8-ray {e8:.2} Mrays/s, packet ×{x:.2}, renderer's {} ×{y:.2} ({d:+} hits); robust 1-ray {r1:.2}, 8-ray {r8:.2}, renderer's ×{ry:.2}",
+                    r.renderer_kernel
                 ),
                 _ => "– (build with --features embree)".to_string(),
             }

@@ -41,12 +41,6 @@ pub struct Layout {
     choice: Vec<Choice>,
 }
 
-/// Half the surface area of node `n`'s box.
-fn area(node: &Bvh2Node) -> f32 {
-    let e = node.aabb.max - node.aabb.min;
-    e.x * e.y + e.y * e.z + e.z * e.x
-}
-
 impl Layout {
     /// Chooses the layout over `nodes` (root first; an inner node's children at `first_index`
     /// and the next; not empty).
@@ -71,7 +65,7 @@ impl Layout {
                 (1..j).map(|k| (cl[k - 1] + cr[j - k - 1], k as u8)).min_by(|a, b| a.0.total_cmp(&b.0)).unwrap()
             };
             let (inner, k) = spread(WIDTH);
-            let a = area(node);
+            let a = node.aabb.half_area();
             let mut c = Choice { cost: [0.0; WIDTH], split: [0; WIDTH] };
             (c.cost[0], c.split[0]) = (a + inner, k);
             for j in 2..=WIDTH {
