@@ -41,10 +41,12 @@ pub struct Node8 {
     pub count: [u8; WIDTH],
     /// Bit i set for the children in use.
     pub valid: u8,
+    /// Bit i set for the leaf children.
+    pub leaves: u8,
 }
 
 impl Node8 {
-    const EMPTY: Node8 = Node8 { planes: [[0.0; WIDTH]; 6], child: [0; WIDTH], count: [0; WIDTH], valid: 0 };
+    const EMPTY: Node8 = Node8 { planes: [[0.0; WIDTH]; 6], child: [0; WIDTH], count: [0; WIDTH], valid: 0, leaves: 0 };
 
     /// Child `i`'s box as (min, max).
     #[must_use]
@@ -162,6 +164,7 @@ impl Bvh8 {
                     let count = b.prim_count.min(255);
                     node.child[slot] = blocks.len() as u32;
                     node.count[slot] = count as u8;
+                    node.leaves |= 1 << slot;
                     TriBlock::push_leaf(&mut blocks, b.first_index, count, &tri);
                 } else {
                     node.child[slot] = out.len() as u32;

@@ -13,7 +13,11 @@
 //! entering any inner child (as the BVH2 traversals do: a leaf is cheap and often ends the ray).
 //! It takes the entered children in slot order, unsorted: any occluder ends the ray, and the
 //! sort cost more than the order saved (any-hit bench rows 0.97–1.15×, all but one faster:
-//! BENCHMARKS.md, issue 18, tenth part).
+//! BENCHMARKS.md, issue 18, tenth part), and without reading entry distances at all: it walks
+//! the hit mask's bits, leaf children (a per-node bit mask) first. Closest-hit traversal goes
+//! straight to the only child it enters, without keys or a sort, and builds sorted keys only
+//! when two or more are entered (single-ray any hit +15–25 %, closest hit +2–6 %, BVH8 bench
+//! program; BENCHMARKS.md, issue 18, twelfth part).
 
 use super::bvh::Hit;
 use super::slab::inverse_direction;
@@ -113,23 +117,41 @@ fn any_leaf(blocks: &[TriBlock], r: &ShearedRay, t_max: f32, scalar: &mut u64) -
     })
 }
 
-/// The children of `node` that the ray enters within `t_max`, as (t bits, slot) keys, and their
-/// number: sorted nearest first if `SORT`, else in slot order. Entry distances are ≥ 0 and never
-/// NaN, so their bit patterns order as the values do.
+/// Entry distances into the children of `node`, per slot, as the SIMD test leaves them (lanes
+/// outside the mask hold garbage) or as the scalar twin returns them.
+enum Entries {
+    Wide(wide::f32x8),
+    Scalar([f32; WIDTH]),
+}
+
+impl Entries {
+    #[inline(always)]
+    fn to_array(&self) -> [f32; WIDTH] {
+        match self {
+            Entries::Wide(t) => t.to_array(),
+            Entries::Scalar(t) => *t,
+        }
+    }
+}
+
+/// The bit mask of the children of `node` that the ray enters within `t_max`, and their entry
+/// distances.
 #[inline(always)]
-fn entered<const SIMD: bool, const SORT: bool>(
-    node: &Node8,
-    r: &WideRay,
-    o: Vec3,
-    inv: Vec3,
-    t_max: f32,
-) -> ([u64; WIDTH], usize) {
-    let (mut mask, t) = if SIMD {
+fn enter<const SIMD: bool>(node: &Node8, r: &WideRay, o: Vec3, inv: Vec3, t_max: f32) -> (u32, Entries) {
+    if SIMD {
         let (m, t) = node.entries(r, t_max);
-        (m, t.to_array())
+        (m, Entries::Wide(t))
     } else {
-        node.entries_scalar(o, inv, t_max)
-    };
+        let (m, t) = node.entries_scalar(o, inv, t_max);
+        (m, Entries::Scalar(t))
+    }
+}
+
+/// The children of `mask` (at least two) as (t bits, slot) keys sorted nearest first, and their
+/// number. Entry distances are ≥ 0 and never NaN, so their bit patterns order as the values do.
+#[inline(always)]
+fn sorted(mut mask: u32, t: &Entries) -> ([u64; WIDTH], usize) {
+    let t = t.to_array();
     let mut keys = [0u64; WIDTH];
     let mut n = 0;
     while mask != 0 {
@@ -137,9 +159,6 @@ fn entered<const SIMD: bool, const SORT: bool>(
         mask &= mask - 1;
         keys[n] = u64::from(t[i].to_bits()) << 32 | i as u64;
         n += 1;
-    }
-    if !SORT {
-        return (keys, n);
     }
     // Two or three keys (the usual counts) by a network of min and max, without a branch on
     // their order (the insertion sort's compares go either way with the ray: BENCHMARKS.md,
@@ -240,12 +259,15 @@ pub(super) fn closest_walk<const SIMD: bool, const COUNT: bool>(
     let (o, inv) = (*o, *inv);
     let nodes = bvh.nodes();
     stack.clear();
-    // The nearest entered child is visited next without a trip through the stack.
-    let mut next = Some(start);
-    while let Some((c, count, tc)) = next.take().or_else(|| stack.pop()) {
-        if tc > best.t {
-            continue;
-        }
+    if start.2 > best.t {
+        return;
+    }
+    // The child visited now: node index or first block, and triangle count (0 for a node). The
+    // nearest entered child is visited next without a trip through the stack, and needs neither
+    // its entry distance (it is within the limit it was tested against, which has not moved) nor,
+    // when it is the only one entered, a sort.
+    let (mut c, mut count) = (start.0, start.1);
+    loop {
         if count > 0 {
             let blocks = leaf(bvh, c, count);
             if COUNT {
@@ -255,22 +277,38 @@ pub(super) fn closest_walk<const SIMD: bool, const COUNT: bool>(
             if COUNT {
                 visits.scalar += scalar;
             }
-            continue;
+        } else {
+            if COUNT {
+                visits.nodes += 1;
+            }
+            let node = &nodes[c as usize];
+            let (mask, t) = enter::<SIMD>(node, r, o, inv, best.t);
+            if mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                if mask & (mask - 1) == 0 {
+                    (c, count) = (node.child[i], u32::from(node.count[i]));
+                    continue;
+                }
+                let (keys, n) = sorted(mask, &t);
+                for &key in keys[1..n].iter().rev() {
+                    let (i, t) = unkey(key);
+                    stack.push((node.child[i], u32::from(node.count[i]), t));
+                }
+                let (i, _) = unkey(keys[0]);
+                (c, count) = (node.child[i], u32::from(node.count[i]));
+                continue;
+            }
         }
-        if COUNT {
-            visits.nodes += 1;
+        // Popped children entered beyond the closest hit found since are skipped.
+        loop {
+            let Some((pc, pcount, tc)) = stack.pop() else {
+                return;
+            };
+            if tc <= best.t {
+                (c, count) = (pc, pcount);
+                break;
+            }
         }
-        let node = &nodes[c as usize];
-        let (keys, n) = entered::<SIMD, true>(node, r, o, inv, best.t);
-        if n == 0 {
-            continue;
-        }
-        for &key in keys[1..n].iter().rev() {
-            let (i, t) = unkey(key);
-            stack.push((node.child[i], u32::from(node.count[i]), t));
-        }
-        let (i, t) = unkey(keys[0]);
-        next = Some((node.child[i], u32::from(node.count[i]), t));
     }
 }
 
@@ -330,21 +368,25 @@ pub(super) fn any_walk<const SIMD: bool, const COUNT: bool>(
         if COUNT {
             visits.nodes += 1;
         }
-        let (keys, n) = entered::<SIMD, false>(node, r, o, inv, t_max);
+        let (mask, _) = enter::<SIMD>(node, r, o, inv, t_max);
         // Leaf children first; then the inner children: the first in slot order next, the
-        // others on the stack, earlier slots on top.
-        for &key in &keys[..n] {
-            let (i, _) = unkey(key);
-            if node.count[i] > 0 && leaf_hit(node.child[i], u32::from(node.count[i]), visits) {
+        // others on the stack, earlier slots on top. Entry distances are not needed: any hit
+        // ends the walk, and the limit never moves.
+        let leaves = mask & u32::from(node.leaves);
+        let mut m = leaves;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            if leaf_hit(node.child[i], u32::from(node.count[i]), visits) {
                 return true;
             }
         }
-        for &key in keys[..n].iter().rev() {
-            let (i, t) = unkey(key);
-            if node.count[i] == 0 {
-                if let Some(farther) = next.replace((node.child[i], 0, t)) {
-                    stack.push(farther);
-                }
+        let mut inner = mask & !leaves;
+        while inner != 0 {
+            let i = (31 - inner.leading_zeros()) as usize;
+            inner &= !(1 << i);
+            if let Some(farther) = next.replace((node.child[i], 0, 0.0)) {
+                stack.push(farther);
             }
         }
     }
