@@ -16,8 +16,8 @@
 //! BENCHMARKS.md, issue 18, tenth part), and without reading entry distances at all: it walks
 //! the hit mask's bits, leaf children (a per-node bit mask) first. Closest-hit traversal goes
 //! straight to the only child it enters, without keys or a sort, and builds sorted keys only
-//! when two or more are entered (single-ray any hit +15–25 %, closest hit +2–6 %, BVH8 bench
-//! program; BENCHMARKS.md, issue 18, twelfth part).
+//! when two or more are entered (any hit 6–34 % faster on the bench's rows, closest hit up to
+//! 18 %: BENCHMARKS.md, issue 18, twelfth part).
 
 use super::bvh::Hit;
 use super::slab::inverse_direction;
@@ -27,7 +27,7 @@ use super::wide::{Bvh8, Node8, WideRay, WIDTH};
 use glam::Vec3;
 
 /// A stack entry: child (node index, or first block of a leaf), leaf triangle count (0 for a
-/// node) and entry distance.
+/// node) and entry distance (closest hit; any-hit walks leave it 0).
 pub(super) type Entry = (u32, u32, f32);
 
 /// Work one traversal did: nodes whose child boxes were tested, triangle blocks and triangles
