@@ -25,6 +25,7 @@ use super::traverse::{Best, RayQuery, Stack};
 use super::triangle8::{intersect_block, intersect_lane, ShearedRay, TriBlock};
 use super::wide::{Bvh8, Node8, WideRay, WIDTH};
 use glam::Vec3;
+use wide::f32x8;
 
 /// A stack entry: child (node index, or first block of a leaf), leaf triangle count (0 for a
 /// node) and entry distance (closest hit; any-hit walks leave it 0).
@@ -117,40 +118,22 @@ fn any_leaf(blocks: &[TriBlock], r: &ShearedRay, t_max: f32, scalar: &mut u64) -
     })
 }
 
-/// Entry distances into the children of `node`, per slot, as the SIMD test leaves them (lanes
-/// outside the mask hold garbage) or as the scalar twin returns them.
-enum Entries {
-    Wide(wide::f32x8),
-    Scalar([f32; WIDTH]),
-}
-
-impl Entries {
-    #[inline(always)]
-    fn to_array(&self) -> [f32; WIDTH] {
-        match self {
-            Entries::Wide(t) => t.to_array(),
-            Entries::Scalar(t) => *t,
-        }
-    }
-}
-
 /// The bit mask of the children of `node` that the ray enters within `t_max`, and their entry
-/// distances.
+/// distances by slot (lanes outside the mask hold garbage): the 8-wide test, or its scalar twin.
 #[inline(always)]
-fn enter<const SIMD: bool>(node: &Node8, r: &WideRay, o: Vec3, inv: Vec3, t_max: f32) -> (u32, Entries) {
+fn enter<const SIMD: bool>(node: &Node8, r: &WideRay, o: Vec3, inv: Vec3, t_max: f32) -> (u32, f32x8) {
     if SIMD {
-        let (m, t) = node.entries(r, t_max);
-        (m, Entries::Wide(t))
+        node.entries(r, t_max)
     } else {
         let (m, t) = node.entries_scalar(o, inv, t_max);
-        (m, Entries::Scalar(t))
+        (m, f32x8::from(t))
     }
 }
 
 /// The children of `mask` (at least two) as (t bits, slot) keys sorted nearest first, and their
 /// number. Entry distances are ≥ 0 and never NaN, so their bit patterns order as the values do.
 #[inline(always)]
-fn sorted(mut mask: u32, t: &Entries) -> ([u64; WIDTH], usize) {
+fn sorted(mut mask: u32, t: f32x8) -> ([u64; WIDTH], usize) {
     let t = t.to_array();
     let mut keys = [0u64; WIDTH];
     let mut n = 0;
@@ -289,7 +272,7 @@ pub(super) fn closest_walk<const SIMD: bool, const COUNT: bool>(
                     (c, count) = (node.child[i], u32::from(node.count[i]));
                     continue;
                 }
-                let (keys, n) = sorted(mask, &t);
+                let (keys, n) = sorted(mask, t);
                 for &key in keys[1..n].iter().rev() {
                     let (i, t) = unkey(key);
                     stack.push((node.child[i], u32::from(node.count[i]), t));
