@@ -189,8 +189,20 @@ fn light_inside_glass_reaches_the_walls_only_as_caustics() {
 /// Case 1: the mirror-and-glass Cornell box at 1e-4, 1 and 1e5 units, on both engines. Ray
 /// offsets, error bounds and search radii follow the scene's size, and radiance is invariant
 /// under a uniform scale, with the same random numbers at every scale:
-/// - photons: every photon path lands where its scale-1 twin does, to 1e-3 of the scene's
-///   diagonal (measured 4·10⁻⁴), and each map holds the same count with the same power / s²;
+/// - photons, compared path by path: rounding differs at each scale (1e-4 is no power of two), by
+///   about 2⁻²⁴ of a coordinate per step, and the spheres are convex mirrors, a Sinai billiard:
+///   a reflection off radius R multiplies a position error by about 1 + 2L/R over the next leg
+///   of length L. A drifted path that meets a jump of the estimator (a facet edge of the
+///   tessellated sphere, where the geometric normal, so Veach's correction and the roulette's
+///   survival probability, jumps) may take the other branch. Measured over 200 000 paths per map
+///   and scale: agreeing photons drift by 2.5·10⁻⁷ of the diagonal on average (at most 8·10⁻⁴),
+///   and 0–2 paths part (global path 11 625 with lights listed in input order: drift 1.2·10⁻⁵
+///   after seven bounces, then the roulette flips on a facet edge). So a path *parts* if its
+///   photon count differs or a photon lands more than 10⁻³ of the diagonal from its twin; at most
+///   one path in 1 000 may part (at the measured 10⁻⁵ per path, 0.1–0.2 are expected among the
+///   12 000–23 000 traced here, and more than 12 has Poisson probability < 10⁻¹⁸), and agreeing photons may drift by 10⁻⁵ on average. A step that depends on the scale (an
+///   absolute offset or radius) parts most paths at their first bounce. Each map holds the same
+///   count with the same power / s²;
 /// - light sampling: no pixel of the emitted and direct layers moves by more than 10⁻³ of its
 ///   value (or of the layer's mean, where darker). None does; before the triangle test's error
 ///   bound took lengths for the shear, shadow rays slipped through the spheres at 1e-4 and 14
@@ -201,7 +213,7 @@ fn light_inside_glass_reaches_the_walls_only_as_caustics() {
 ///   object would be ten times that; and no row may lose half its light (black rows).
 #[test]
 fn scale_changes_nothing() {
-    use photonwave::reference::photons::trace_photons;
+    use photonwave::reference::photons::{trace_path, trace_photons};
     use photonwave::rng::Domain;
     let s = Settings {
         width: 32,
@@ -222,16 +234,39 @@ fn scale_changes_nothing() {
             .collect();
     let (unit, rest) = scenes.split_first().unwrap();
     for domain in [Domain::GlobalPhoton, Domain::CausticPhoton] {
-        let s = Settings { threads: 2, ..s.clone() };
-        let a = trace_photons(&unit.2, &common::job(&unit.2, &s), domain, 20_000, &NoProgress);
+        let paths = trace_photons(&unit.2, &common::job(&unit.2, &s), domain, 20_000, &NoProgress).emitted;
+        let trace = |scene: &photonwave::scene::Scene, job: &photonwave::job::Job, path: u64| {
+            let (mut out, mut rays, mut numerics) = (Vec::new(), 0, photonwave::stats::Numerics::default());
+            trace_path(scene, job, domain, path, &mut out, &mut rays, &mut numerics);
+            let diagonal = scene.diagonal();
+            out.iter().map(|p| p.position / diagonal).collect::<Vec<Vec3>>()
+        };
+        let unit_job = common::job(&unit.2, &s);
         for (label, _, scene, _) in rest {
-            let b = trace_photons(scene, &common::job(scene, &s), domain, 20_000, &NoProgress);
-            assert_eq!(a.photons.len(), b.photons.len(), "{domain:?}, scale {label}");
-            let (da, db) = (unit.2.diagonal(), scene.diagonal());
-            for (i, (p, q)) in a.photons.iter().zip(&b.photons).enumerate() {
-                let d = (q.position / db - p.position / da).length();
-                assert!(d < 1e-3, "{domain:?}, scale {label}: photon {i} at {} against {}", q.position, p.position);
+            let job = common::job(scene, &s);
+            let (mut parted, mut drift, mut agreeing) = (Vec::new(), 0.0f64, 0u32);
+            for path in 0..paths {
+                let (a, b) = (trace(&unit.2, &unit_job, path), trace(scene, &job, path));
+                let d: Vec<f32> = a.iter().zip(&b).map(|(p, q)| (*q - *p).length()).collect();
+                if a.len() != b.len() || d.iter().any(|&d| d >= 1e-3) {
+                    parted.push(path);
+                } else {
+                    drift += d.iter().map(|&d| f64::from(d)).sum::<f64>();
+                    agreeing += d.len() as u32;
+                }
             }
+            let drift = drift / f64::from(agreeing.max(1));
+            let first = &parted[..parted.len().min(8)];
+            println!(
+                "{domain:?}, scale {label}: {} of {paths} paths parted (first {first:?}), mean drift {drift:.1e}",
+                parted.len()
+            );
+            assert!(
+                parted.len() as u64 <= paths / 1000,
+                "{domain:?}, scale {label}: {} of {paths} paths parted (first {first:?})",
+                parted.len()
+            );
+            assert!(drift <= 1e-5, "{domain:?}, scale {label}: photons drift by {drift} of the diagonal on average");
         }
     }
     for engine in ENGINES {
