@@ -6,7 +6,8 @@
 //! Collapse: [`super::wide_collapse`] chooses, by the surface area heuristic over the whole
 //! tree, which inner BVH2 nodes become 8-wide nodes and which dissolve into their parent's
 //! slots; this module builds that shape. BVH2 leaves (≤ 8 triangles from obvhs's build) stay
-//! leaves with their boxes, so every traversal prunes a triangle exactly when the BVH2 does.
+//! leaves with their boxes, so every traversal prunes by the BVH2's leaf boxes (what that does
+//! and does not guarantee: [`super::wide_collapse`]).
 //! Triangle indices are unchanged, so leaves address the same BVH-ordered columns as the BVH2.
 //! Against the greedy collapse it replaced (the inner child of largest area opened until eight),
 //! the bunny's tree has a third fewer nodes (4 887 → 3 289, 4.3 → 5.8 children each) and bounce

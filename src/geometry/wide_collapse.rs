@@ -18,9 +18,13 @@
 //! (as Ylitie et al. do) ran 3–5 % faster still, but the union box prunes differently: the
 //! `edge_rays` fuzz target found a ray, 4 000 scene diagonals from two micron-sized triangles,
 //! whose entry into one leaf's box rounded past a hit tied in t with the other, so the BVH2
-//! found one triangle and the merged leaf the other. With the BVH2's leaf boxes, every traversal
-//! prunes a triangle exactly when the BVH2 does (an ancestor's box passes whenever its leaf's
-//! does: the slab test is monotonic in the planes), and every kernel returns the same hit.
+//! found one triangle and the merged leaf the other. With the BVH2's leaf boxes every kernel
+//! prunes a leaf by the same box with the same arithmetic (an ancestor's box passes whenever its
+//! leaf's does: the slab test is monotonic in the planes). That keeps the kernels' hits equal in
+//! every case tests/packet.rs and the fuzz regressions hold, but it is no proof: pruning is exact
+//! only where a triangle's computed t lies inside its box, which needles and grazing rays can
+//! break, and then which leaf is pruned depends on what a kernel found first (BENCHMARKS.md,
+//! issue 18, fourteenth part: a second tree for the single rays made the kernels disagree so).
 
 use obvhs::bvh2::node::Bvh2Node;
 
