@@ -243,11 +243,12 @@ fn scale_changes_nothing() {
             out.iter().map(|p| p.position / diagonal).collect::<Vec<Vec3>>()
         };
         let unit_job = common::job(&unit.2, &s);
+        let unit_paths: Vec<Vec<Vec3>> = (0..paths).map(|path| trace(&unit.2, &unit_job, path)).collect();
         for (label, _, scene, _) in rest {
             let job = common::job(scene, &s);
             let (mut parted, mut drift, mut agreeing) = (Vec::new(), 0.0f64, 0u32);
-            for path in 0..paths {
-                let (a, b) = (trace(&unit.2, &unit_job, path), trace(scene, &job, path));
+            for (path, a) in (0..paths).zip(&unit_paths) {
+                let b = trace(scene, &job, path);
                 let d: Vec<f32> = a.iter().zip(&b).map(|(p, q)| (*q - *p).length()).collect();
                 if a.len() != b.len() || d.iter().any(|&d| d >= 1e-3) {
                     parted.push(path);

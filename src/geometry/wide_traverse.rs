@@ -267,17 +267,16 @@ pub(super) fn closest_walk<const SIMD: bool, const COUNT: bool>(
             let node = &nodes[c as usize];
             let (mask, t) = enter::<SIMD>(node, r, o, inv, best.t);
             if mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                if mask & (mask - 1) == 0 {
-                    (c, count) = (node.child[i], u32::from(node.count[i]));
-                    continue;
-                }
-                let (keys, n) = sorted(mask, t);
-                for &key in keys[1..n].iter().rev() {
-                    let (i, t) = unkey(key);
-                    stack.push((node.child[i], u32::from(node.count[i]), t));
-                }
-                let (i, _) = unkey(keys[0]);
+                let i = if mask & (mask - 1) == 0 {
+                    mask.trailing_zeros() as usize
+                } else {
+                    let (keys, n) = sorted(mask, t);
+                    for &key in keys[1..n].iter().rev() {
+                        let (i, t) = unkey(key);
+                        stack.push((node.child[i], u32::from(node.count[i]), t));
+                    }
+                    unkey(keys[0]).0
+                };
                 (c, count) = (node.child[i], u32::from(node.count[i]));
                 continue;
             }
