@@ -315,7 +315,7 @@ fn collapse_keeps_every_triangle_once() {
     for b in wide.blocks() {
         for l in 0..8 {
             if b.live >> l & 1 == 1 {
-                let id = (b.first + l) as usize;
+                let id = b.ids[l as usize] as usize;
                 seen[id] += 1;
                 assert_eq!(b.triangle(l as usize), [tris.p0[id], tris.p1[id], tris.p2[id]]);
             }

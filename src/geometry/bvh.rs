@@ -1,5 +1,8 @@
-//! The bounding volume hierarchy: obvhs builds a BVH2 over padded triangle boxes; traversal
-//! calls our watertight triangle test.
+//! The bounding volume hierarchies: obvhs builds a BVH2 over padded triangle boxes, which orders
+//! the scene's triangle columns and which the ray packets walk; [`super::sah`] builds a second
+//! BVH2 over the same boxes, collapsed to the 8-wide tree the single rays walk. Traversal calls
+//! our watertight triangle test, with every hit's t settled into its triangle's box
+//! ([`super::slab::settle`]), so both trees give the same hits.
 //!
 //! obvhs 0.4.0 computes Morton codes over the union of the primitive boxes; a box centre lying
 //! exactly on that union's max face gets a code that wraps to 0 (DESIGN.md §8), so the +x/+y/+z
@@ -30,9 +33,12 @@ pub struct Hit {
 /// A BVH over triangles stored as three vertex columns.
 pub struct Bvh {
     bvh: Bvh2,
-    /// The same tree collapsed to 8-wide nodes, built on first use: by `photonwave bench`, and
-    /// by renders whose ray queues try single rays ([`crate::traversal_choice`]).
+    /// The SAH tree over the same triangles ([`super::sah`]) collapsed to 8-wide nodes, built
+    /// on first use: by `photonwave bench`, and by renders whose ray queues try single rays
+    /// ([`crate::traversal_choice`]).
     wide: std::sync::OnceLock<Bvh8>,
+    /// [`shared_pad`] of the triangles: the padding of the boxes hits are settled against.
+    pad: f32,
 }
 
 impl Bvh {
@@ -45,7 +51,14 @@ impl Bvh {
         let mut build_time = std::time::Duration::ZERO;
         let bvh = obvhs::bvh2::builder::build_bvh2(&boxes, BvhBuildParams::medium_build(), &mut build_time);
         let order = bvh.primitive_indices.clone();
-        (Bvh { bvh, wide: std::sync::OnceLock::new() }, order)
+        (Bvh { bvh, wide: std::sync::OnceLock::new(), pad: shared_pad(p0, p1, p2) }, order)
+    }
+
+    /// The padding every triangle's box shares ([`shared_pad`]): the margin of the box a hit's
+    /// t is settled against ([`super::slab::settle`]).
+    #[must_use]
+    pub fn pad(&self) -> f32 {
+        self.pad
     }
 
     /// The obvhs nodes (root first; children of an inner node at `first_index` and the next).
@@ -54,12 +67,14 @@ impl Bvh {
         &self.bvh.nodes
     }
 
-    /// The tree collapsed to 8-wide nodes (same leaves, same triangle order), with the leaves'
-    /// triangles copied from `tris` (the BVH-ordered columns) into blocks; built on first call.
+    /// The 8-wide tree over `tris` (the BVH-ordered columns, whose indices its leaves keep):
+    /// [`super::sah`]'s BVH2 over their padded boxes, collapsed, with the leaves' triangles
+    /// copied into blocks; built on first call.
     #[must_use]
     pub fn wide(&self, tris: TriangleColumns<'_>) -> &Bvh8 {
         self.wide.get_or_init(|| {
-            Bvh8::collapse(&self.bvh.nodes, |id| {
+            let sah = super::sah::build(&padded_boxes(tris.p0, tris.p1, tris.p2));
+            Bvh8::collapse(&sah.nodes, &sah.primitive_indices, self.pad, |id| {
                 let i = id as usize;
                 [tris.p0[i], tris.p1[i], tris.p2[i]]
             })
@@ -124,10 +139,9 @@ fn hit_t(tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32, i: usize) -> f
     intersect_triangle(o, d, t_max, tris.p0[i], tris.p1[i], tris.p2[i]).map_or(f32::INFINITY, |h| h.t)
 }
 
-/// Triangle boxes padded as [`Bvh::build`] pads them (module notes): by [`BOX_PAD`] of the
-/// scene diagonal plus a few ulps of their own magnitude.
+/// The padding every triangle's box gets: [`BOX_PAD`] of the scene diagonal (1 for no triangles).
 #[must_use]
-pub fn padded_boxes(p0: &[Vec3], p1: &[Vec3], p2: &[Vec3]) -> Vec<Aabb> {
+pub fn shared_pad(p0: &[Vec3], p1: &[Vec3], p2: &[Vec3]) -> f32 {
     let mut lo = Vec3::splat(f32::INFINITY);
     let mut hi = Vec3::splat(f32::NEG_INFINITY);
     for p in p0.iter().chain(p1).chain(p2) {
@@ -135,12 +149,20 @@ pub fn padded_boxes(p0: &[Vec3], p1: &[Vec3], p2: &[Vec3]) -> Vec<Aabb> {
         hi = hi.max(*p);
     }
     let diag = if p0.is_empty() { 1.0 } else { (hi - lo).length().max(f32::MIN_POSITIVE) };
+    diag * BOX_PAD
+}
+
+/// Triangle boxes padded as [`Bvh::build`] pads them (module notes): by [`shared_pad`] plus a
+/// few ulps of their own magnitude.
+#[must_use]
+pub fn padded_boxes(p0: &[Vec3], p1: &[Vec3], p2: &[Vec3]) -> Vec<Aabb> {
+    let shared = shared_pad(p0, p1, p2);
     (0..p0.len())
         .map(|i| {
             let mn = p0[i].min(p1[i]).min(p2[i]);
             let mx = p0[i].max(p1[i]).max(p2[i]);
             // Padding relative to both the scene and the box's own magnitude.
-            let pad = Vec3::splat(diag * BOX_PAD) + mn.abs().max(mx.abs()) * 4.0 * f32::EPSILON;
+            let pad = Vec3::splat(shared) + mn.abs().max(mx.abs()) * 4.0 * f32::EPSILON;
             Aabb::new(Vec3A::from(mn - pad), Vec3A::from(mx + pad))
         })
         .collect()

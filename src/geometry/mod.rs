@@ -3,6 +3,7 @@
 pub mod bvh;
 pub mod offset;
 pub mod packet;
+pub mod sah;
 pub mod slab;
 pub mod traverse;
 pub mod triangle;

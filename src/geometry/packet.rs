@@ -9,13 +9,14 @@
 //! node is reached by at most `thin` active lanes ([`THIN_LANES`] by default), those lanes finish
 //! its subtree by single-ray traversal.
 //!
-//! Decisions match [`super::traverse`] (same conservative box test, same triangle test, ties to
-//! the lower triangle index), so hits are identical lane by lane; tests/packet.rs checks it.
+//! Decisions match [`super::traverse`] (same conservative box test, same triangle test, every
+//! hit's t settled into its triangle's box by [`super::slab::settle`]'s operations, ties to the
+//! lower triangle index), so hits are identical lane by lane; tests/packet.rs checks it.
 
 use super::bvh::{Bvh, Hit, TriangleColumns};
-use super::slab::FAR_GROWTH;
+use super::slab::{intersect_settled, slab8, triangle_box};
 use super::traverse::{closest_from, occluded_from, Best, RayQuery, Stack};
-use super::triangle::{intersect_triangle, is_degenerate};
+use super::triangle::is_degenerate;
 use super::triangle8::{bits, watertight8};
 use glam::Vec3;
 use obvhs::bvh2::node::Bvh2Node;
@@ -122,26 +123,29 @@ impl Packet {
     /// [`Self::entry`] for the box `lo`–`hi`.
     #[inline(always)]
     pub(super) fn entry_box(&self, lo: [f32; 3], hi: [f32; 3], t_max: f32x8) -> f32x8 {
-        let slab = |a: usize, o: f32x8, inv: f32x8| {
-            let t0 = (f32x8::splat(lo[a]) - o) * inv;
-            let t1 = (f32x8::splat(hi[a]) - o) * inv;
-            (t0.fast_min(t1), t0.fast_max(t1))
-        };
-        let (nx, fx) = slab(0, self.ox, self.ix);
-        let (ny, fy) = slab(1, self.oy, self.iy);
-        let (nz, fz) = slab(2, self.oz, self.iz);
-        // No NaN can arise (finite origins, boxes and inverse directions), so the min/max need
-        // no NaN handling: the same values as the scalar test's.
-        let near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
-        let far = fx.fast_min(fy).fast_min(fz) * f32x8::splat(FAR_GROWTH);
+        // Written out, not with array maps (left out of line in some builds: see `WideRay::new`).
+        let splat = |v: [f32; 3]| [f32x8::splat(v[0]), f32x8::splat(v[1]), f32x8::splat(v[2])];
+        let (near, far) = slab8(splat(lo), splat(hi), [self.ox, self.oy, self.oz], [self.ix, self.iy, self.iz]);
         let hit = near.simd_le(far) & near.simd_le(t_max);
         hit.select(near, f32x8::splat(f32::NAN))
     }
+
+    /// [`super::slab::settle`] for the eight rays at once: each lane's `t` raised to its entry
+    /// into the triangle's box, +∞ where it misses that box ([`slab8`]: the scalar function's
+    /// values bit for bit).
+    #[inline(always)]
+    fn settle(&self, t: f32x8, v: [Vec3; 3], pad: f32) -> f32x8 {
+        let (lo, hi) = triangle_box(v, pad);
+        let splat = |v: glam::Vec3A| [f32x8::splat(v.x), f32x8::splat(v.y), f32x8::splat(v.z)];
+        let (lo, hi) = (splat(lo), splat(hi));
+        let (near, far) = slab8(lo, hi, [self.ox, self.oy, self.oz], [self.ix, self.iy, self.iz]);
+        t.fast_max(near.simd_le(far).select(near, f32x8::splat(f32::INFINITY)))
+    }
 }
 
-/// The watertight ray/triangle test of [`intersect_triangle`] for 8 rays against one triangle:
-/// each lane's vertices relative to its origin, permuted by its axis choice and sheared, then
-/// [`watertight8`] (see there for the fallbacks).
+/// The watertight ray/triangle test of [`super::triangle::intersect_triangle`] for 8 rays
+/// against one triangle: each lane's vertices relative to its origin, permuted by its axis
+/// choice and sheared, then [`watertight8`] (see there for the fallbacks).
 #[inline(always)]
 fn intersect8(p: &Packet, lanes: u32, v: [Vec3; 3], t_max: f32x8) -> (u32, u32, f32x8, [f32x8; 3]) {
     let perm = |q: Vec3| {
@@ -192,8 +196,9 @@ fn ordered_children(p: &Packet, nodes: &[Bvh2Node], node: &Bvh2Node, t: f32x8, m
 pub(super) fn closest_leaf(
     p: &Packet,
     tris: TriangleColumns<'_>,
-    ids: std::ops::Range<u32>,
+    ids: impl IntoIterator<Item = u32>,
     lanes: u32,
+    pad: f32,
     best: &mut [Best; LANES],
     limit: &mut f32x8,
 ) {
@@ -203,10 +208,12 @@ pub(super) fn closest_leaf(
         if is_degenerate(v[0], v[1], v[2]) {
             continue;
         }
-        let (mut hit, mut fallback, t, b) = intersect8(p, lanes, v, *limit);
+        let (hit, mut fallback, t, b) = intersect8(p, lanes, v, *limit);
         if hit | fallback == 0 {
             continue;
         }
+        let t = p.settle(t, v, pad);
+        let mut hit = hit & bits(t.simd_lt(*limit));
         let (t, b) = (t.to_array(), b.map(f32x8::to_array));
         while hit != 0 {
             let l = hit.trailing_zeros() as usize;
@@ -216,7 +223,7 @@ pub(super) fn closest_leaf(
         while fallback != 0 {
             let l = fallback.trailing_zeros() as usize;
             fallback &= fallback - 1;
-            best[l].test(tris, p.o[l], p.d[l], id);
+            best[l].test(tris, p.o[l], p.d[l], p.inv[l], pad, id);
         }
         *limit = limits(best);
     }
@@ -261,7 +268,7 @@ fn closest8(
             continue;
         }
         if node.prim_count > 0 {
-            closest_leaf(&p, tris, leaf_ids(node), mask, &mut best, &mut limit);
+            closest_leaf(&p, tris, leaf_ids(node), mask, bvh.pad(), &mut best, &mut limit);
             t_best = best_ts(&best);
             continue;
         }
@@ -289,8 +296,9 @@ fn leaf_ids(node: &Bvh2Node) -> std::ops::Range<u32> {
 pub(super) fn any_leaf(
     p: &Packet,
     tris: TriangleColumns<'_>,
-    ids: std::ops::Range<u32>,
+    ids: impl IntoIterator<Item = u32>,
     lanes: u32,
+    pad: f32,
     t_max: f32x8,
     t_arr: &[f32; LANES],
 ) -> u32 {
@@ -305,12 +313,14 @@ pub(super) fn any_leaf(
         if is_degenerate(v[0], v[1], v[2]) {
             continue;
         }
-        let (hit, mut fallback, _, _) = intersect8(p, open, v, t_max);
-        blocked |= hit;
+        let (hit, mut fallback, t, _) = intersect8(p, open, v, t_max);
+        if hit != 0 {
+            blocked |= hit & bits(p.settle(t, v, pad).simd_lt(t_max));
+        }
         while fallback != 0 {
             let l = fallback.trailing_zeros() as usize;
             fallback &= fallback - 1;
-            if intersect_triangle(p.o[l], p.d[l], t_arr[l], v[0], v[1], v[2]).is_some() {
+            if intersect_settled(p.o[l], p.d[l], p.inv[l], t_arr[l], v, pad).is_some() {
                 blocked |= 1 << l;
             }
         }
@@ -354,7 +364,7 @@ fn occluded8(
             continue;
         }
         if node.prim_count > 0 {
-            blocked |= any_leaf(&p, tris, leaf_ids(node), mask & !blocked, t_max, &t_arr);
+            blocked |= any_leaf(&p, tris, leaf_ids(node), mask & !blocked, bvh.pad(), t_max, &t_arr);
             if blocked & p.valid == p.valid {
                 stack.clear();
                 break;
@@ -368,7 +378,7 @@ fn occluded8(
         for (child, _, lanes) in &mut children {
             let c = &nodes[*child as usize];
             if *lanes != 0 && c.prim_count > 0 {
-                blocked |= any_leaf(&p, tris, leaf_ids(c), *lanes & !blocked, t_max, &t_arr);
+                blocked |= any_leaf(&p, tris, leaf_ids(c), *lanes & !blocked, bvh.pad(), t_max, &t_arr);
                 *lanes = 0;
             }
         }
@@ -467,6 +477,35 @@ mod tests {
                 f32::INFINITY,
             );
             assert_eq!(got[l].to_bits(), want.to_bits(), "lane {l}");
+        }
+    }
+
+    /// The packet form of `settle` returns the scalar function's t bit for bit, lane by lane:
+    /// rays entering the triangle's box before, at and after t, and rays missing it.
+    #[test]
+    fn packet_settle_matches_scalar_settle() {
+        let tris = [
+            [Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, -1.0), Vec3::new(0.0, 0.0, 1.0)],
+            [Vec3::new(0.0, 0.0, -10.0), Vec3::new(2e-7, 0.0, 10.0), Vec3::new(0.0, 2e-7, 10.0)],
+        ];
+        let rays: Vec<RayQuery> = (0..8)
+            .map(|i| {
+                let x = i as f32 * 0.4 - 1.6;
+                RayQuery::new(Vec3::new(x, 0.5, -3.0), Vec3::new(0.1 * x, -0.2, 1.0), f32::INFINITY)
+            })
+            .collect();
+        let p = Packet::load(&rays);
+        for v in tris {
+            for pad in [0.0, 1e-5, 0.5] {
+                for t in [1e-3f32, 1.0, 3.0, 50.0] {
+                    let got = p.settle(f32x8::splat(t), v, pad).to_array();
+                    for (l, r) in rays.iter().enumerate() {
+                        let inv = inverse_direction(r.direction);
+                        let want = super::super::slab::settle(t, r.origin.into(), inv.into(), v, pad);
+                        assert_eq!(got[l].to_bits(), want.to_bits(), "lane {l}, pad {pad}, t {t}");
+                    }
+                }
+            }
         }
     }
 }

@@ -3,13 +3,13 @@
 //!
 //! Both traversals make the same decisions where it matters: the box test is conservative (far
 //! distances grown by 1 + 2γ₃, pbrt-v4 §6.1.2; zero direction components get a finite ±f32::MAX
-//! inverse so no 0·∞ NaN can arise), every triangle is tested with the same watertight routine,
-//! and a tie in t between two triangles goes to the lower triangle index. The closest hit is
-//! therefore the same whatever order the leaves are visited in.
+//! inverse so no 0·∞ NaN can arise), every triangle is tested with the same watertight routine
+//! and its t settled into the triangle's box ([`super::slab::settle`]), and a tie in t between two
+//! triangles goes to the lower triangle index. The closest hit is therefore the same whatever
+//! tree is walked and whatever order the leaves are visited in.
 
 use super::bvh::{Bvh, Hit, TriangleColumns};
-use super::slab::{box_entry, inverse_direction};
-use super::triangle::intersect_triangle;
+use super::slab::{box_entry, intersect_settled, inverse_direction};
 use glam::{Vec3, Vec3A};
 
 /// No triangle.
@@ -82,11 +82,13 @@ impl Best {
             *self = Best { t, tri: id, b };
         }
     }
-    /// Tests triangle `id` and keeps it by [`Best::offer`]'s rule.
+    /// Tests triangle `id` ([`intersect_settled`], boxes padded by `pad`) and keeps it by
+    /// [`Best::offer`]'s rule.
     #[inline]
-    pub fn test(&mut self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, id: u32) {
+    pub fn test(&mut self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, inv: Vec3, pad: f32, id: u32) {
         let i = id as usize;
-        if let Some(h) = intersect_triangle(o, d, self.limit(), tris.p0[i], tris.p1[i], tris.p2[i]) {
+        let p = [tris.p0[i], tris.p1[i], tris.p2[i]];
+        if let Some(h) = intersect_settled(o, d, inv, self.limit(), p, pad) {
             self.offer(h.t, id, h.b);
         }
     }
@@ -168,7 +170,7 @@ pub fn closest_from(
             let node = &nodes[cur as usize];
             if node.prim_count > 0 {
                 for id in node.first_index..node.first_index + node.prim_count {
-                    best.test(tris, o, d, id);
+                    best.test(tris, o, d, inv, bvh.pad(), id);
                 }
                 break;
             }
@@ -214,7 +216,7 @@ pub fn occluded_from(
             if node.prim_count > 0 {
                 for id in node.first_index..node.first_index + node.prim_count {
                     let i = id as usize;
-                    if intersect_triangle(o, d, t_max, tris.p0[i], tris.p1[i], tris.p2[i]).is_some() {
+                    if intersect_settled(o, d, inv, t_max, [tris.p0[i], tris.p1[i], tris.p2[i]], bvh.pad()).is_some() {
                         stack.clear();
                         return true;
                     }
@@ -236,7 +238,8 @@ pub fn occluded_from(
                 if g.1 && child.prim_count > 0 {
                     for id in child.first_index..child.first_index + child.prim_count {
                         let i = id as usize;
-                        if intersect_triangle(o, d, t_max, tris.p0[i], tris.p1[i], tris.p2[i]).is_some() {
+                        let p = [tris.p0[i], tris.p1[i], tris.p2[i]];
+                        if intersect_settled(o, d, inv, t_max, p, bvh.pad()).is_some() {
                             stack.clear();
                             return true;
                         }

@@ -5,12 +5,12 @@
 //!
 //! Both run [`watertight8`]: the scalar test's operations in the same order (no fused
 //! multiply-adds on either side), so every lane's decision, t and barycentrics are
-//! bit-identical to [`intersect_triangle`]'s (its scalar twin). The scalar test recomputes in
+//! bit-identical to [`super::triangle::intersect_triangle`]'s (its scalar twin). The scalar test recomputes in
 //! f64 edge functions that round to exactly zero and the sign of a t that f32 cannot prove
 //! positive; lanes where either happens are handed back for the scalar test to decide.
 
 use super::offset::gamma;
-use super::triangle::{dominant_axis, intersect_triangle, is_degenerate, TINY_T_TERM};
+use super::triangle::{dominant_axis, is_degenerate, TINY_T_TERM};
 use glam::Vec3;
 use wide::f32x8;
 
@@ -97,18 +97,21 @@ pub(super) fn bits(m: f32x8) -> u32 {
 pub struct TriBlock {
     /// Vertex columns: p0.x, p0.y, p0.z, p1.x, …, p2.z.
     pub v: [[f32; 8]; 9],
-    /// Triangle index (BVH order) of lane 0.
-    pub first: u32,
+    /// Triangle index (of the BVH-ordered columns) per lane; padding lanes repeat the last.
+    pub ids: [u32; 8],
     /// Lanes holding a triangle that can be hit (not padding, not degenerate).
     pub live: u8,
 }
 
 impl TriBlock {
-    /// Blocks for the `count` triangles from `first` of the BVH-ordered vertices `tri(id)`.
-    pub fn push_leaf(out: &mut Vec<TriBlock>, first: u32, count: u32, tri: impl Fn(u32) -> [Vec3; 3]) {
-        for start in (first..first + count).step_by(8) {
-            let mut b = TriBlock { v: [[0.0; 8]; 9], first: start, live: 0 };
-            for (l, id) in (start..(start + 8).min(first + count)).enumerate() {
+    /// Blocks for the triangles `ids` (indices of the BVH-ordered vertices `tri(id)`), eight to
+    /// a block.
+    pub fn push_leaf(out: &mut Vec<TriBlock>, ids: &[u32], tri: impl Fn(u32) -> [Vec3; 3]) {
+        for chunk in ids.chunks(8) {
+            let last = chunk[chunk.len() - 1];
+            let mut b = TriBlock { v: [[0.0; 8]; 9], ids: [last; 8], live: 0 };
+            for (l, &id) in chunk.iter().enumerate() {
+                b.ids[l] = id;
                 let p = tri(id);
                 for (k, v) in p.iter().enumerate() {
                     for a in 0..3 {
@@ -133,7 +136,7 @@ impl TriBlock {
 }
 
 /// One ray prepared for [`intersect_block`]: its axis permutation (z = the direction's largest
-/// axis, as [`intersect_triangle`] chooses it) and shear, splatted.
+/// axis, as [`super::triangle::intersect_triangle`] chooses it) and shear, splatted.
 #[derive(Clone, Copy, Debug)]
 pub struct ShearedRay {
     /// Source axes of the permuted x, y, z.
@@ -187,12 +190,4 @@ pub fn intersect_block(r: &ShearedRay, block: &TriBlock, t_max: f32) -> (u32, u3
     let (x1, y1, z1) = vertex(1);
     let (x2, y2, z2) = vertex(2);
     watertight8([x0, x1, x2], [y0, y1, y2], [z0, z1, z2], r.sz, f32x8::splat(t_max), u32::from(block.live))
-}
-
-/// Scalar twin of [`intersect_block`] for lane `l`.
-#[inline]
-#[must_use]
-pub fn intersect_lane(r: &ShearedRay, block: &TriBlock, l: usize, t_max: f32) -> Option<super::triangle::TriangleHit> {
-    let [p0, p1, p2] = block.triangle(l);
-    intersect_triangle(r.origin, r.dir, t_max, p0, p1, p2)
 }

@@ -1,14 +1,15 @@
-//! The 8-wide BVH: obvhs's BVH2 collapsed into nodes of up to eight children, whose boxes one
-//! ray tests at once (`wide::f32x8`, one child per lane) — Embree's layout for incoherent rays
-//! (Wald et al. 2008, "Getting rid of packets"; Benthin et al. 2012). Reads the BVH2 nodes;
-//! writes [`Node8`]s with the six box planes of the children as SoA columns.
+//! The 8-wide BVH: a BVH2 ([`super::sah`]'s, over the scene's padded triangle boxes) collapsed
+//! into nodes of up to eight children, whose boxes one ray tests at once (`wide::f32x8`, one
+//! child per lane) — Embree's layout for incoherent rays (Wald et al. 2008, "Getting rid of
+//! packets"; Benthin et al. 2012). Reads the BVH2 nodes; writes [`Node8`]s with the six box
+//! planes of the children as SoA columns, and the leaves' triangles in [`TriBlock`]s.
 //!
 //! Collapse: [`super::wide_collapse`] chooses, by the surface area heuristic over the whole
 //! tree, which inner BVH2 nodes become 8-wide nodes and which dissolve into their parent's
-//! slots; this module builds that shape. BVH2 leaves (≤ 8 triangles from obvhs's build) stay
-//! leaves with their boxes, so every traversal prunes by the BVH2's leaf boxes (what that does
-//! and does not guarantee: [`super::wide_collapse`]).
-//! Triangle indices are unchanged, so leaves address the same BVH-ordered columns as the BVH2.
+//! slots; this module builds that shape. BVH2 leaves (≤ 8 triangles) stay leaves with their
+//! boxes. Each block lane keeps its triangle's index in the BVH-ordered columns the packets'
+//! tree also addresses, so a tie in t goes to the same triangle whichever tree is walked, and
+//! [`WideRay::settle`] makes the rest of every hit tree-independent ([`super::slab::settle`]).
 //! Against the greedy collapse it replaced (the inner child of largest area opened until eight),
 //! the bunny's tree has a third fewer nodes (4 887 → 3 289, 4.3 → 5.8 children each) and bounce
 //! rays visit 7.4 nodes instead of 7.7 (BENCHMARKS.md, issue 18, eleventh part).
@@ -19,7 +20,7 @@
 //! is monotonic in b, rounding included, and never NaN (finite origins, boxes and inverses).
 //! [`Node8::entries_scalar`] is the scalar twin, calling [`box_entry`] per child.
 
-use super::slab::{box_entry, FAR_GROWTH};
+use super::slab::{box_entry, slab8, FAR_GROWTH};
 use super::triangle8::TriBlock;
 use super::wide_collapse::Layout;
 use glam::{Vec3, Vec3A};
@@ -125,6 +126,23 @@ impl WideRay {
             far: [opposite(near[0]), opposite(near[1]), opposite(near[2])],
         }
     }
+
+    /// [`super::slab::settle`] for the eight triangles of `block` at once: `t` per lane raised
+    /// to the ray's entry into the lane's [`super::slab::triangle_box`], +∞ where it misses that
+    /// box ([`slab8`]; min and max are exact, so the order they take the vertices in does not
+    /// matter: the scalar function's values bit for bit).
+    #[inline(always)]
+    #[must_use]
+    pub fn settle(&self, t: f32x8, block: &TriBlock, pad: f32) -> f32x8 {
+        let pad = f32x8::splat(pad);
+        let col = |i: usize| f32x8::from(block.v[i]);
+        let lo = |a: usize| col(a).fast_min(col(3 + a)).fast_min(col(6 + a)) - pad;
+        let hi = |a: usize| col(a).fast_max(col(3 + a)).fast_max(col(6 + a)) + pad;
+        // Written out, not with array maps (left out of line in some builds: see `WideRay::new`).
+        let (lo, hi) = ([lo(0), lo(1), lo(2)], [hi(0), hi(1), hi(2)]);
+        let (near, far) = slab8(lo, hi, [self.ox, self.oy, self.oz], [self.ix, self.iy, self.iz]);
+        t.fast_max(near.simd_le(far).select(near, f32x8::splat(f32::INFINITY)))
+    }
 }
 
 /// The 8-wide nodes, root first (empty for a scene without triangles), and the leaves'
@@ -133,16 +151,19 @@ impl WideRay {
 pub struct Bvh8 {
     nodes: Vec<Node8>,
     blocks: Vec<TriBlock>,
+    /// The BVH2's [`super::bvh::Bvh::pad`].
+    pad: f32,
 }
 
 impl Bvh8 {
     /// Collapses the BVH2 `nodes` (root first; children of an inner node at `first_index` and
-    /// the next) whose leaves hold the triangles `tri(id)` (BVH order), in the shape
-    /// [`Layout::choose`] finds cheapest.
+    /// the next; a leaf holds `ids[first_index..][..prim_count]`, indices of the triangles
+    /// `tri(id)`), in the shape [`Layout::choose`] finds cheapest; `pad` is the
+    /// [`super::bvh::Bvh::pad`] of the triangles.
     #[must_use]
-    pub fn collapse(nodes: &[Bvh2Node], tri: impl Fn(u32) -> [Vec3; 3]) -> Self {
+    pub fn collapse(nodes: &[Bvh2Node], ids: &[u32], pad: f32, tri: impl Fn(u32) -> [Vec3; 3]) -> Self {
         if nodes.is_empty() {
-            return Bvh8::default();
+            return Bvh8 { pad, ..Bvh8::default() };
         }
         let layout = Layout::choose(nodes);
         let mut out = vec![Node8::EMPTY];
@@ -166,7 +187,8 @@ impl Bvh8 {
                     node.child[slot] = blocks.len() as u32;
                     node.count[slot] = count as u8;
                     node.leaves |= 1 << slot;
-                    TriBlock::push_leaf(&mut blocks, b.first_index, count, &tri);
+                    let first = b.first_index as usize;
+                    TriBlock::push_leaf(&mut blocks, &ids[first..first + count as usize], &tri);
                 } else {
                     node.child[slot] = out.len() as u32;
                     work.push((k, out.len()));
@@ -176,7 +198,13 @@ impl Bvh8 {
             }
             out[at] = node;
         }
-        Bvh8 { nodes: out, blocks }
+        Bvh8 { nodes: out, blocks, pad }
+    }
+
+    /// The padding of the boxes hits are settled against ([`super::slab::settle`]).
+    #[must_use]
+    pub fn pad(&self) -> f32 {
+        self.pad
     }
 
     /// The nodes, root first.
@@ -200,8 +228,49 @@ impl Bvh8 {
 
 #[cfg(test)]
 mod tests {
-    use super::super::slab::inverse_direction;
+    use super::super::slab::{inverse_direction, settle};
     use super::*;
+
+    /// The block form of `settle` returns the scalar function's t bit for bit: t below, inside
+    /// and beyond each triangle's box, boxes the ray misses, flat and needle-thin triangles,
+    /// zero direction components.
+    #[test]
+    fn settle_matches_the_scalar_twin() {
+        let tris = [
+            [Vec3::ZERO, Vec3::X, Vec3::Y],
+            [Vec3::new(0.0, 0.0, 2.0), Vec3::new(1.0, 0.0, 2.0), Vec3::new(0.0, 1.0, 2.0)],
+            [Vec3::new(-3.0, 0.0, -1.0), Vec3::new(-2.0, 0.0, 1.0), Vec3::new(-2.5, 0.0, 0.0)],
+            [Vec3::new(1.0, 1.0, 1.0), Vec3::new(4.0, 4.0, 4.0), Vec3::new(1.0, 4.0, 1.0)],
+            [Vec3::new(-0.5, -0.5, 5.0), Vec3::new(0.5, 0.5, 6.0), Vec3::new(0.5, -0.5, 5.5)],
+            [Vec3::new(0.0, 0.0, -10.0), Vec3::new(2e-7, 0.0, 10.0), Vec3::new(0.0, 2e-7, 10.0)],
+        ];
+        let mut block = TriBlock { v: [[0.0; 8]; 9], ids: [0; 8], live: 0 };
+        for (l, p) in tris.iter().enumerate() {
+            for (k, v) in p.iter().enumerate() {
+                for a in 0..3 {
+                    block.v[3 * k + a][l] = v[a];
+                }
+            }
+            block.live |= 1 << l;
+        }
+        let dirs = [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(1.0, 1.0, 1.0), Vec3::new(0.0, -1.0, 1e-30)];
+        let origins = [Vec3::ZERO, Vec3::new(0.0, 0.0, -5.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(-2.0, 0.0, 0.0)];
+        for o in origins {
+            for d in dirs {
+                let inv = inverse_direction(d);
+                let ray = WideRay::new(o, inv);
+                for pad in [0.0, 1e-5, 0.25] {
+                    for t in [1e-3f32, 0.5, 1.0, 2.0, 7.5, 100.0] {
+                        let wide = ray.settle(f32x8::splat(t), &block, pad).to_array();
+                        for (l, p) in tris.iter().enumerate() {
+                            let want = settle(t, o.into(), inv.into(), *p, pad);
+                            assert_eq!(wide[l].to_bits(), want.to_bits(), "o {o}, d {d}, pad {pad}, t {t}, lane {l}");
+                        }
+                    }
+                }
+            }
+        }
+    }
 
     /// The 8-wide child test returns the scalar twin's mask and entry distances bit for bit,
     /// for rays with zero direction components, rays on slab planes and flat boxes.

@@ -14,17 +14,11 @@
 //!   A(n) + min over k of C(left, k) + C(right, 8 − k);
 //! - C(n, j ≥ 2): the better of C(n, j − 1) and min over k of C(left, k) + C(right, j − k).
 //!
-//! BVH2 leaves stay leaves, with their own boxes. Letting small sibling leaves share one leaf
-//! (as Ylitie et al. do) ran 3–5 % faster still, but the union box prunes differently: the
-//! `edge_rays` fuzz target found a ray, 4 000 scene diagonals from two micron-sized triangles,
-//! whose entry into one leaf's box rounded past a hit tied in t with the other, so the BVH2
-//! found one triangle and the merged leaf the other. With the BVH2's leaf boxes every kernel
-//! prunes a leaf by the same box with the same arithmetic (an ancestor's box passes whenever its
-//! leaf's does: the slab test is monotonic in the planes). That keeps the kernels' hits equal in
-//! every case tests/packet.rs and the fuzz regressions hold, but it is no proof: pruning is exact
-//! only where a triangle's computed t lies inside its box, which needles and grazing rays can
-//! break, and then which leaf is pruned depends on what a kernel found first (BENCHMARKS.md,
-//! issue 18, fourteenth part: a second tree for the single rays made the kernels disagree so).
+//! BVH2 leaves stay leaves, with their own boxes. (Letting small sibling leaves share one leaf,
+//! as Ylitie et al. do, ran 3–5 % faster over obvhs's PLOC tree; it was tried before hits were
+//! settled into their triangles' boxes, when a union box could prune a hit the BVH2 found:
+//! BENCHMARKS.md, issue 18, eleventh part. The tree collapsed now is the SAH build's, whose
+//! leaves already fill their blocks.)
 
 use obvhs::bvh2::node::Bvh2Node;
 

@@ -5,11 +5,11 @@
 //! BVH-ordered triangle columns; writes hits or occlusion flags.
 //!
 //! Box and triangle tests are [`super::packet`]'s (the same conservative slab test, the same
-//! 8-wide watertight test with its scalar fallbacks, ties in t to the lower triangle index), so
-//! every lane's hit is the one every other traversal finds; tests/packet.rs checks it. Children
-//! are visited nearest first by the entry distance of the first lane that enters them. Any-hit
-//! traversal tests a node's leaf children as soon as the node is reached, before entering any
-//! inner child, as the other traversals do.
+//! 8-wide watertight test with its scalar fallbacks, the same settled t, ties in t to the lower
+//! triangle index), so every lane's hit is the one every other traversal finds; tests/packet.rs
+//! checks it. Children are visited nearest first by the entry distance of the first lane that
+//! enters them. Any-hit traversal tests a node's leaf children as soon as the node is reached,
+//! before entering any inner child, as the other traversals do.
 //!
 //! Hand-over (Embree's hybrid traversal, Benthin et al. 2012): a stack entry reached by at most
 //! [`THIN_LANES`] active lanes is finished by each of those lanes alone, with the 8-wide single
@@ -42,11 +42,12 @@ impl Default for Entry {
     }
 }
 
-/// The triangles of a leaf child: `count` from its first block's first triangle.
+/// The triangles of a leaf child: `count` of them, from its first block on.
 #[inline(always)]
-fn leaf_ids(bvh: &Bvh8, first_block: u32, count: u32) -> std::ops::Range<u32> {
-    let first = bvh.blocks()[first_block as usize].first;
-    first..first + count
+fn leaf_ids(bvh: &Bvh8, first_block: u32, count: u32) -> impl Iterator<Item = u32> + '_ {
+    let first = first_block as usize;
+    let blocks = &bvh.blocks()[first..first + count.div_ceil(8) as usize];
+    blocks.iter().flat_map(|b| b.ids).take(count as usize)
 }
 
 /// The children of `node` that lanes of `mask` enter within `t`, nearest first: their keys (the
@@ -127,7 +128,7 @@ fn closest8(
             continue;
         }
         if e.count > 0 {
-            closest_leaf(&p, tris, leaf_ids(bvh, e.child, e.count), mask, &mut best, &mut limit);
+            closest_leaf(&p, tris, leaf_ids(bvh, e.child, e.count), mask, bvh.pad(), &mut best, &mut limit);
             t_best = best_ts(&best);
             continue;
         }
@@ -187,7 +188,7 @@ fn occluded8(
             continue;
         }
         if e.count > 0 {
-            blocked |= any_leaf(&p, tris, leaf_ids(bvh, e.child, e.count), mask, t_max, &t_arr);
+            blocked |= any_leaf(&p, tris, leaf_ids(bvh, e.child, e.count), mask, bvh.pad(), t_max, &t_arr);
             if blocked & p.valid == p.valid {
                 break;
             }
@@ -200,8 +201,15 @@ fn occluded8(
             let s = (key & 0xff) as usize;
             let open = lanes[s] & !blocked;
             if node.count[s] > 0 && open != 0 {
-                blocked |=
-                    any_leaf(&p, tris, leaf_ids(bvh, node.child[s], u32::from(node.count[s])), open, t_max, &t_arr);
+                blocked |= any_leaf(
+                    &p,
+                    tris,
+                    leaf_ids(bvh, node.child[s], u32::from(node.count[s])),
+                    open,
+                    bvh.pad(),
+                    t_max,
+                    &t_arr,
+                );
                 if blocked & p.valid == p.valid {
                     break 'walk;
                 }

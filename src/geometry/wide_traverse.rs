@@ -5,9 +5,11 @@
 //!
 //! The kernel is generic over the child test: `SIMD = true` runs [`Node8::entries`], `false` its
 //! scalar twin [`Node8::entries_scalar`]; everything else is shared. Both make the decisions of
-//! [`super::traverse`] (conservative box test, the same watertight triangle test, ties in t to
-//! the lower triangle index), so the closest hit is the same triangle, t and barycentrics as
-//! every other traversal's, whatever order the leaves are met in; tests/packet.rs checks it.
+//! [`super::traverse`] (conservative box test, the same watertight triangle test, every hit's t
+//! settled into its triangle's box by [`super::slab::settle`]'s operations, ties in t to the
+//! lower triangle index), so the closest hit is the same triangle, t and barycentrics as every
+//! other traversal's, whatever tree is walked and whatever order the leaves are met in;
+//! tests/packet.rs checks it.
 //!
 //! Any-hit traversal tests a node's leaf children as soon as the node is reached, before
 //! entering any inner child (as the BVH2 traversals do: a leaf is cheap and often ends the ray).
@@ -20,9 +22,9 @@
 //! 18 %: BENCHMARKS.md, issue 18, twelfth part).
 
 use super::bvh::Hit;
-use super::slab::inverse_direction;
+use super::slab::{intersect_settled, inverse_direction};
 use super::traverse::{Best, RayQuery, Stack};
-use super::triangle8::{intersect_block, intersect_lane, ShearedRay, TriBlock};
+use super::triangle8::{intersect_block, ShearedRay, TriBlock};
 use super::wide::{Bvh8, Node8, WideRay, WIDTH};
 use glam::Vec3;
 use wide::f32x8;
@@ -61,21 +63,24 @@ fn leaf(bvh: &Bvh8, first: u32, count: u32) -> &[TriBlock] {
     &bvh.blocks()[first..first + count.div_ceil(8) as usize]
 }
 
-/// Tests the leaf's triangles, keeping the closest hit by [`Best::offer`]'s rule. Each block is
-/// tested against the limit as it stood before it; a lane hit after an earlier lane of the same
-/// block has lowered the limit is decided again by the scalar test, so every triangle is
-/// decided exactly as the scalar traversal, testing them one by one, would decide it (a miss
-/// under a limit stays a miss under a lower one).
+/// Tests the leaf's triangles, keeping the closest hit by [`Best::offer`]'s rule, each hit's t
+/// [`super::slab::settle`]d into its triangle's box. Each block is tested against the limit as it stood
+/// before it; a lane hit after an earlier lane of the same block has lowered the limit is decided
+/// again by the scalar test, so every triangle is decided exactly as the scalar traversal,
+/// testing them one by one, would decide it (a miss under a limit stays a miss under a lower one).
 #[inline]
-fn closest_leaf(blocks: &[TriBlock], r: &ShearedRay, best: &mut Best) -> u64 {
+fn closest_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, best: &mut Best) -> u64 {
+    let r = &ray.sheared;
     let mut scalar = 0;
     for b in blocks {
         let limit = best.limit();
         let (hit, fallback, t, bary) = intersect_block(r, b, limit);
-        let mut todo = hit | fallback;
-        if todo == 0 {
+        if hit | fallback == 0 {
             continue;
         }
+        let t = ray.wide.settle(t, b, pad);
+        let hit = hit & t.simd_lt(f32x8::splat(limit)).to_bitmask();
+        let mut todo = hit | fallback;
         // Written out, not `bary.map(..)`: array maps on the single ray's path were left out of
         // line in some builds, depending on how the compiler split the crate into codegen units
         // (one in `WideRay::new`, a call per ray, made every single-ray bench row 7–26 % slower:
@@ -84,12 +89,12 @@ fn closest_leaf(blocks: &[TriBlock], r: &ShearedRay, best: &mut Best) -> u64 {
         while todo != 0 {
             let l = todo.trailing_zeros() as usize;
             todo &= todo - 1;
-            let id = b.first + l as u32;
+            let id = b.ids[l];
             if hit >> l & 1 == 1 && best.limit().to_bits() == limit.to_bits() {
                 best.offer(t[l], id, [bary[0][l], bary[1][l], bary[2][l]]);
             } else {
                 scalar += 1;
-                if let Some(h) = intersect_lane(r, b, l, best.limit()) {
+                if let Some(h) = intersect_settled(r.origin, r.dir, ray.inv, best.limit(), b.triangle(l), pad) {
                     best.offer(h.t, id, h.b);
                 }
             }
@@ -98,19 +103,20 @@ fn closest_leaf(blocks: &[TriBlock], r: &ShearedRay, best: &mut Best) -> u64 {
     scalar
 }
 
-/// Whether any triangle of the leaf is hit within (0, t_max).
+/// Whether any triangle of the leaf is hit within (0, t_max), its t [`super::slab::settle`]d.
 #[inline]
-fn any_leaf(blocks: &[TriBlock], r: &ShearedRay, t_max: f32, scalar: &mut u64) -> bool {
+fn any_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, t_max: f32, scalar: &mut u64) -> bool {
+    let r = &ray.sheared;
     blocks.iter().any(|b| {
-        let (hit, mut fallback, _, _) = intersect_block(r, b, t_max);
-        if hit != 0 {
+        let (hit, mut fallback, t, _) = intersect_block(r, b, t_max);
+        if hit != 0 && hit & ray.wide.settle(t, b, pad).simd_lt(f32x8::splat(t_max)).to_bitmask() != 0 {
             return true;
         }
         *scalar += u64::from(fallback.count_ones());
         while fallback != 0 {
             let l = fallback.trailing_zeros() as usize;
             fallback &= fallback - 1;
-            if intersect_lane(r, b, l, t_max).is_some() {
+            if intersect_settled(r.origin, r.dir, ray.inv, t_max, b.triangle(l), pad).is_some() {
                 return true;
             }
         }
@@ -238,7 +244,7 @@ pub(super) fn closest_walk<const SIMD: bool, const COUNT: bool>(
     stack: &mut Stack<Entry>,
     visits: &mut Visits,
 ) {
-    let Prepared { o, inv, wide: r, sheared } = prepared;
+    let Prepared { o, inv, wide: r, .. } = prepared;
     let (o, inv) = (*o, *inv);
     let nodes = bvh.nodes();
     stack.clear();
@@ -256,7 +262,7 @@ pub(super) fn closest_walk<const SIMD: bool, const COUNT: bool>(
             if COUNT {
                 visits.leaf(blocks);
             }
-            let scalar = closest_leaf(blocks, sheared, best);
+            let scalar = closest_leaf(blocks, prepared, bvh.pad(), best);
             if COUNT {
                 visits.scalar += scalar;
             }
@@ -326,7 +332,7 @@ pub(super) fn any_walk<const SIMD: bool, const COUNT: bool>(
     stack: &mut Stack<Entry>,
     visits: &mut Visits,
 ) -> bool {
-    let Prepared { o, inv, wide: r, sheared } = prepared;
+    let Prepared { o, inv, wide: r, .. } = prepared;
     let (o, inv) = (*o, *inv);
     let nodes = bvh.nodes();
     let leaf_hit = |first: u32, count: u32, visits: &mut Visits| {
@@ -334,7 +340,7 @@ pub(super) fn any_walk<const SIMD: bool, const COUNT: bool>(
         if COUNT {
             visits.leaf(blocks);
         }
-        any_leaf(blocks, sheared, t_max, &mut visits.scalar)
+        any_leaf(blocks, prepared, bvh.pad(), t_max, &mut visits.scalar)
     };
     stack.clear();
     // The nearest entered inner child is visited next without a trip through the stack.
