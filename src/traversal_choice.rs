@@ -2,16 +2,15 @@
 //!
 //! The SIMD traversal has two kernels that find the same hits: packets of 8 rays through the
 //! PLOC BVH2 ([`crate::geometry::packet`]) and single rays through the 8-wide BVH collapsed from
-//! a second, SAH-built tree ([`crate::geometry::wide_traverse`]). Which is faster depends on the scene and the queue,
-//! not on the triangle count alone (BENCHMARKS.md, "Packets or single rays, chosen per queue by
-//! timing"): packets win on camera rays everywhere and on the shadow rays of the bundled boxes;
-//! single rays on photon rays in every scene measured (1.3–2.2× in the trials) and on the
-//! final-gather rays of the bundled Cornell boxes (1.19–1.35×, the packets' coherence sort
-//! included). So each queue times both
-//! kernels on its first chunks and keeps the faster for the rest of the render (every later pass
-//! included). Hits are identical either way, whatever tree each walks (every hit's t is settled
-//! into its triangle's box: [`crate::geometry::slab::settle`]), so the choice changes speed
-//! only, never an image.
+//! a second, SAH-built tree ([`crate::geometry::wide_traverse`]). Which is faster depends on the
+//! scene and the queue, not on the triangle count alone (BENCHMARKS.md, "Packets or single
+//! rays, chosen per queue by timing"): packets win on camera rays everywhere and on the shadow
+//! rays of the bundled boxes; single rays on photon rays in every scene measured (1.3–2.2× in the
+//! trials) and on the final-gather rays of the bundled Cornell boxes (1.19–1.35×, the packets'
+//! coherence sort included). So each queue times both kernels on its first chunks and keeps the
+//! faster for the rest of the render (every later pass included). Hits are identical either
+//! way, whatever tree each walks (every hit's t is settled into its triangle's box:
+//! [`crate::geometry::slab::settle`]), so the choice changes speed only, never an image.
 //! Reads chunk timings; writes the choice per queue.
 
 use crate::code_path::CodePath;

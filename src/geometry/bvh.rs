@@ -47,11 +47,12 @@ impl Bvh {
     /// per-triangle columns by it so that leaf indices address them directly.
     #[must_use]
     pub fn build(p0: &[Vec3], p1: &[Vec3], p2: &[Vec3]) -> (Bvh, Vec<u32>) {
-        let boxes = padded_boxes(p0, p1, p2);
+        let pad = shared_pad(p0, p1, p2);
+        let boxes = padded_boxes(p0, p1, p2, pad);
         let mut build_time = std::time::Duration::ZERO;
         let bvh = obvhs::bvh2::builder::build_bvh2(&boxes, BvhBuildParams::medium_build(), &mut build_time);
         let order = bvh.primitive_indices.clone();
-        (Bvh { bvh, wide: std::sync::OnceLock::new(), pad: shared_pad(p0, p1, p2) }, order)
+        (Bvh { bvh, wide: std::sync::OnceLock::new(), pad }, order)
     }
 
     /// The padding every triangle's box shares ([`shared_pad`]): the margin of the box a hit's
@@ -73,7 +74,7 @@ impl Bvh {
     #[must_use]
     pub fn wide(&self, tris: TriangleColumns<'_>) -> &Bvh8 {
         self.wide.get_or_init(|| {
-            let sah = super::sah::build(&padded_boxes(tris.p0, tris.p1, tris.p2));
+            let sah = super::sah::build(&padded_boxes(tris.p0, tris.p1, tris.p2, self.pad));
             Bvh8::collapse(&sah.nodes, &sah.primitive_indices, self.pad, |id| {
                 let i = id as usize;
                 [tris.p0[i], tris.p1[i], tris.p2[i]]
@@ -152,11 +153,10 @@ pub fn shared_pad(p0: &[Vec3], p1: &[Vec3], p2: &[Vec3]) -> f32 {
     diag * BOX_PAD
 }
 
-/// Triangle boxes padded as [`Bvh::build`] pads them (module notes): by [`shared_pad`] plus a
-/// few ulps of their own magnitude.
+/// Triangle boxes padded as [`Bvh::build`] pads them (module notes): by `shared`, the triangles'
+/// [`shared_pad`], plus a few ulps of their own magnitude.
 #[must_use]
-pub fn padded_boxes(p0: &[Vec3], p1: &[Vec3], p2: &[Vec3]) -> Vec<Aabb> {
-    let shared = shared_pad(p0, p1, p2);
+pub fn padded_boxes(p0: &[Vec3], p1: &[Vec3], p2: &[Vec3], shared: f32) -> Vec<Aabb> {
     (0..p0.len())
         .map(|i| {
             let mn = p0[i].min(p1[i]).min(p2[i]);
@@ -178,7 +178,7 @@ impl CwBaseline {
     /// Builds over BVH-ordered columns (so primitive indices address them directly).
     #[must_use]
     pub fn build(tris: TriangleColumns<'_>) -> Self {
-        let boxes = padded_boxes(tris.p0, tris.p1, tris.p2);
+        let boxes = padded_boxes(tris.p0, tris.p1, tris.p2, shared_pad(tris.p0, tris.p1, tris.p2));
         let mut t = std::time::Duration::ZERO;
         CwBaseline { bvh: obvhs::cwbvh::builder::build_cwbvh(&boxes, BvhBuildParams::medium_build(), &mut t) }
     }

@@ -123,11 +123,17 @@ impl Packet {
     /// [`Self::entry`] for the box `lo`–`hi`.
     #[inline(always)]
     pub(super) fn entry_box(&self, lo: [f32; 3], hi: [f32; 3], t_max: f32x8) -> f32x8 {
-        // Written out, not with array maps (left out of line in some builds: see `WideRay::new`).
-        let splat = |v: [f32; 3]| [f32x8::splat(v[0]), f32x8::splat(v[1]), f32x8::splat(v[2])];
-        let (near, far) = slab8(splat(lo), splat(hi), [self.ox, self.oy, self.oz], [self.ix, self.iy, self.iz]);
+        let (near, far) = self.slab(lo, hi);
         let hit = near.simd_le(far) & near.simd_le(t_max);
         hit.select(near, f32x8::splat(f32::NAN))
+    }
+
+    /// Every lane's near and far distances for the box `lo`–`hi` ([`slab8`]).
+    #[inline(always)]
+    fn slab(&self, lo: [f32; 3], hi: [f32; 3]) -> (f32x8, f32x8) {
+        // Written out, not with array maps (left out of line in some builds: see `WideRay::new`).
+        let splat = |v: [f32; 3]| [f32x8::splat(v[0]), f32x8::splat(v[1]), f32x8::splat(v[2])];
+        slab8(splat(lo), splat(hi), [self.ox, self.oy, self.oz], [self.ix, self.iy, self.iz])
     }
 
     /// [`super::slab::settle`] for the eight rays at once: each lane's `t` raised to its entry
@@ -136,9 +142,7 @@ impl Packet {
     #[inline(always)]
     fn settle(&self, t: f32x8, v: [Vec3; 3], pad: f32) -> f32x8 {
         let (lo, hi) = triangle_box(v, pad);
-        let splat = |v: glam::Vec3A| [f32x8::splat(v.x), f32x8::splat(v.y), f32x8::splat(v.z)];
-        let (lo, hi) = (splat(lo), splat(hi));
-        let (near, far) = slab8(lo, hi, [self.ox, self.oy, self.oz], [self.ix, self.iy, self.iz]);
+        let (near, far) = self.slab(lo.into(), hi.into());
         t.fast_max(near.simd_le(far).select(near, f32x8::splat(f32::INFINITY)))
     }
 }
@@ -212,7 +216,8 @@ pub(super) fn closest_leaf(
         if hit | fallback == 0 {
             continue;
         }
-        let t = p.settle(t, v, pad);
+        // Only lanes that hit have a t to settle (fallback lanes are decided by the scalar test).
+        let t = if hit == 0 { t } else { p.settle(t, v, pad) };
         let mut hit = hit & bits(t.simd_lt(*limit));
         let (t, b) = (t.to_array(), b.map(f32x8::to_array));
         while hit != 0 {

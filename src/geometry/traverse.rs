@@ -4,9 +4,9 @@
 //! Both traversals make the same decisions where it matters: the box test is conservative (far
 //! distances grown by 1 + 2γ₃, pbrt-v4 §6.1.2; zero direction components get a finite ±f32::MAX
 //! inverse so no 0·∞ NaN can arise), every triangle is tested with the same watertight routine
-//! and its t settled into the triangle's box ([`super::slab::settle`]), and a tie in t between two
-//! triangles goes to the lower triangle index. The closest hit is therefore the same whatever
-//! tree is walked and whatever order the leaves are visited in.
+//! and its t settled into the triangle's box ([`super::slab::settle`]), and a tie in t between
+//! two triangles goes to the lower triangle index. The closest hit is therefore the same
+//! whatever tree is walked and whatever order the leaves are visited in.
 
 use super::bvh::{Bvh, Hit, TriangleColumns};
 use super::slab::{box_entry, intersect_settled, inverse_direction};
@@ -157,7 +157,7 @@ pub fn closest_from(
     best: &mut Best,
     stack: &mut Stack<(u32, f32)>,
 ) {
-    let nodes = bvh.nodes();
+    let (nodes, pad) = (bvh.nodes(), bvh.pad());
     let (oa, inva) = (Vec3A::from(o), Vec3A::from(inv));
     stack.push((start, start_t));
     while let Some((n, tn)) = stack.pop() {
@@ -170,7 +170,7 @@ pub fn closest_from(
             let node = &nodes[cur as usize];
             if node.prim_count > 0 {
                 for id in node.first_index..node.first_index + node.prim_count {
-                    best.test(tris, o, d, inv, bvh.pad(), id);
+                    best.test(tris, o, d, inv, pad, id);
                 }
                 break;
             }
@@ -206,7 +206,7 @@ pub fn occluded_from(
     t_max: f32,
     stack: &mut Stack<u32>,
 ) -> bool {
-    let nodes = bvh.nodes();
+    let (nodes, pad) = (bvh.nodes(), bvh.pad());
     let (oa, inva) = (Vec3A::from(o), Vec3A::from(inv));
     stack.push(start);
     while let Some(n) = stack.pop() {
@@ -216,7 +216,7 @@ pub fn occluded_from(
             if node.prim_count > 0 {
                 for id in node.first_index..node.first_index + node.prim_count {
                     let i = id as usize;
-                    if intersect_settled(o, d, inv, t_max, [tris.p0[i], tris.p1[i], tris.p2[i]], bvh.pad()).is_some() {
+                    if intersect_settled(o, d, inv, t_max, [tris.p0[i], tris.p1[i], tris.p2[i]], pad).is_some() {
                         stack.clear();
                         return true;
                     }
@@ -239,7 +239,7 @@ pub fn occluded_from(
                     for id in child.first_index..child.first_index + child.prim_count {
                         let i = id as usize;
                         let p = [tris.p0[i], tris.p1[i], tris.p2[i]];
-                        if intersect_settled(o, d, inv, t_max, p, bvh.pad()).is_some() {
+                        if intersect_settled(o, d, inv, t_max, p, pad).is_some() {
                             stack.clear();
                             return true;
                         }

@@ -5,9 +5,10 @@
 //!
 //! Both run [`watertight8`]: the scalar test's operations in the same order (no fused
 //! multiply-adds on either side), so every lane's decision, t and barycentrics are
-//! bit-identical to [`super::triangle::intersect_triangle`]'s (its scalar twin). The scalar test recomputes in
-//! f64 edge functions that round to exactly zero and the sign of a t that f32 cannot prove
-//! positive; lanes where either happens are handed back for the scalar test to decide.
+//! bit-identical to [`super::triangle::intersect_triangle`]'s (its scalar twin). The scalar test
+//! recomputes in f64 edge functions that round to exactly zero and the sign of a t that f32
+//! cannot prove positive; lanes where either happens are handed back for the scalar test to
+//! decide.
 
 use super::offset::gamma;
 use super::triangle::{dominant_axis, is_degenerate, TINY_T_TERM};

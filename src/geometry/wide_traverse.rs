@@ -64,10 +64,11 @@ fn leaf(bvh: &Bvh8, first: u32, count: u32) -> &[TriBlock] {
 }
 
 /// Tests the leaf's triangles, keeping the closest hit by [`Best::offer`]'s rule, each hit's t
-/// [`super::slab::settle`]d into its triangle's box. Each block is tested against the limit as it stood
-/// before it; a lane hit after an earlier lane of the same block has lowered the limit is decided
-/// again by the scalar test, so every triangle is decided exactly as the scalar traversal,
-/// testing them one by one, would decide it (a miss under a limit stays a miss under a lower one).
+/// [`super::slab::settle`]d into its triangle's box. Each block is tested against the limit as
+/// it stood before it; a lane hit after an earlier lane of the same block has lowered the limit
+/// is decided again by the scalar test, so every triangle is decided exactly as the scalar
+/// traversal, testing them one by one, would decide it (a miss under a limit stays a miss under
+/// a lower one).
 #[inline]
 fn closest_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, best: &mut Best) -> u64 {
     let r = &ray.sheared;
@@ -78,7 +79,8 @@ fn closest_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, best: &mut Best) 
         if hit | fallback == 0 {
             continue;
         }
-        let t = ray.wide.settle(t, b, pad);
+        // Only lanes that hit have a t to settle (fallback lanes are decided by the scalar test).
+        let t = if hit == 0 { t } else { ray.wide.settle(t, b, pad) };
         let hit = hit & t.simd_lt(f32x8::splat(limit)).to_bitmask();
         let mut todo = hit | fallback;
         // Written out, not `bary.map(..)`: array maps on the single ray's path were left out of
