@@ -36,6 +36,9 @@ pub(super) struct Packet {
     ox: f32x8,
     oy: f32x8,
     oz: f32x8,
+    dx: f32x8,
+    dy: f32x8,
+    dz: f32x8,
     ix: f32x8,
     iy: f32x8,
     iz: f32x8,
@@ -47,38 +50,36 @@ pub(super) struct Packet {
     sx: f32x8,
     sy: f32x8,
     sz: f32x8,
-    o: [Vec3; LANES],
-    d: [Vec3; LANES],
-    inv: [Vec3; LANES],
+    /// The rays' t_max as given (0 in lanes past the slice's end).
+    pub(super) t_max: f32x8,
     /// Lanes holding a valid ray.
     pub(super) valid: u32,
 }
 
 impl Packet {
-    /// Loads up to 8 rays. Inverse directions, the watertight test's axis choice and its shear
-    /// are computed 8-wide with the scalar code's operations (IEEE division, the same
-    /// comparisons), so every lane's values equal the scalar ones bit for bit.
+    /// Loads up to 8 rays. Validity ([`RayQuery::is_valid`]), inverse directions, the
+    /// watertight test's axis choice and its shear are computed 8-wide with the scalar code's
+    /// operations (IEEE division, the same comparisons), so every lane's values equal the scalar
+    /// ones bit for bit. Lanes without a valid ray hold a stand-in (origin 0, direction +x).
     pub(super) fn load(rays: &[RayQuery]) -> Self {
-        let mut o = [Vec3::ZERO; LANES];
-        let mut d = [Vec3::X; LANES];
-        let mut valid = 0u32;
-        for (l, r) in rays.iter().enumerate().take(LANES) {
-            if r.is_valid() {
-                o[l] = r.origin;
-                d[l] = r.direction;
-                valid |= 1 << l;
-            }
+        // Lanes past the slice's end read zeros: a zero direction and t_max, so not valid.
+        let mut c = [[0.0f32; LANES]; 7];
+        for (l, r) in rays.iter().take(LANES).enumerate() {
+            (c[0][l], c[1][l], c[2][l]) = (r.origin.x, r.origin.y, r.origin.z);
+            (c[3][l], c[4][l], c[5][l], c[6][l]) = (r.direction.x, r.direction.y, r.direction.z, r.t_max);
         }
-        let col = |f: &dyn Fn(usize) -> f32| f32x8::from(std::array::from_fn::<f32, LANES, _>(f));
-        let (ox, oy, oz) = (col(&|l| o[l].x), col(&|l| o[l].y), col(&|l| o[l].z));
-        let (dx, dy, dz) = (col(&|l| d[l].x), col(&|l| d[l].y), col(&|l| d[l].z));
+        let (ox, oy, oz) = (f32x8::from(c[0]), f32x8::from(c[1]), f32x8::from(c[2]));
+        let (dx, dy, dz, t_max) = (f32x8::from(c[3]), f32x8::from(c[4]), f32x8::from(c[5]), f32x8::from(c[6]));
+        let zero = f32x8::ZERO;
+        let finite = ox.is_finite() & oy.is_finite() & oz.is_finite() & dx.is_finite() & dy.is_finite();
+        let valid =
+            finite & dz.is_finite() & (dx.simd_ne(zero) | dy.simd_ne(zero) | dz.simd_ne(zero)) & t_max.simd_gt(zero);
+        let (ox, oy, oz) = (valid.select(ox, zero), valid.select(oy, zero), valid.select(oz, zero));
+        let (dx, dy, dz) = (valid.select(dx, f32x8::ONE), valid.select(dy, zero), valid.select(dz, zero));
         // traverse::safe_inverse: 1/d, or ±f32::MAX (the sign of d) where that is not finite.
-        let safe_inverse = |v: f32x8| {
-            let i = f32x8::ONE / v;
-            let max = f32x8::splat(f32::MAX) | (v & f32x8::splat(-0.0));
-            i.is_finite().select(i, max)
-        };
-        let (ix, iy, iz) = (safe_inverse(dx), safe_inverse(dy), safe_inverse(dz));
+        let (rx, ry, rz) = (f32x8::ONE / dx, f32x8::ONE / dy, f32x8::ONE / dz);
+        let safe = |i: f32x8, v: f32x8| i.is_finite().select(i, f32x8::splat(f32::MAX) | (v & f32x8::splat(-0.0)));
+        let (ix, iy, iz) = (safe(rx, dx), safe(ry, dy), safe(rz, dz));
         // triangle::dominant_axis: x if |x| > |y| and |x| > |z|; y if not the former and
         // |y| > |z|; z otherwise.
         let (ax, ay, az) = (dx.abs(), dy.abs(), dz.abs());
@@ -90,25 +91,27 @@ impl Packet {
         let px = kz2.select(dx, kz0.select(dy, dz));
         let py = kz2.select(dy, kz0.select(dz, dx));
         let pz = kz2.select(dz, kz0.select(dx, dy));
-        let (sx, sy, sz) = (-px / pz, -py / pz, f32x8::ONE / pz);
-        let (ixa, iya, iza) = (ix.to_array(), iy.to_array(), iz.to_array());
-        Packet {
-            ox,
-            oy,
-            oz,
-            ix,
-            iy,
-            iz,
-            kz2,
-            kz0,
-            sx,
-            sy,
-            sz,
-            o,
-            d,
-            inv: std::array::from_fn(|l| Vec3::new(ixa[l], iya[l], iza[l])),
-            valid,
-        }
+        // 1/d'z is the permuted axis's reciprocal, taken before the safe inverse's substitution.
+        let (sx, sy, sz) = (-px / pz, -py / pz, kz2.select(rz, kz0.select(rx, ry)));
+        Packet { ox, oy, oz, dx, dy, dz, ix, iy, iz, kz2, kz0, sx, sy, sz, t_max, valid: bits(valid) }
+    }
+
+    /// Lane `l`'s origin (for the scalar tests that finish its fallbacks and hand-overs).
+    #[inline]
+    pub(super) fn origin(&self, l: usize) -> Vec3 {
+        Vec3::new(self.ox.as_array()[l], self.oy.as_array()[l], self.oz.as_array()[l])
+    }
+
+    /// Lane `l`'s direction.
+    #[inline]
+    pub(super) fn dir(&self, l: usize) -> Vec3 {
+        Vec3::new(self.dx.as_array()[l], self.dy.as_array()[l], self.dz.as_array()[l])
+    }
+
+    /// Lane `l`'s inverse direction ([`super::slab::inverse_direction`]'s values).
+    #[inline]
+    pub(super) fn inv(&self, l: usize) -> Vec3 {
+        Vec3::new(self.ix.as_array()[l], self.iy.as_array()[l], self.iz.as_array()[l])
     }
 
     /// Entry distances into `node`'s box per lane, NaN where a lane misses or enters beyond its
@@ -228,7 +231,7 @@ pub(super) fn closest_leaf(
         while fallback != 0 {
             let l = fallback.trailing_zeros() as usize;
             fallback &= fallback - 1;
-            best[l].test(tris, p.o[l], p.d[l], p.inv[l], pad, id);
+            best[l].test(tris, p.origin(l), p.dir(l), p.inv(l), pad, id);
         }
         *limit = limits(best);
     }
@@ -266,7 +269,7 @@ fn closest8(
             while mask != 0 {
                 let l = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                closest_from(bvh, tris, n, tn[l], p.o[l], p.d[l], p.inv[l], &mut best[l], single);
+                closest_from(bvh, tris, n, tn[l], p.origin(l), p.dir(l), p.inv(l), &mut best[l], single);
             }
             t_best = best_ts(&best);
             limit = limits(&best);
@@ -325,7 +328,7 @@ pub(super) fn any_leaf(
         while fallback != 0 {
             let l = fallback.trailing_zeros() as usize;
             fallback &= fallback - 1;
-            if intersect_settled(p.o[l], p.d[l], p.inv[l], t_arr[l], v, pad).is_some() {
+            if intersect_settled(p.origin(l), p.dir(l), p.inv(l), t_arr[l], v, pad).is_some() {
                 blocked |= 1 << l;
             }
         }
@@ -345,7 +348,7 @@ fn occluded8(
     let (stack, single) = (&mut stacks.0, &mut stacks.1);
     let nodes = bvh.nodes();
     let p = Packet::load(rays);
-    let t_max = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| rays.get(l).map_or(0.0, |r| r.t_max)));
+    let t_max = p.t_max;
     let t_arr = t_max.to_array();
     let mut blocked = 0u32;
     if !nodes.is_empty() && p.valid != 0 {
@@ -362,7 +365,7 @@ fn occluded8(
             while mask != 0 {
                 let l = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                if occluded_from(bvh, tris, n, p.o[l], p.d[l], p.inv[l], t_arr[l], single) {
+                if occluded_from(bvh, tris, n, p.origin(l), p.dir(l), p.inv(l), t_arr[l], single) {
                     blocked |= 1 << l;
                 }
             }
@@ -457,6 +460,46 @@ pub fn occluded_packets_thin(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQu
 mod tests {
     use super::super::slab::{box_entry, inverse_direction};
     use super::*;
+
+    /// `load` computes 8-wide what the scalar traversal computes per ray, bit for bit: which
+    /// rays are valid ([`RayQuery::is_valid`]: NaN and infinite origins or directions, zero
+    /// directions of either sign, t_max of 0, below 0 or NaN), and for valid ones the origin,
+    /// direction, inverse direction (subnormal and zero components included) and the watertight
+    /// test's shear; lanes past a short slice are not valid.
+    #[test]
+    fn load_matches_the_scalar_ray() {
+        use super::super::triangle::{dominant_axis, permute};
+        let (nan, inf, tiny) = (f32::NAN, f32::INFINITY, 1e-40f32);
+        let rays = [
+            RayQuery::new(Vec3::new(1.0, -2.0, 3.0), Vec3::new(0.3, -0.5, 0.8), 10.0),
+            RayQuery::new(Vec3::new(nan, 0.0, 0.0), Vec3::X, 1.0),
+            RayQuery::new(Vec3::ZERO, Vec3::new(0.0, inf, 0.0), 1.0),
+            RayQuery::new(Vec3::ZERO, Vec3::new(-0.0, 0.0, -0.0), 1.0),
+            RayQuery::new(Vec3::ONE, Vec3::new(tiny, -0.0, 0.0), f32::INFINITY),
+            RayQuery::new(Vec3::ONE, Vec3::new(0.0, -1.0, 1.0), 0.0),
+            RayQuery::new(Vec3::ONE, Vec3::new(-2.0, 1.0, 0.5), nan),
+            RayQuery::new(Vec3::new(-1e30, 5.0, 0.0), Vec3::new(-0.2, 0.1, -0.3), -1.0),
+            RayQuery::new(Vec3::new(0.5, 0.25, -8.0), Vec3::new(0.0, 0.0, -1.0), 2.0),
+            RayQuery::new(Vec3::new(7.0, 0.0, 1.0), Vec3::new(0.1, 0.9, -0.1), 2.0),
+        ];
+        for slice in [&rays[..8], &rays[2..], &rays[4..7]] {
+            let p = Packet::load(slice);
+            let (sx, sy, sz) = (p.sx.to_array(), p.sy.to_array(), p.sz.to_array());
+            for l in 0..LANES {
+                let r = slice.get(l).filter(|r| r.is_valid());
+                assert_eq!(p.valid >> l & 1 == 1, r.is_some(), "lane {l}");
+                let Some(r) = r else { continue };
+                let (o, d) = (r.origin, r.direction);
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                assert_eq!(bits(p.origin(l)), bits(o), "lane {l}");
+                assert_eq!(bits(p.dir(l)), bits(d), "lane {l}");
+                assert_eq!(bits(p.inv(l)), bits(inverse_direction(d)), "lane {l}");
+                let q = permute(d, dominant_axis(d));
+                let want = [-q.x / q.z, -q.y / q.z, 1.0 / q.z].map(f32::to_bits);
+                assert_eq!([sx[l], sy[l], sz[l]].map(f32::to_bits), want, "lane {l}");
+            }
+        }
+    }
 
     #[test]
     fn packet_entry_matches_scalar_box_entry() {

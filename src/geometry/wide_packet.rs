@@ -7,9 +7,10 @@
 //! Box and triangle tests are [`super::packet`]'s (the same conservative slab test, the same
 //! 8-wide watertight test with its scalar fallbacks, the same settled t, ties in t to the lower
 //! triangle index), so every lane's hit is the one every other traversal finds; tests/packet.rs
-//! checks it. Children are visited nearest first by the entry distance of the first lane that
-//! enters them. Any-hit traversal tests a node's leaf children as soon as the node is reached,
-//! before entering any inner child, as the other traversals do.
+//! checks it. Closest-hit traversal visits children nearest first by the entry distance of the
+//! first lane that enters them. Any-hit traversal tests a node's leaf children as soon as the
+//! node is reached, before entering any inner child, as the other traversals do, and takes
+//! children in slot order, unsorted, as the single ray's does (any occluder ends a lane).
 //!
 //! Hand-over (Embree's hybrid traversal, Benthin et al. 2012): a stack entry reached by at most
 //! [`THIN_LANES`] active lanes is finished by each of those lanes alone, with the 8-wide single
@@ -22,7 +23,7 @@ use super::packet::{any_leaf, best_ts, closest_leaf, limits, Packet, LANES};
 use super::traverse::{Best, RayQuery, Stack};
 use super::triangle8::bits;
 use super::wide::{Bvh8, Node8, WIDTH};
-use super::wide_traverse::{any_walk, closest_walk, Entry as SingleEntry, Prepared, Visits};
+use super::wide_traverse::{any_walk, closest_walk, sort_keys, Entry as SingleEntry, Prepared, Visits};
 use wide::f32x8;
 
 /// A child waiting on the stack: node index or first block of a leaf, its triangle count (0 for
@@ -50,12 +51,17 @@ fn leaf_ids(bvh: &Bvh8, first_block: u32, count: u32) -> impl Iterator<Item = u3
     blocks.iter().flat_map(|b| b.ids).take(count as usize)
 }
 
-/// The children of `node` that lanes of `mask` enter within `t`, nearest first: their keys (the
-/// entry distance of the first lane that enters, as bits above the slot; distances are ≥ 0 and
-/// never NaN there, so bits order as values do; the smallest over the lanes measured no better)
-/// and number; and per slot the entry distances and entering lanes.
+/// The children of `node` that lanes of `mask` enter within `t`: their keys (the entry distance of
+/// the first lane that enters, as bits above the slot; distances are ≥ 0 and never NaN there, so
+/// bits order as values do; the smallest over the lanes measured no better) and number, nearest
+/// first when `SORT` (else in slot order); and per slot the entry distances and entering lanes.
 #[inline(always)]
-fn entered(p: &Packet, node: &Node8, t: f32x8, mask: u32) -> ([u64; WIDTH], usize, [f32x8; WIDTH], [u32; WIDTH]) {
+fn entered<const SORT: bool>(
+    p: &Packet,
+    node: &Node8,
+    t: f32x8,
+    mask: u32,
+) -> ([u64; WIDTH], usize, [f32x8; WIDTH], [u32; WIDTH]) {
     let (mut keys, mut n) = ([0u64; WIDTH], 0);
     let (mut ts, mut lanes) = ([f32x8::ZERO; WIDTH], [0u32; WIDTH]);
     let pl = &node.planes;
@@ -74,7 +80,9 @@ fn entered(p: &Packet, node: &Node8, t: f32x8, mask: u32) -> ([u64; WIDTH], usiz
         n += 1;
         (ts[s], lanes[s]) = (te, m);
     }
-    keys[..n].sort_unstable();
+    if SORT {
+        sort_keys(&mut keys, n);
+    }
     (keys, n, ts, lanes)
 }
 
@@ -133,7 +141,7 @@ fn closest8(
             continue;
         }
         let node = &nodes[e.child as usize];
-        let (keys, n, ts, lanes) = entered(&p, node, t_best, mask);
+        let (keys, n, ts, lanes) = entered::<true>(&p, node, t_best, mask);
         // Farthest pushed first, so the nearest is popped first.
         for &key in keys[..n].iter().rev() {
             let s = (key & 0xff) as usize;
@@ -158,7 +166,7 @@ fn occluded8(
     let mut prepared: [Option<Prepared>; LANES] = Default::default();
     let nodes = bvh.nodes();
     let p = Packet::load(rays);
-    let t_max = f32x8::from(std::array::from_fn::<f32, LANES, _>(|l| rays.get(l).map_or(0.0, |r| r.t_max)));
+    let t_max = p.t_max;
     let t_arr = t_max.to_array();
     let mut blocked = 0u32;
     stack.clear();
@@ -195,8 +203,8 @@ fn occluded8(
             continue;
         }
         let node = &nodes[e.child as usize];
-        let (keys, n, ts, lanes) = entered(&p, node, t_max, mask);
-        // Leaf children at once, nearest first; then the inner children, nearest on top.
+        // Leaf children at once, then the inner children, the first slot on top.
+        let (keys, n, ts, lanes) = entered::<false>(&p, node, t_max, mask);
         for &key in &keys[..n] {
             let s = (key & 0xff) as usize;
             let open = lanes[s] & !blocked;

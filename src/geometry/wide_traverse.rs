@@ -151,14 +151,20 @@ fn sorted(mut mask: u32, t: f32x8) -> ([u64; WIDTH], usize) {
         keys[n] = u64::from(t[i].to_bits()) << 32 | i as u64;
         n += 1;
     }
-    // Two or three keys (the usual counts) by a network of min and max, without a branch on
-    // their order (the insertion sort's compares go either way with the ray: BENCHMARKS.md,
-    // issue 18, tenth part); more by insertion sort (at most eight keys). Keys are distinct:
-    // each holds its slot.
+    sort_keys(&mut keys, n);
+    (keys, n)
+}
+
+/// Sorts the first `n` of `keys` (distinct: each holds its slot) ascending. Two or three keys
+/// (the usual counts) by a network of min and max, without a branch on their order (the
+/// insertion sort's compares go either way with the ray: BENCHMARKS.md, issue 18, tenth part);
+/// more by insertion sort (at most eight keys).
+#[inline(always)]
+pub(super) fn sort_keys(keys: &mut [u64; WIDTH], n: usize) {
     if n == 2 {
         let (a, b) = (keys[0], keys[1]);
         (keys[0], keys[1]) = (a.min(b), a.max(b));
-        return (keys, n);
+        return;
     }
     if n == 3 {
         let (a, b, c) = (keys[0], keys[1], keys[2]);
@@ -166,7 +172,7 @@ fn sorted(mut mask: u32, t: f32x8) -> ([u64; WIDTH], usize) {
         let (b, c) = (b.min(c), b.max(c));
         let (a, b) = (a.min(b), a.max(b));
         (keys[0], keys[1], keys[2]) = (a, b, c);
-        return (keys, n);
+        return;
     }
     for j in 1..n {
         let k = keys[j];
@@ -177,7 +183,6 @@ fn sorted(mut mask: u32, t: f32x8) -> ([u64; WIDTH], usize) {
         }
         keys[m] = k;
     }
-    (keys, n)
 }
 
 /// One ray as both tests want it: origin, inverse direction, splatted for the child test and
