@@ -76,7 +76,7 @@ impl Packet {
             finite & dz.is_finite() & (dx.simd_ne(zero) | dy.simd_ne(zero) | dz.simd_ne(zero)) & t_max.simd_gt(zero);
         let (ox, oy, oz) = (valid.select(ox, zero), valid.select(oy, zero), valid.select(oz, zero));
         let (dx, dy, dz) = (valid.select(dx, f32x8::ONE), valid.select(dy, zero), valid.select(dz, zero));
-        // traverse::safe_inverse: 1/d, or ±f32::MAX (the sign of d) where that is not finite.
+        // slab::safe_inverse: 1/d, or ±f32::MAX (the sign of d) where that is not finite.
         let (rx, ry, rz) = (f32x8::ONE / dx, f32x8::ONE / dy, f32x8::ONE / dz);
         let safe = |i: f32x8, v: f32x8| i.is_finite().select(i, f32x8::splat(f32::MAX) | (v & f32x8::splat(-0.0)));
         let (ix, iy, iz) = (safe(rx, dx), safe(ry, dy), safe(rz, dz));
@@ -249,7 +249,8 @@ fn closest8(
     let (stack, single) = (&mut stacks.0, &mut stacks.1);
     let nodes = bvh.nodes();
     let p = Packet::load(rays);
-    let mut best: [Best; LANES] = std::array::from_fn(|l| Best::new(rays.get(l).map_or(0.0, |r| r.t_max)));
+    let t_max = p.t_max.to_array();
+    let mut best: [Best; LANES] = std::array::from_fn(|l| Best::new(t_max[l]));
     let mut t_best = best_ts(&best);
     let mut limit = limits(&best);
     if !nodes.is_empty() && p.valid != 0 {
@@ -481,11 +482,18 @@ mod tests {
             RayQuery::new(Vec3::new(-1e30, 5.0, 0.0), Vec3::new(-0.2, 0.1, -0.3), -1.0),
             RayQuery::new(Vec3::new(0.5, 0.25, -8.0), Vec3::new(0.0, 0.0, -1.0), 2.0),
             RayQuery::new(Vec3::new(7.0, 0.0, 1.0), Vec3::new(0.1, 0.9, -0.1), 2.0),
+            // Ties in |d| between axes (the axis choice breaks them toward z, then y).
+            RayQuery::new(Vec3::ZERO, Vec3::new(1.0, -1.0, 0.5), 3.0),
+            RayQuery::new(Vec3::ZERO, Vec3::new(-1.0, 1.0, 1.0), 3.0),
+            RayQuery::new(Vec3::ZERO, Vec3::new(0.5, 2.0, -2.0), 3.0),
         ];
-        for slice in [&rays[..8], &rays[2..], &rays[4..7]] {
+        for slice in [&rays[..8], &rays[2..10], &rays[5..], &rays[4..7]] {
             let p = Packet::load(slice);
             let (sx, sy, sz) = (p.sx.to_array(), p.sy.to_array(), p.sz.to_array());
             for l in 0..LANES {
+                // t_max as given in every lane, valid or not; 0 past the slice.
+                let t_max = slice.get(l).map_or(0.0, |r| r.t_max);
+                assert_eq!(p.t_max.to_array()[l].to_bits(), t_max.to_bits(), "lane {l}");
                 let r = slice.get(l).filter(|r| r.is_valid());
                 assert_eq!(p.valid >> l & 1 == 1, r.is_some(), "lane {l}");
                 let Some(r) = r else { continue };

@@ -99,7 +99,8 @@ fn closest8(
     let mut prepared: [Option<Prepared>; LANES] = Default::default();
     let nodes = bvh.nodes();
     let p = Packet::load(rays);
-    let mut best: [Best; LANES] = std::array::from_fn(|l| Best::new(rays.get(l).map_or(0.0, |r| r.t_max)));
+    let t_max = p.t_max.to_array();
+    let mut best: [Best; LANES] = std::array::from_fn(|l| Best::new(t_max[l]));
     let mut t_best = best_ts(&best);
     let mut limit = limits(&best);
     stack.clear();
