@@ -14,7 +14,7 @@
 //! lower triangle index), so hits are identical lane by lane; tests/packet.rs checks it.
 
 use super::bvh::{Bvh, Hit, TriangleColumns};
-use super::slab::{intersect_settled, slab8, triangle_box};
+use super::slab::{intersect_settled, settle8, slab8, triangle_box};
 use super::traverse::{closest_from, occluded_from, Best, RayQuery, Stack};
 use super::triangle::is_degenerate;
 use super::triangle8::{bits, watertight8};
@@ -71,9 +71,10 @@ impl Packet {
         let (ox, oy, oz) = (f32x8::from(c[0]), f32x8::from(c[1]), f32x8::from(c[2]));
         let (dx, dy, dz, t_max) = (f32x8::from(c[3]), f32x8::from(c[4]), f32x8::from(c[5]), f32x8::from(c[6]));
         let zero = f32x8::ZERO;
-        let finite = ox.is_finite() & oy.is_finite() & oz.is_finite() & dx.is_finite() & dy.is_finite();
-        let valid =
-            finite & dz.is_finite() & (dx.simd_ne(zero) | dy.simd_ne(zero) | dz.simd_ne(zero)) & t_max.simd_gt(zero);
+        let finite_o = ox.is_finite() & oy.is_finite() & oz.is_finite();
+        let finite_d = dx.is_finite() & dy.is_finite() & dz.is_finite();
+        let nonzero_d = dx.simd_ne(zero) | dy.simd_ne(zero) | dz.simd_ne(zero);
+        let valid = finite_o & finite_d & nonzero_d & t_max.simd_gt(zero);
         let (ox, oy, oz) = (valid.select(ox, zero), valid.select(oy, zero), valid.select(oz, zero));
         let (dx, dy, dz) = (valid.select(dx, f32x8::ONE), valid.select(dy, zero), valid.select(dz, zero));
         // slab::safe_inverse: 1/d, or ±f32::MAX (the sign of d) where that is not finite.
@@ -134,20 +135,24 @@ impl Packet {
     /// Every lane's near and far distances for the box `lo`–`hi` ([`slab8`]).
     #[inline(always)]
     fn slab(&self, lo: [f32; 3], hi: [f32; 3]) -> (f32x8, f32x8) {
-        // Written out, not with array maps (left out of line in some builds: see `WideRay::new`).
-        let splat = |v: [f32; 3]| [f32x8::splat(v[0]), f32x8::splat(v[1]), f32x8::splat(v[2])];
         slab8(splat(lo), splat(hi), [self.ox, self.oy, self.oz], [self.ix, self.iy, self.iz])
     }
 
     /// [`super::slab::settle`] for the eight rays at once: each lane's `t` raised to its entry
-    /// into the triangle's box, +∞ where it misses that box ([`slab8`]: the scalar function's
+    /// into the triangle's box, +∞ where it misses that box ([`settle8`]: the scalar function's
     /// values bit for bit).
     #[inline(always)]
     fn settle(&self, t: f32x8, v: [Vec3; 3], pad: f32) -> f32x8 {
         let (lo, hi) = triangle_box(v, pad);
-        let (near, far) = self.slab(lo.into(), hi.into());
-        t.fast_max(near.simd_le(far).select(near, f32x8::splat(f32::INFINITY)))
+        settle8(t, splat(lo.into()), splat(hi.into()), [self.ox, self.oy, self.oz], [self.ix, self.iy, self.iz])
     }
+}
+
+/// A point's coordinates splatted across the lanes. Written out, not with array maps (left out
+/// of line in some builds: see `WideRay::new`).
+#[inline(always)]
+fn splat(v: [f32; 3]) -> [f32x8; 3] {
+    [f32x8::splat(v[0]), f32x8::splat(v[1]), f32x8::splat(v[2])]
 }
 
 /// The watertight ray/triangle test of [`super::triangle::intersect_triangle`] for 8 rays

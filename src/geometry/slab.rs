@@ -58,6 +58,16 @@ pub fn slab8(lo: [f32x8; 3], hi: [f32x8; 3], o: [f32x8; 3], inv: [f32x8; 3]) -> 
     (near, fx.fast_min(fy).fast_min(fz) * f32x8::splat(FAR_GROWTH))
 }
 
+/// [`settle`] for eight (ray, box) pairs at once, with [`slab8`]'s arguments: each lane's `t`
+/// raised to its ray's entry into its box, +∞ where the ray misses the box; the scalar
+/// function's values bit for bit.
+#[inline(always)]
+#[must_use]
+pub fn settle8(t: f32x8, lo: [f32x8; 3], hi: [f32x8; 3], o: [f32x8; 3], inv: [f32x8; 3]) -> f32x8 {
+    let (near, far) = slab8(lo, hi, o, inv);
+    t.fast_max(near.simd_le(far).select(near, f32x8::splat(f32::INFINITY)))
+}
+
 /// Inverse direction with finite components.
 #[inline]
 #[must_use]

@@ -20,7 +20,7 @@
 //! is monotonic in b, rounding included, and never NaN (finite origins, boxes and inverses).
 //! [`Node8::entries_scalar`] is the scalar twin, calling [`box_entry`] per child.
 
-use super::slab::{box_entry, slab8, FAR_GROWTH};
+use super::slab::{box_entry, settle8, FAR_GROWTH};
 use super::triangle8::TriBlock;
 use super::wide_collapse::Layout;
 use glam::{Vec3, Vec3A};
@@ -129,7 +129,7 @@ impl WideRay {
 
     /// [`super::slab::settle`] for the eight triangles of `block` at once: `t` per lane raised
     /// to the ray's entry into the lane's [`super::slab::triangle_box`], +∞ where it misses that
-    /// box ([`slab8`]; min and max are exact, so the order they take the vertices in does not
+    /// box ([`settle8`]; min and max are exact, so the order they take the vertices in does not
     /// matter: the scalar function's values bit for bit).
     #[inline(always)]
     #[must_use]
@@ -140,8 +140,7 @@ impl WideRay {
         let hi = |a: usize| col(a).fast_max(col(3 + a)).fast_max(col(6 + a)) + pad;
         // Written out, not with array maps (left out of line in some builds: see `WideRay::new`).
         let (lo, hi) = ([lo(0), lo(1), lo(2)], [hi(0), hi(1), hi(2)]);
-        let (near, far) = slab8(lo, hi, [self.ox, self.oy, self.oz], [self.ix, self.iy, self.iz]);
-        t.fast_max(near.simd_le(far).select(near, f32x8::splat(f32::INFINITY)))
+        settle8(t, lo, hi, [self.ox, self.oy, self.oz], [self.ix, self.iy, self.iz])
     }
 }
 
