@@ -72,7 +72,9 @@ pub fn settle8(t: f32x8, lo: [f32x8; 3], hi: [f32x8; 3], o: [f32x8; 3], inv: [f3
 #[inline]
 #[must_use]
 pub fn inverse_direction(d: Vec3) -> Vec3 {
-    Vec3::new(safe_inverse(d.x), safe_inverse(d.y), safe_inverse(d.z))
+    // [`safe_inverse`] per component, as one select instead of a branch each.
+    let i = Vec3::ONE / d;
+    Vec3::select(i.is_finite_mask(), i, Vec3::splat(f32::MAX).copysign(d))
 }
 
 /// The box a hit on the triangle `p` must lie in: its vertices' box grown by `pad` on every
@@ -134,5 +136,24 @@ mod tests {
         assert!(intersect_settled(beside, d, inv, f32::INFINITY, p, pad).is_none());
         let h = intersect_settled(o, d, inv, f32::INFINITY, p, pad).unwrap();
         assert!((h.t - 2.25).abs() < 1e-6, "{h:?}");
+    }
+
+    /// The vector select gives [`safe_inverse`] per component, bit for bit: zeros of both signs
+    /// and subnormals (whose reciprocal overflows) get ±f32::MAX, everything else 1/d.
+    #[test]
+    fn inverse_direction_is_the_safe_inverse_per_component() {
+        let values = [0.0, -0.0, 1e-45, -1e-45, 1e-39, -3e-39, 0.5, -2.0, 3.0e38, -1.0e-30];
+        for &x in &values {
+            for &y in &values {
+                for &z in &values {
+                    let inv = inverse_direction(Vec3::new(x, y, z)).to_array();
+                    for (got, d) in inv.iter().zip([x, y, z]) {
+                        assert_eq!(got.to_bits(), safe_inverse(d).to_bits(), "d = ({x}, {y}, {z})");
+                    }
+                }
+            }
+        }
+        assert_eq!(safe_inverse(-0.0), -f32::MAX);
+        assert_eq!(safe_inverse(1e-45), f32::MAX);
     }
 }

@@ -36,7 +36,10 @@ impl RayQuery {
     #[inline]
     #[must_use]
     pub fn is_valid(&self) -> bool {
-        self.origin.is_finite() && self.direction.is_finite() && self.direction != Vec3::ZERO && self.t_max > 0.0
+        // Evaluated whole, without short-circuits: a branch per term cost the single ray more
+        // than the terms (BENCHMARKS.md, issue 18, seventeenth part).
+        let (o, d) = (self.origin, self.direction);
+        (o.is_finite_mask() & d.is_finite_mask()).all() & d.cmpne(Vec3::ZERO).any() & (self.t_max > 0.0)
     }
 }
 
@@ -355,5 +358,32 @@ impl Bvh {
     #[must_use]
     pub fn occluded(&self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32) -> bool {
         occluded(self, tris, &RayQuery::new(o, d, t_max))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A ray is traced only with a finite origin, a finite direction with some non-zero
+    /// component (−0 counts as zero) and t_max > 0 (NaN is not).
+    #[test]
+    fn is_valid_needs_finite_rays_a_direction_and_a_positive_range() {
+        let ray = |o: Vec3, d: Vec3, t: f32| RayQuery::new(o, d, t).is_valid();
+        let (o, d) = (Vec3::new(1.0, -2.0, 3.0), Vec3::new(0.0, -0.0, 1e-45));
+        assert!(ray(o, d, 1.0) && ray(o, d, f32::INFINITY));
+        assert!(!ray(o, Vec3::new(0.0, -0.0, 0.0), 1.0));
+        assert!(!ray(o, Vec3::ZERO, 1.0));
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            for axis in 0..3 {
+                let mut v = Vec3::ONE;
+                v[axis] = bad;
+                assert!(!ray(v, d, 1.0), "origin {v}");
+                assert!(!ray(o, v, 1.0), "direction {v}");
+            }
+        }
+        for t in [0.0, -0.0, -1.0, f32::NAN] {
+            assert!(!ray(o, d, t), "t_max {t}");
+        }
     }
 }

@@ -131,8 +131,10 @@ impl TriBlock {
     #[inline]
     #[must_use]
     pub fn triangle(&self, l: usize) -> [Vec3; 3] {
-        let v = &self.v;
-        [0, 1, 2].map(|k| Vec3::new(v[3 * k][l], v[3 * k + 1][l], v[3 * k + 2][l]))
+        // Written out, not `[0, 1, 2].map(..)`: the map was left out of line wherever the
+        // traversals inlined this fallback.
+        let vertex = |k: usize| Vec3::new(self.v[3 * k][l], self.v[3 * k + 1][l], self.v[3 * k + 2][l]);
+        [vertex(0), vertex(1), vertex(2)]
     }
 }
 
@@ -158,13 +160,16 @@ impl ShearedRay {
     #[inline]
     #[must_use]
     pub fn new(o: Vec3, d: Vec3) -> Self {
+        // Arrays, not glam's `Vec3` indexing (a match on the index: branches the ray decides).
+        const NEXT: [usize; 3] = [1, 2, 0];
         let kz = dominant_axis(d);
-        let kx = (kz + 1) % 3;
-        let ky = (kx + 1) % 3;
-        let (dx, dy, dz) = (d[kx], d[ky], d[kz]);
+        let kx = NEXT[kz];
+        let ky = NEXT[kx];
+        let (oa, da) = (o.to_array(), d.to_array());
+        let (dx, dy, dz) = (da[kx], da[ky], da[kz]);
         ShearedRay {
             axes: [kx, ky, kz],
-            o: [f32x8::splat(o[kx]), f32x8::splat(o[ky]), f32x8::splat(o[kz])],
+            o: [f32x8::splat(oa[kx]), f32x8::splat(oa[ky]), f32x8::splat(oa[kz])],
             sx: f32x8::splat(-dx / dz),
             sy: f32x8::splat(-dy / dz),
             sz: f32x8::splat(1.0 / dz),

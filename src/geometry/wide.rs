@@ -14,13 +14,16 @@
 //! the bunny's tree has a third fewer nodes (4 887 → 3 289, 4.3 → 5.8 children each) and bounce
 //! rays visit 7.4 nodes instead of 7.7 (BENCHMARKS.md, issue 18, eleventh part).
 //!
-//! The box test is [`box_entry`]'s, lane by lane: the same conservative slab test (far
-//! distance grown by 1 + 2γ₃), the same operations in the same order. Taking the near plane by
-//! the sign of the inverse direction instead of min(t0, t1) gives the same values: (b − o)·inv
-//! is monotonic in b, rounding included, and never NaN (finite origins, boxes and inverses).
-//! [`Node8::entries_scalar`] is the scalar twin, calling [`box_entry`] per child.
+//! The box test is [`box_entry`]'s, lane by lane ([`slab8`]): the same conservative slab test
+//! (far distance grown by 1 + 2γ₃), the same operations in the same order. Both planes of each
+//! axis are computed and ordered by min and max, rather than the near plane chosen by the sign
+//! of the inverse direction: the values are the same ((b − o)·inv is monotonic in b, rounding
+//! included, and never NaN), and three min/max per node cost less than reading six plane
+//! indices back from the stack, where the compiler had spilled them (single-ray rows up to 13 %
+//! faster: BENCHMARKS.md, issue 18, seventeenth part). [`Node8::entries_scalar`] is the scalar
+//! twin, calling [`box_entry`] per child.
 
-use super::slab::{box_entry, settle8, FAR_GROWTH};
+use super::slab::{box_entry, settle8, slab8};
 use super::triangle8::TriBlock;
 use super::wide_collapse::Layout;
 use glam::{Vec3, Vec3A};
@@ -64,11 +67,8 @@ impl Node8 {
     pub fn entries(&self, r: &WideRay, t_max: f32) -> (u32, f32x8) {
         let p = &self.planes;
         let plane = |k: usize| f32x8::from(p[k]);
-        let slab = |k: usize, o: f32x8, inv: f32x8| (plane(k) - o) * inv;
-        let (nx, ny, nz) = (slab(r.near[0], r.ox, r.ix), slab(r.near[1], r.oy, r.iy), slab(r.near[2], r.oz, r.iz));
-        let (fx, fy, fz) = (slab(r.far[0], r.ox, r.ix), slab(r.far[1], r.oy, r.iy), slab(r.far[2], r.oz, r.iz));
-        let t_near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
-        let t_far = fx.fast_min(fy).fast_min(fz) * f32x8::splat(FAR_GROWTH);
+        let (lo, hi) = ([plane(0), plane(1), plane(2)], [plane(3), plane(4), plane(5)]);
+        let (t_near, t_far) = slab8(lo, hi, [r.ox, r.oy, r.oz], [r.ix, r.iy, r.iz]);
         let hit = t_near.simd_le(t_far) & t_near.simd_le(f32x8::splat(t_max));
         (hit.to_bitmask() & u32::from(self.valid), t_near)
     }
@@ -91,8 +91,7 @@ impl Node8 {
     }
 }
 
-/// One ray splatted across the lanes for [`Node8::entries`], with the plane of each axis it
-/// enters first (the min plane where the inverse direction is ≥ 0, else the max plane).
+/// One ray splatted across the lanes for [`Node8::entries`]: origin and inverse direction.
 #[derive(Clone, Copy, Debug)]
 pub struct WideRay {
     ox: f32x8,
@@ -101,8 +100,6 @@ pub struct WideRay {
     ix: f32x8,
     iy: f32x8,
     iz: f32x8,
-    near: [usize; 3],
-    far: [usize; 3],
 }
 
 impl WideRay {
@@ -110,11 +107,6 @@ impl WideRay {
     #[inline]
     #[must_use]
     pub fn new(o: Vec3, inv: Vec3) -> Self {
-        // Written out, not with array maps: one build left this map out of line, a call per ray
-        // that made every single-ray bench row 7–26 % slower (BENCHMARKS.md, issue 18, eighth part).
-        let side = |a: usize| if inv[a] >= 0.0 { a } else { a + 3 };
-        let near = [side(0), side(1), side(2)];
-        let opposite = |k: usize| if k < 3 { k + 3 } else { k - 3 };
         WideRay {
             ox: f32x8::splat(o.x),
             oy: f32x8::splat(o.y),
@@ -122,8 +114,6 @@ impl WideRay {
             ix: f32x8::splat(inv.x),
             iy: f32x8::splat(inv.y),
             iz: f32x8::splat(inv.z),
-            near,
-            far: [opposite(near[0]), opposite(near[1]), opposite(near[2])],
         }
     }
 

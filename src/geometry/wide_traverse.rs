@@ -69,7 +69,7 @@ fn leaf(bvh: &Bvh8, first: u32, count: u32) -> &[TriBlock] {
 /// is decided again by the scalar test, so every triangle is decided exactly as the scalar
 /// traversal, testing them one by one, would decide it (a miss under a limit stays a miss under
 /// a lower one).
-#[inline]
+#[inline(always)]
 fn closest_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, best: &mut Best) -> u64 {
     let r = &ray.sheared;
     let mut scalar = 0;
@@ -106,7 +106,7 @@ fn closest_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, best: &mut Best) 
 }
 
 /// Whether any triangle of the leaf is hit within (0, t_max), its t [`super::slab::settle`]d.
-#[inline]
+#[inline(always)]
 fn any_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, t_max: f32, scalar: &mut u64) -> bool {
     let r = &ray.sheared;
     blocks.iter().any(|b| {
