@@ -19,7 +19,8 @@
 //! the hit mask's bits, leaf children (a per-node bit mask) first. Closest-hit traversal goes
 //! straight to the only child it enters, without keys or a sort, and builds sorted keys only
 //! when two or more are entered (any hit 6–34 % faster on the bench's rows, closest hit up to
-//! 18 %: BENCHMARKS.md, issue 18, twelfth part).
+//! 18 %: BENCHMARKS.md, issue 18, twelfth part); two are ordered by the min and max of their
+//! two keys, without the key array and its loop (issue 18, seventeenth part).
 
 use super::bvh::Hit;
 use super::slab::{intersect_settled, inverse_direction};
@@ -280,8 +281,18 @@ pub(super) fn closest_walk<const SIMD: bool, const COUNT: bool>(
             let node = &nodes[c as usize];
             let (mask, t) = enter::<SIMD>(node, r, o, inv, best.t);
             if mask != 0 {
-                let i = if mask & (mask - 1) == 0 {
+                let rest = mask & (mask - 1);
+                let i = if rest == 0 {
                     mask.trailing_zeros() as usize
+                } else if rest & (rest - 1) == 0 {
+                    // Two children (the usual case): their two keys ordered by min and max,
+                    // without a branch on their order, the array of keys or a loop.
+                    let t = t.as_array();
+                    let key = |i: usize| u64::from(t[i].to_bits()) << 32 | i as u64;
+                    let (a, b) = (key(mask.trailing_zeros() as usize), key(rest.trailing_zeros() as usize));
+                    let (far, tf) = unkey(a.max(b));
+                    stack.push((node.child[far], u32::from(node.count[far]), tf));
+                    unkey(a.min(b)).0
                 } else {
                     let (keys, n) = sorted(mask, t);
                     for &key in keys[1..n].iter().rev() {
