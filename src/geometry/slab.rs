@@ -1,8 +1,8 @@
 //! The conservative slab test of a ray against a box, shared by every traversal: entry
 //! distance with the far distance grown by 1 + 2γ₃ (pbrt-v4 §6.1.2), and inverse directions
-//! that stay finite (zero components get ±f32::MAX, so no 0·∞ NaN can arise); and the rule that
-//! keeps every hit's t within its triangle's box ([`settle`]). Reads a ray and a box; writes an
-//! entry distance.
+//! that stay finite (zero or subnormal components get ±f32::MAX, so no 0·∞ NaN can arise); and
+//! the rule that keeps every hit's t within its triangle's box ([`settle`]). Reads a ray and a
+//! box; writes an entry distance.
 
 use super::offset::gamma;
 use super::triangle::{intersect_triangle, TriangleHit};
@@ -139,10 +139,11 @@ mod tests {
     }
 
     /// The vector select gives [`safe_inverse`] per component, bit for bit: zeros of both signs
-    /// and subnormals (whose reciprocal overflows) get ±f32::MAX, everything else 1/d.
+    /// and subnormals (whose reciprocal overflows) get ±f32::MAX, everything else 1/d (±0 for
+    /// infinities; NaN, which no valid ray has, ±f32::MAX by its sign bit).
     #[test]
     fn inverse_direction_is_the_safe_inverse_per_component() {
-        let values = [0.0, -0.0, 1e-45, -1e-45, 1e-39, -3e-39, 0.5, -2.0, 3.0e38, -1.0e-30];
+        let values = [0.0, -0.0, 1e-45, -1e-45, 1e-39, -3e-39, 0.5, -2.0, 3.0e38, -1.0e-30, f32::INFINITY, -f32::NAN];
         for &x in &values {
             for &y in &values {
                 for &z in &values {

@@ -17,11 +17,12 @@
 //! The box test is [`box_entry`]'s, lane by lane ([`slab8`]): the same conservative slab test
 //! (far distance grown by 1 + 2γ₃), the same operations in the same order. Both planes of each
 //! axis are computed and ordered by min and max, rather than the near plane chosen by the sign
-//! of the inverse direction: the values are the same ((b − o)·inv is monotonic in b, rounding
-//! included, and never NaN), and three min/max per node cost less than reading six plane
-//! indices back from the stack, where the compiler had spilled them (single-ray rows up to 13 %
-//! faster: BENCHMARKS.md, issue 18, seventeenth part). [`Node8::entries_scalar`] is the scalar
-//! twin, calling [`box_entry`] per child.
+//! of the inverse direction: the mask and entry distances are the same ((b − o)·inv is
+//! monotonic in b, rounding included, and never NaN; boxes have min ≤ max; only a zero's sign
+//! may differ before the final max with 0), and three min/max per node cost less than reading
+//! six plane indices back from the stack, where the compiler had spilled them (single-ray rows
+//! up to 13 % faster: BENCHMARKS.md, issue 18, seventeenth part). [`Node8::entries_scalar`] is
+//! the scalar twin, calling [`box_entry`] per child.
 
 use super::slab::{box_entry, settle8, slab8};
 use super::triangle8::TriBlock;
@@ -128,7 +129,8 @@ impl WideRay {
         let col = |i: usize| f32x8::from(block.v[i]);
         let lo = |a: usize| col(a).fast_min(col(3 + a)).fast_min(col(6 + a)) - pad;
         let hi = |a: usize| col(a).fast_max(col(3 + a)).fast_max(col(6 + a)) + pad;
-        // Written out, not with array maps (left out of line in some builds: see `WideRay::new`).
+        // Written out, not with array maps (left out of line in some builds: BENCHMARKS.md,
+        // issue 18, eighth part).
         let (lo, hi) = ([lo(0), lo(1), lo(2)], [hi(0), hi(1), hi(2)]);
         settle8(t, lo, hi, [self.ox, self.oy, self.oz], [self.ix, self.iy, self.iz])
     }

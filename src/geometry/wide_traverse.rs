@@ -86,8 +86,8 @@ fn closest_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, best: &mut Best) 
         let mut todo = hit | fallback;
         // Written out, not `bary.map(..)`: array maps on the single ray's path were left out of
         // line in some builds, depending on how the compiler split the crate into codegen units
-        // (one in `WideRay::new`, a call per ray, made every single-ray bench row 7–26 % slower:
-        // BENCHMARKS.md, issue 18, eighth part).
+        // (one that was in `WideRay::new`, a call per ray, made every single-ray bench row 7–26 %
+        // slower: BENCHMARKS.md, issue 18, eighth part).
         let (t, bary) = (t.to_array(), [bary[0].to_array(), bary[1].to_array(), bary[2].to_array()]);
         while todo != 0 {
             let l = todo.trailing_zeros() as usize;
@@ -214,7 +214,8 @@ fn prepare(bvh: &Bvh8, ray: &RayQuery) -> Option<Prepared> {
     Some(Prepared::new(ray))
 }
 
-/// The slot and entry distance of a key from [`entered`].
+/// The slot and entry distance of a key (t bits << 32 | slot) from [`sorted`] or the
+/// two-children case of [`closest_walk`].
 #[inline(always)]
 fn unkey(key: u64) -> (usize, f32) {
     ((key & 0xff) as usize, f32::from_bits((key >> 32) as u32))
