@@ -149,7 +149,7 @@ impl Packet {
 }
 
 /// A point's coordinates splatted across the lanes. Written out, not with array maps (left out
-/// of line in some builds: see `WideRay::new`).
+/// of line in some builds: BENCHMARKS.md, issue 18, eighth part).
 #[inline(always)]
 fn splat(v: [f32; 3]) -> [f32x8; 3] {
     [f32x8::splat(v[0]), f32x8::splat(v[1]), f32x8::splat(v[2])]

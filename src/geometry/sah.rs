@@ -112,8 +112,10 @@ fn median(ids: &mut [u32], centres: &[Vec3A], axis: usize) -> usize {
 fn sweep(ids: &mut [u32], boxes: &[Aabb], centres: &[Vec3A], extent: Vec3A, areas: &mut [f32]) -> usize {
     let n = ids.len();
     let mut best = (f32::INFINITY, usize::MAX, n / 2);
+    let mut sorted_on = None;
     for axis in (0..3).filter(|&a| extent[a] > 0.0) {
         sort_on(ids, centres, axis);
+        sorted_on = Some(axis);
         let mut right = Aabb::empty();
         for k in (1..n).rev() {
             right = right.union(&boxes[ids[k] as usize]);
@@ -130,7 +132,10 @@ fn sweep(ids: &mut [u32], boxes: &[Aabb], centres: &[Vec3A], extent: Vec3A, area
     }
     // No finite cost (areas overflowing f32): the median of the widest axis.
     let axis = if best.1 == usize::MAX { extent.max_position() } else { best.1 };
-    sort_on(ids, centres, axis);
+    // The order (coordinate, then index) is total, so ids already sorted on it stay as they are.
+    if sorted_on != Some(axis) {
+        sort_on(ids, centres, axis);
+    }
     best.2
 }
 

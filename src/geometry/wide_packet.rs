@@ -23,7 +23,7 @@ use super::packet::{any_leaf, best_ts, closest_leaf, limits, Packet, LANES};
 use super::traverse::{Best, RayQuery, Stack};
 use super::triangle8::bits;
 use super::wide::{Bvh8, Node8, WIDTH};
-use super::wide_traverse::{any_walk, closest_walk, sort_keys, Entry as SingleEntry, Prepared, Visits};
+use super::wide_traverse::{any_walk, closest_walk, key, sort_keys, unkey, Entry as SingleEntry, Prepared, Visits};
 use wide::f32x8;
 
 /// A child waiting on the stack: node index or first block of a leaf, its triangle count (0 for
@@ -76,7 +76,7 @@ fn entered<const SORT: bool>(
             continue;
         }
         let near = te.to_array()[m.trailing_zeros() as usize];
-        keys[n] = u64::from(near.to_bits()) << 32 | s as u64;
+        keys[n] = key(near, s);
         n += 1;
         (ts[s], lanes[s]) = (te, m);
     }
@@ -144,8 +144,8 @@ fn closest8(
         let node = &nodes[e.child as usize];
         let (keys, n, ts, lanes) = entered::<true>(&p, node, t_best, mask);
         // Farthest pushed first, so the nearest is popped first.
-        for &key in keys[..n].iter().rev() {
-            let s = (key & 0xff) as usize;
+        for &k in keys[..n].iter().rev() {
+            let s = unkey(k).0;
             stack.push(Entry { child: node.child[s], count: u32::from(node.count[s]), t: ts[s], lanes: lanes[s] });
         }
     }
@@ -206,8 +206,8 @@ fn occluded8(
         let node = &nodes[e.child as usize];
         // Leaf children at once, then the inner children, the first slot on top.
         let (keys, n, ts, lanes) = entered::<false>(&p, node, t_max, mask);
-        for &key in &keys[..n] {
-            let s = (key & 0xff) as usize;
+        for &k in &keys[..n] {
+            let s = unkey(k).0;
             let open = lanes[s] & !blocked;
             if node.count[s] > 0 && open != 0 {
                 blocked |= any_leaf(
@@ -224,8 +224,8 @@ fn occluded8(
                 }
             }
         }
-        for &key in keys[..n].iter().rev() {
-            let s = (key & 0xff) as usize;
+        for &k in keys[..n].iter().rev() {
+            let s = unkey(k).0;
             if node.count[s] == 0 {
                 stack.push(Entry { child: node.child[s], count: 0, t: ts[s], lanes: lanes[s] });
             }

@@ -149,7 +149,7 @@ fn sorted(mut mask: u32, t: f32x8) -> ([u64; WIDTH], usize) {
     while mask != 0 {
         let i = mask.trailing_zeros() as usize;
         mask &= mask - 1;
-        keys[n] = u64::from(t[i].to_bits()) << 32 | i as u64;
+        keys[n] = key(t[i], i);
         n += 1;
     }
     sort_keys(&mut keys, n);
@@ -214,10 +214,16 @@ fn prepare(bvh: &Bvh8, ray: &RayQuery) -> Option<Prepared> {
     Some(Prepared::new(ray))
 }
 
-/// The slot and entry distance of a key (t bits << 32 | slot) from [`sorted`] or the
-/// two-children case of [`closest_walk`].
+/// The sort key of a child entered at `t` (≥ 0, never NaN, so the bits order as the values
+/// do) in `slot`: t's bits above the slot, so that equal distances go to the lower slot.
 #[inline(always)]
-fn unkey(key: u64) -> (usize, f32) {
+pub(super) fn key(t: f32, slot: usize) -> u64 {
+    u64::from(t.to_bits()) << 32 | slot as u64
+}
+
+/// The slot and entry distance of a [`key`].
+#[inline(always)]
+pub(super) fn unkey(key: u64) -> (usize, f32) {
     ((key & 0xff) as usize, f32::from_bits((key >> 32) as u32))
 }
 
@@ -289,8 +295,8 @@ pub(super) fn closest_walk<const SIMD: bool, const COUNT: bool>(
                     // Two children (the usual case): their two keys ordered by min and max,
                     // without a branch on their order, the array of keys or a loop.
                     let t = t.as_array();
-                    let key = |i: usize| u64::from(t[i].to_bits()) << 32 | i as u64;
-                    let (a, b) = (key(mask.trailing_zeros() as usize), key(rest.trailing_zeros() as usize));
+                    let (i, j) = (mask.trailing_zeros() as usize, rest.trailing_zeros() as usize);
+                    let (a, b) = (key(t[i], i), key(t[j], j));
                     let (far, tf) = unkey(a.max(b));
                     stack.push((node.child[far], u32::from(node.count[far]), tf));
                     unkey(a.min(b)).0
