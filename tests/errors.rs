@@ -209,6 +209,21 @@ fn the_bench_command_checks_its_input_and_prints_one_json_object() {
     // A small generated sphere, one repetition: the report's shape, not its speed.
     let v = bench_json(&["bench", "generated:sphere", "--rings", "8", "--reps", "1", "--json"]);
     assert!(v["target_cpu"].is_string() && v["threads"] == 1, "{v}");
+    // Embree, when built in, runs at the widest instruction set this build targets.
+    if cfg!(feature = "embree") {
+        let widest = if cfg!(target_feature = "avx2") {
+            "avx2"
+        } else if cfg!(target_feature = "avx") {
+            "avx"
+        } else if cfg!(target_feature = "sse4.2") {
+            "sse4.2"
+        } else {
+            "sse2"
+        };
+        assert_eq!(v["embree_isa"], widest, "{v}");
+    } else {
+        assert!(v["embree_isa"].is_null(), "{v}");
+    }
     let traversal = v["traversal"].as_array().unwrap();
     assert_eq!(traversal.len(), 6, "three ray sets × closest/any");
     for row in traversal {
@@ -260,7 +275,8 @@ fn bench_lights_a_bare_mesh_and_measures_one_half() {
         assert!(row["count"].as_u64().unwrap() > 0, "{row}");
     }
     for row in traversal {
-        for field in ["embree1_mrays", "embree_robust1_mrays", "renderer_vs_embree_robust"] {
+        for field in ["embree1_mrays", "embree_robust1_mrays", "renderer_vs_embree_robust", "embree_extra_hits_by_call"]
+        {
             assert_eq!(row[field].is_null(), !cfg!(feature = "embree"), "{field}: {row}");
         }
     }

@@ -147,6 +147,23 @@ const BUFFER_VERTEX: u32 = 1;
 const FORMAT_UINT3: u32 = 0x5003;
 const FORMAT_FLOAT3: u32 = 0x9003;
 
+/// The instruction set Embree is asked to use: the widest this build was compiled for (AVX2
+/// under `.cargo/config.toml`'s x86-64-v3), so that both sides of the comparison run the same
+/// vector width. Left to itself Embree picks the widest the CPU has, AVX-512 on an Intel Xeon,
+/// whose registers and mask instructions our `f32x8` code does not use.
+#[must_use]
+pub fn isa() -> &'static str {
+    if cfg!(target_feature = "avx2") {
+        "avx2"
+    } else if cfg!(target_feature = "avx") {
+        "avx"
+    } else if cfg!(target_feature = "sse4.2") {
+        "sse4.2"
+    } else {
+        "sse2"
+    }
+}
+
 /// A committed Embree scene holding one triangle mesh: the scene's triangles, three unshared
 /// vertices each, in the scene's order (Embree's primitive id is our triangle index).
 pub struct EmbreeScene {
@@ -161,7 +178,7 @@ unsafe impl Sync for EmbreeScene {}
 
 impl EmbreeScene {
     /// Builds Embree's BVH over `tris` at HIGH quality, in its robust (watertight) mode if
-    /// `robust`; an error names Embree's error code.
+    /// `robust`, on a device limited to [`isa`]; an error names Embree's error code.
     pub fn build(tris: TriangleColumns<'_>, robust: bool) -> Result<Self, String> {
         let n = tris.p0.len();
         if n == 0 {
@@ -171,7 +188,8 @@ impl EmbreeScene {
         // buffers Embree allocates (uninitialised) are written through raw pointers within the
         // sizes asked for, before the geometry is committed.
         unsafe {
-            let device = rtcNewDevice(std::ptr::null());
+            let config = std::ffi::CString::new(format!("isa={}", isa())).expect("no NUL in the ISA name");
+            let device = rtcNewDevice(config.as_ptr());
             if device.is_null() {
                 return Err("Embree: rtcNewDevice failed (is libembree3 usable on this CPU?)".into());
             }

@@ -181,6 +181,9 @@ pub struct Report {
     pub features: Vec<&'static str>,
     /// Worker threads every kernel ran on.
     pub threads: usize,
+    /// The instruction set Embree was limited to (`isa=` of its device config: the widest this
+    /// build targets); `null` without `--features embree`.
+    pub embree_isa: Option<&'static str>,
     /// Traversal rows.
     pub traversal: Vec<TraversalRow>,
     /// Density rows.
@@ -192,7 +195,11 @@ impl Report {
     #[must_use]
     pub fn new(threads: usize) -> Self {
         let (target_cpu, rustflags, features) = build_flags();
-        Report { target_cpu, rustflags, features, threads, traversal: vec![], density: vec![] }
+        #[cfg(feature = "embree")]
+        let embree_isa = Some(embree::isa());
+        #[cfg(not(feature = "embree"))]
+        let embree_isa = None;
+        Report { target_cpu, rustflags, features, threads, embree_isa, traversal: vec![], density: vec![] }
     }
     /// Adds one scene's rows.
     pub fn add(&mut self, rows: (Vec<TraversalRow>, Vec<DensityRow>)) {

@@ -78,6 +78,12 @@ pub struct TraversalRow {
     pub embree_robust8_mrays: Option<f64>,
     /// `renderer_mrays` ÷ the faster of robust Embree's two: the comparison at equal accuracy.
     pub renderer_vs_embree_robust: Option<f64>,
+    /// Rays each of Embree's four calls reports hit minus rays ours report hit: default mode's
+    /// single rays and packets, robust mode's single rays and packets. Embree's own calls may
+    /// differ from each other by a ray or two on edges (seen: robust `rtcIntersect1` against
+    /// `rtcIntersect8` on CornellBox-Glossy's shadow rays, one ray of 217 518), so they are
+    /// reported, not asserted.
+    pub embree_extra_hits_by_call: Option<[i64; 4]>,
 }
 
 /// A per-ray kernel as a chunk counter for [`count_hits`].
@@ -207,12 +213,11 @@ pub fn traversal(
             let (tp, ts, tw, twp) = (t[0], t[1], t[2], t[3]);
             #[cfg(feature = "embree")]
             let embree = {
-                assert_eq!(h1, h8, "{name} {label} {query}: Embree's single rays and packets disagree");
-                assert_eq!(hr1, hr8, "{name} {label} {query}: robust Embree's single rays and packets disagree");
-                Some((t[4], t[5], h1 as i64 - hp as i64, t[6], t[7]))
+                let extra = [h1, h8, hr1, hr8].map(|h| h as i64 - hp as i64);
+                Some((t[4], t[5], extra, t[6], t[7]))
             };
             #[cfg(not(feature = "embree"))]
-            let embree: Option<(f64, f64, i64, f64, f64)> = None;
+            let embree: Option<(f64, f64, [i64; 4], f64, f64)> = None;
             assert_eq!(hp, hs, "{name} {label} {query}: packet and single-ray hit counts differ");
             assert_eq!(hw, hs, "{name} {label} {query}: 8-wide and obvhs hit counts differ");
             assert_eq!(hwp, hs, "{name} {label} {query}: 8-wide packets and obvhs hit counts differ");
@@ -246,7 +251,8 @@ pub fn traversal(
                 embree1_mrays: embree.map(|e| m / e.0),
                 embree8_mrays: embree.map(|e| m / e.1),
                 ratio_vs_embree: embree.map(|e| e.0.min(e.1) / tp),
-                embree_extra_hits: embree.map(|e| e.2),
+                embree_extra_hits: embree.map(|e| e.2[0]),
+                embree_extra_hits_by_call: embree.map(|e| e.2),
                 embree_robust1_mrays: embree.map(|e| m / e.3),
                 embree_robust8_mrays: embree.map(|e| m / e.4),
                 renderer_vs_embree_robust: embree.map(|e| e.3.min(e.4) / t_renderer),

@@ -76,6 +76,8 @@ pub fn run(args: BenchArgs) -> Result<()> {
     let (cpu, flags, features) = bench::build_flags();
     if !args.json {
         eprintln!("build: target-cpu {cpu}; SIMD features {features:?}; RUSTFLAGS `{flags}`; {threads} thread(s)");
+        #[cfg(feature = "embree")]
+        eprintln!("Embree limited to isa={} (this build's widest)", bench::embree::isa());
     }
     let mut report = bench::Report::new(threads);
     let options = bench::Options {
