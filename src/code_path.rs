@@ -102,7 +102,7 @@ pub fn coherence_key(o: Vec3, d: Vec3, grid: &MortonGrid) -> u32 {
 /// Traces `rays` in coherence-key order (packets of 8 that start close together and point
 /// alike) and writes the results into `out` in the input order. The SIMD kernels' results do not
 /// depend on the order (each lane's hit is the scalar twin's), so sorting changes speed only.
-fn in_coherent_order<T: Copy + Default>(
+pub(crate) fn in_coherent_order<T: Copy + Default>(
     rays: &[RayQuery],
     bounds: (Vec3, Vec3),
     out: &mut [T],

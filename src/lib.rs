@@ -18,7 +18,7 @@
 //! - [`memory`]: the memory a render needs against what the machine has;
 //! - [`geometry`]: triangles, the BVH, single-ray and 8-wide packet traversal;
 //! - [`code_path`]: the SIMD kernels or their scalar twins, for traversal and photon lookups;
-//! - [`traversal_choice`]: packets or single rays per ray queue, chosen by timing both;
+//! - [`traversal_choice`]: the traversal kernel per ray queue, chosen by timing the candidates;
 //!
 //! **Data** — records and their own methods:
 //! - [`texture`]: image textures, bilinear lookups, sRGB decoding;

@@ -340,16 +340,17 @@ impl RenderStats {
             out += &format!("    {name:<18} {:>7} {:>11} {:>8.3} {:>12.0}\n", s.runs, s.items, s.seconds, rate);
         }
         if !self.traversal.is_empty() {
-            out += "  traversal per ray queue (chosen by timing both kernels, Mrays/s):\n";
+            out += "  traversal per ray queue (chosen by timing the kernels, Mrays/s):\n";
             for c in &self.traversal {
-                let kernel = match c.kernel {
-                    crate::traversal_choice::Kernel::Packets => "packets",
-                    crate::traversal_choice::Kernel::Single => "single rays",
-                };
-                out += &format!(
-                    "    {:<16} {kernel:<12} (packets {:.2}, single rays {:.2})\n",
-                    c.queue, c.packets_mrays, c.single_mrays
-                );
+                let speeds: Vec<String> = [
+                    ("packets", c.packets_mrays),
+                    ("single rays", c.single_mrays),
+                    ("8-wide packets", c.wide_packets_mrays),
+                ]
+                .iter()
+                .filter_map(|(name, v)| v.map(|v| format!("{name} {v:.2}")))
+                .collect();
+                out += &format!("    {:<16} {:<14} ({})\n", c.queue, c.kernel.name(), speeds.join(", "));
             }
         }
         out

@@ -358,10 +358,10 @@ fn renders_with_simd_kernels_match_renders_with_scalar_twins() {
     }
 }
 
-/// Packets and single rays find the same hits, so the per-queue choice between them changes
-/// speed only: renders with every queue on packets, every queue on single rays, and with the
-/// timed trials (on two threads, so that trials run concurrently) are
-/// identical to the bit, and the trials report a choice for each queue that ran one.
+/// Packets, single rays and 8-wide packets find the same hits, so the per-queue choice between
+/// them changes speed only: renders with every queue on each kernel, and with the timed trials
+/// (on two threads, so that trials run concurrently) are identical to the bit, and the trials
+/// report a choice for each queue that ran one, with a speed for each kernel it tried.
 #[test]
 fn the_traversal_choice_never_changes_an_image() {
     use photonwave::traversal_choice::{Kernel, TraversalChoice};
@@ -385,14 +385,19 @@ fn the_traversal_choice_never_changes_an_image() {
     };
     let (packets, _) = render(TraversalChoice::fixed(Kernel::Packets));
     let (single, _) = render(TraversalChoice::fixed(Kernel::Single));
+    let (wide_packets, _) = render(TraversalChoice::fixed(Kernel::WidePackets));
     let (chosen, stats) = render(TraversalChoice::timed());
     assert!(packets == single, "single rays changed the image");
+    assert!(packets == wide_packets, "8-wide packets changed the image");
     assert!(packets == chosen, "the trials changed the image");
     let queues: Vec<&str> = stats.traversal.iter().map(|c| c.queue.as_str()).collect();
-    for q in ["emitted", "photon", "secondary", "shadow"] {
+    for q in ["camera", "emitted", "photon", "secondary", "shadow"] {
         assert!(queues.contains(&q), "{q} not in {queues:?}");
     }
-    assert!(!queues.contains(&"camera"), "camera rays have no trial: {queues:?}");
-    let speed = |v: f64| v.is_finite() && v > 0.0;
-    assert!(stats.traversal.iter().all(|c| speed(c.packets_mrays) && speed(c.single_mrays)), "{:?}", stats.traversal);
+    let speed = |v: Option<f64>| v.is_some_and(|v| v.is_finite() && v > 0.0);
+    for c in &stats.traversal {
+        assert!(speed(c.packets_mrays) && speed(c.wide_packets_mrays), "{c:?}");
+        // Camera rays never try single rays.
+        assert_eq!(speed(c.single_mrays), c.queue != "camera", "{c:?}");
+    }
 }

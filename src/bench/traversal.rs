@@ -60,8 +60,9 @@ pub struct TraversalRow {
     /// packet ÷ the faster of Embree's two.
     pub ratio_vs_embree: Option<f64>,
     /// The kernel the renderer's per-queue choice runs on such rays
-    /// ([`crate::traversal_choice`]): packets on camera rays, otherwise the faster here of
-    /// packets and the 8-wide single ray (what its trial picks).
+    /// ([`crate::traversal_choice`]), named as its stats name them: the fastest here of BVH2
+    /// packets (`packets`), the 8-wide single ray (`single`; not tried on camera rays) and 8-wide
+    /// packets (`wide_packets`), as its trial picks.
     pub renderer_kernel: &'static str,
     /// That kernel's speed here, million rays per second.
     pub renderer_mrays: f64,
@@ -227,8 +228,15 @@ pub fn traversal(
             // Not asserted: obvhs's CWBVH traversal loses a few hits (recorded, see BENCHMARKS.md).
             let visits = count_visits(bvh.wide(tris), rays, any);
             let m = rays.len() as f64 * 1e-6;
+            // What the renderer's trial would keep: the fastest candidate, ties to the earlier
+            // (camera rays never try single rays).
+            let mut candidates = vec![("packets", tp)];
+            if label != "camera" {
+                candidates.push(("single", tw));
+            }
+            candidates.push(("wide_packets", twp));
             let (renderer_kernel, t_renderer) =
-                if label != "camera" && tw < tp { ("single", tw) } else { ("packets", tp) };
+                candidates.into_iter().reduce(|best, c| if c.1 < best.1 { c } else { best }).expect("packets");
             rows.push(TraversalRow {
                 renderer_kernel,
                 renderer_mrays: m / t_renderer,

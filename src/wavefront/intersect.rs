@@ -15,16 +15,26 @@ use std::time::Instant;
 
 /// Fills `hits` with the closest hits of `rays` (of `queue`), each chunk writing its own lanes
 /// in place (per-chunk columns appended afterwards cost `intersect_paths` ~6 % of its samples:
-/// the copy and fresh pages for every bounce).
-fn closest_hits(shared: &Shared, queue: Queue, rays: &RayColumns, hits: &mut HitColumns) {
+/// the copy and fresh pages for every bounce). `span` places the queue in its pass, for the
+/// kernel trial ([`crate::traversal_choice`]): its first lane's index and the pass's lane count
+/// (the camera queue: the wave's first sample and the image's samples).
+fn closest_hits(shared: &Shared, queue: Queue, span: (u64, u64), rays: &RayColumns, hits: &mut HitColumns) {
     let scene = &*shared.scene;
     let n = rays.len();
     par_pieces(n, CHUNK, shared.job.threads, hits.pieces(n, CHUNK), |r, piece| {
+        let at = (span.0 + r.start as u64) as f32 / span.1.max(1) as f32;
         let queries: Vec<RayQuery> =
             r.map(|i| RayQuery::new(rays.origin(i), rays.direction(i), f32::INFINITY)).collect();
         let job = &shared.job;
-        let found =
-            job.traversal.closest(queue, job.settings.code_path, scene.bvh(), scene.columns(), &queries, scene.bounds);
+        let found = job.traversal.closest(
+            queue,
+            at,
+            job.settings.code_path,
+            scene.bvh(),
+            scene.columns(),
+            &queries,
+            scene.bounds,
+        );
         piece.write(&found);
     });
 }
@@ -42,7 +52,8 @@ pub fn intersect_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut 
         (_, true) => Queue::Emitted,
         (_, false) => Queue::Photons,
     };
-    closest_hits(&shared, queue, &q.rays, &mut q.hits);
+    // Photon queues choose on their first chunks, wherever they lie.
+    closest_hits(&shared, queue, (0, 1), &q.rays, &mut q.hits);
     let n = q.len();
     work.rays += n as u64;
     stats.record("intersect_photons", n, t);
@@ -55,7 +66,11 @@ pub fn intersect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut st
     // The first bounce's queue holds the primary rays, and later ones none.
     let primary = w.paths.kind.first() == Some(&PathKind::Camera) && w.paths.depth.first() == Some(&0);
     let queue = if primary { Queue::Camera } else { Queue::Secondary };
-    closest_hits(&shared, queue, &w.paths.rays, &mut w.paths.hits);
+    // A primary queue holds the wave's samples in order: the camera trial spreads over the image.
+    let samples = u64::from(shared.job.settings.width)
+        * u64::from(shared.job.settings.height)
+        * u64::from(shared.job.settings.spp);
+    closest_hits(&shared, queue, (w.first_sample, samples), &w.paths.rays, &mut w.paths.hits);
     for k in &w.paths.kind {
         match k {
             PathKind::Camera => w.rays.camera += 1,
