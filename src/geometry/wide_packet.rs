@@ -10,7 +10,10 @@
 //! checks it. Closest-hit traversal visits children nearest first by the entry distance of the
 //! first lane that enters them. Any-hit traversal tests a node's leaf children as soon as the
 //! node is reached, before entering any inner child, as the other traversals do, and takes
-//! children in slot order, unsorted, as the single ray's does (any occluder ends a lane).
+//! children in slot order, unsorted, as the single ray's does (any occluder ends a lane); its
+//! stack holds only inner nodes and their lanes, no entry distances (Embree's occlusion walk
+//! keeps no more: 0.98–1.19× the speed of the sorted walk's key and distance arrays on the
+//! boxes, the bunny and the ogre, BENCHMARKS.md, issue 18, eighteenth part).
 //!
 //! Hand-over (Embree's hybrid traversal, Benthin et al. 2012): a stack entry reached by at most
 //! [`THIN_LANES`] active lanes is finished by each of those lanes alone, with the 8-wide single
@@ -26,9 +29,9 @@ use super::wide::{Bvh8, Node8, WIDTH};
 use super::wide_traverse::{any_walk, closest_walk, key, sort_keys, unkey, Entry as SingleEntry, Prepared, Visits};
 use wide::f32x8;
 
-/// A child waiting on the stack: node index or first block of a leaf, its triangle count (0 for
-/// a node), and per lane the entry distance (closest hit; NaN where the lane does not enter) or
-/// the lanes that enter it (any hit, in `lanes`).
+/// A child waiting on the closest-hit stack: node index or first block of a leaf, its triangle
+/// count (0 for a node), per lane the entry distance (NaN where the lane does not enter), and the
+/// lanes that enter it.
 #[derive(Clone, Copy)]
 struct Entry {
     child: u32,
@@ -51,25 +54,27 @@ fn leaf_ids(bvh: &Bvh8, first_block: u32, count: u32) -> impl Iterator<Item = u3
     blocks.iter().flat_map(|b| b.ids).take(count as usize)
 }
 
+/// Per lane, the entry distance into child `s` of `node` within `t` (NaN where the lane misses it:
+/// [`Packet::entry_box`]).
+#[inline(always)]
+fn child_entry(p: &Packet, node: &Node8, s: usize, t: f32x8) -> f32x8 {
+    let pl = &node.planes;
+    p.entry_box([pl[0][s], pl[1][s], pl[2][s]], [pl[3][s], pl[4][s], pl[5][s]], t)
+}
+
 /// The children of `node` that lanes of `mask` enter within `t`: their keys (the entry distance of
 /// the first lane that enters, as bits above the slot; distances are ≥ 0 and never NaN there, so
 /// bits order as values do; the smallest over the lanes measured no better) and number, nearest
-/// first when `SORT` (else in slot order); and per slot the entry distances and entering lanes.
+/// first; and per slot the entry distances and entering lanes.
 #[inline(always)]
-fn entered<const SORT: bool>(
-    p: &Packet,
-    node: &Node8,
-    t: f32x8,
-    mask: u32,
-) -> ([u64; WIDTH], usize, [f32x8; WIDTH], [u32; WIDTH]) {
+fn entered(p: &Packet, node: &Node8, t: f32x8, mask: u32) -> ([u64; WIDTH], usize, [f32x8; WIDTH], [u32; WIDTH]) {
     let (mut keys, mut n) = ([0u64; WIDTH], 0);
     let (mut ts, mut lanes) = ([f32x8::ZERO; WIDTH], [0u32; WIDTH]);
-    let pl = &node.planes;
     let mut valid = u32::from(node.valid);
     while valid != 0 {
         let s = valid.trailing_zeros() as usize;
         valid &= valid - 1;
-        let te = p.entry_box([pl[0][s], pl[1][s], pl[2][s]], [pl[3][s], pl[4][s], pl[5][s]], t);
+        let te = child_entry(p, node, s, t);
         let inside = te.simd_le(t);
         let m = bits(inside) & mask;
         if m == 0 {
@@ -80,9 +85,7 @@ fn entered<const SORT: bool>(
         n += 1;
         (ts[s], lanes[s]) = (te, m);
     }
-    if SORT {
-        sort_keys(&mut keys, n);
-    }
+    sort_keys(&mut keys, n);
     (keys, n, ts, lanes)
 }
 
@@ -95,7 +98,7 @@ fn closest8(
     stacks: &mut Stacks,
     thin: u32,
 ) {
-    let Stacks { packet: stack, single } = stacks;
+    let Stacks { packet: stack, single, .. } = stacks;
     let mut prepared: [Option<Prepared>; LANES] = Default::default();
     let nodes = bvh.nodes();
     let p = Packet::load(rays);
@@ -142,7 +145,7 @@ fn closest8(
             continue;
         }
         let node = &nodes[e.child as usize];
-        let (keys, n, ts, lanes) = entered::<true>(&p, node, t_best, mask);
+        let (keys, n, ts, lanes) = entered(&p, node, t_best, mask);
         // Farthest pushed first, so the nearest is popped first.
         for &k in keys[..n].iter().rev() {
             let s = unkey(k).0;
@@ -154,7 +157,10 @@ fn closest8(
     }
 }
 
-/// Any-hit tests of 8 rays.
+/// Any-hit tests of 8 rays. A node's children are tested in slot order: a leaf child that lanes
+/// enter is tested at once, an inner one is pushed with the lanes that enter it (no entry
+/// distances: any occluder ends a lane), so every leaf child of a node is tested before any of
+/// its inner children is entered, and the last inner child pushed is entered first.
 fn occluded8(
     bvh: &Bvh8,
     tris: TriangleColumns<'_>,
@@ -163,7 +169,7 @@ fn occluded8(
     stacks: &mut Stacks,
     thin: u32,
 ) {
-    let Stacks { packet: stack, single } = stacks;
+    let Stacks { any: stack, single, .. } = stacks;
     let mut prepared: [Option<Prepared>; LANES] = Default::default();
     let nodes = bvh.nodes();
     let p = Packet::load(rays);
@@ -172,10 +178,10 @@ fn occluded8(
     let mut blocked = 0u32;
     stack.clear();
     if !nodes.is_empty() && p.valid != 0 {
-        stack.push(Entry { child: 0, count: 0, t: f32x8::ZERO, lanes: p.valid });
+        stack.push((0, p.valid));
     }
-    'walk: while let Some(e) = stack.pop() {
-        let mask = e.lanes & !blocked;
+    'walk: while let Some((n, lanes)) = stack.pop() {
+        let mask = lanes & !blocked;
         if mask == 0 {
             continue;
         }
@@ -186,8 +192,7 @@ fn occluded8(
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
                 let ray = prepared[l].get_or_insert_with(|| Prepared::new(&rays[l]));
-                if any_walk::<true, false>(bvh, ray, (e.child, e.count, 0.0), t_arr[l], single, &mut Visits::default())
-                {
+                if any_walk::<true, false>(bvh, ray, (n, 0, 0.0), t_arr[l], single, &mut Visits::default()) {
                     blocked |= 1 << l;
                 }
             }
@@ -196,38 +201,23 @@ fn occluded8(
             }
             continue;
         }
-        if e.count > 0 {
-            blocked |= any_leaf(&p, tris, leaf_ids(bvh, e.child, e.count), mask, bvh.pad(), t_max, &t_arr);
+        let node = &nodes[n as usize];
+        let mut valid = u32::from(node.valid);
+        while valid != 0 {
+            let s = valid.trailing_zeros() as usize;
+            valid &= valid - 1;
+            let m = bits(child_entry(&p, node, s, t_max).simd_le(t_max)) & mask & !blocked;
+            if m == 0 {
+                continue;
+            }
+            let count = u32::from(node.count[s]);
+            if count == 0 {
+                stack.push((node.child[s], m));
+                continue;
+            }
+            blocked |= any_leaf(&p, tris, leaf_ids(bvh, node.child[s], count), m, bvh.pad(), t_max, &t_arr);
             if blocked & p.valid == p.valid {
-                break;
-            }
-            continue;
-        }
-        let node = &nodes[e.child as usize];
-        // Leaf children at once, then the inner children, the first slot on top.
-        let (keys, n, ts, lanes) = entered::<false>(&p, node, t_max, mask);
-        for &k in &keys[..n] {
-            let s = unkey(k).0;
-            let open = lanes[s] & !blocked;
-            if node.count[s] > 0 && open != 0 {
-                blocked |= any_leaf(
-                    &p,
-                    tris,
-                    leaf_ids(bvh, node.child[s], u32::from(node.count[s])),
-                    open,
-                    bvh.pad(),
-                    t_max,
-                    &t_arr,
-                );
-                if blocked & p.valid == p.valid {
-                    break 'walk;
-                }
-            }
-        }
-        for &k in keys[..n].iter().rev() {
-            let s = unkey(k).0;
-            if node.count[s] == 0 {
-                stack.push(Entry { child: node.child[s], count: 0, t: ts[s], lanes: lanes[s] });
+                break 'walk;
             }
         }
     }
@@ -241,15 +231,17 @@ fn occluded8(
 /// issue 18, eleventh part): bunny camera rays 19.0 → 21.6 Mrays/s against none.
 pub const THIN_LANES: u32 = 4;
 
-/// The two stacks of a packet walk: the packet's, and the single ray's for lanes handed over.
+/// The stacks of a packet walk: the closest-hit packet's, the any-hit packet's (inner nodes and
+/// the lanes that enter them), and the single ray's for lanes handed over.
 struct Stacks {
     packet: Stack<Entry>,
+    any: Stack<(u32, u32)>,
     single: Stack<SingleEntry>,
 }
 
 impl Stacks {
     fn new() -> Self {
-        Stacks { packet: Stack::new(), single: Stack::new() }
+        Stacks { packet: Stack::new(), any: Stack::new(), single: Stack::new() }
     }
 }
 
