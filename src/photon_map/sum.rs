@@ -191,29 +191,38 @@ impl PhotonMap {
                     ]
                 })
             }
-            Reflectance::PerPhoton(g) => {
-                let (keys, on) = (key.to_array(), lanes.to_bitmask());
-                let fps: [Vec3; 8] = std::array::from_fn(|l| {
-                    if on >> l & 1 == 1 {
-                        g(key_wi(keys[l]).normalize_or_zero())
-                    } else {
-                        Vec3::ZERO
-                    }
-                });
-                weighted.map(|(pr, pg, pb)| {
-                    let (pr, pg, pb) = (pr.to_array(), pg.to_array(), pb.to_array());
-                    let mut out = [[0f32; 8]; 3];
-                    for l in 0..8 {
-                        if on >> l & 1 == 1 {
-                            out[0][l] = fps[l].x * pr[l];
-                            out[1][l] = fps[l].y * pg[l];
-                            out[2][l] = fps[l].z * pb[l];
-                        }
-                    }
-                    out.map(f32x8::from)
-                })
-            }
+            Reflectance::PerPhoton(g) => Self::per_photon8(key, lanes, weighted, g),
         }
+    }
+
+    /// f(wi)·Φ·w of 8 photons for a reflectance evaluated per photon (`g`, once per photon), in
+    /// the lanes of `lanes`, for each of the `W` weighted powers `weighted` (per channel). Out of
+    /// line on purpose: inlined, the compiler hoisted the eight direction decodes and
+    /// normalisations (a square root and a division each) out of the arms of the reflectance
+    /// match and out of the loop over a block's queries, so that every block of every Lambertian
+    /// estimate paid for them (BENCHMARKS.md, issue 18, eighteenth part).
+    #[inline(never)]
+    fn per_photon8<const W: usize>(
+        key: u32x8,
+        lanes: f32x8,
+        weighted: [(f32x8, f32x8, f32x8); W],
+        g: &dyn Fn(Vec3) -> Vec3,
+    ) -> [[f32x8; 3]; W] {
+        let (keys, on) = (key.to_array(), lanes.to_bitmask());
+        let fps: [Vec3; 8] =
+            std::array::from_fn(|l| if on >> l & 1 == 1 { g(key_wi(keys[l]).normalize_or_zero()) } else { Vec3::ZERO });
+        weighted.map(|(pr, pg, pb)| {
+            let (pr, pg, pb) = (pr.to_array(), pg.to_array(), pb.to_array());
+            let mut out = [[0f32; 8]; 3];
+            for l in 0..8 {
+                if on >> l & 1 == 1 {
+                    out[0][l] = fps[l].x * pr[l];
+                    out[1][l] = fps[l].y * pg[l];
+                    out[2][l] = fps[l].z * pb[l];
+                }
+            }
+            out.map(f32x8::from)
+        })
     }
 
     #[inline]
