@@ -7,7 +7,7 @@
 //! twins make the same decisions (same hits, same photons found); sums over photons differ only
 //! in rounding order.
 //! The renderer runs [`CodePath::Simd`] unless `code_path = "scalar"` is set; within it,
-//! [`crate::traversal_choice`] picks packets or single rays per ray queue.
+//! [`crate::traversal_choice`] picks BVH2 packets, single rays or 8-wide packets per ray queue.
 
 use crate::geometry::bvh::{Bvh, Hit, TriangleColumns};
 use crate::geometry::{packet, traverse, RayQuery};

@@ -79,7 +79,8 @@ pub fn check_planned(job: &Job, scene: &Scene, engine: Engine, progressive: bool
                 + u64::from(settings.caustic_photons) * u64::from(job.plan.caustic_map.on)
         };
         let per_pixel = crate::memory::bytes_per_pixel(progressive);
-        // The wavefront engine's SIMD traversal builds the 8-wide BVH for single rays.
+        // The wavefront engine's SIMD traversal builds the 8-wide BVH for single rays and 8-wide
+        // packets.
         let wide_bvh = if engine == Engine::Wavefront && settings.code_path == crate::code_path::CodePath::Simd {
             scene.triangle_count() as u64 * crate::memory::WIDE_BVH_BYTES_PER_TRIANGLE
         } else {

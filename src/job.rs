@@ -32,7 +32,8 @@ pub struct Job {
     pub threads: usize,
     /// The pass being rendered.
     pub pass: Pass,
-    /// Packets or single rays per ray queue, chosen in the first pass and kept by the others.
+    /// The traversal kernel per ray queue (BVH2 packets, single rays or 8-wide packets), chosen
+    /// in the first pass and kept by the others.
     pub traversal: Arc<TraversalChoice>,
 }
 

@@ -28,9 +28,9 @@ pub fn bytes_per_pixel(progressive: bool) -> u64 {
 /// Bytes of everything else (measured 12 MiB; the scene itself is already loaded).
 pub const BASE_BYTES: u64 = 16 << 20;
 
-/// Bytes per triangle of the 8-wide BVH the SIMD traversal builds for single rays (measured
-/// 91–93 on the bunny, the ogre and the 1 M-triangle sphere, BENCHMARKS.md issue 18): built
-/// during the render, so it counts against the machine's memory.
+/// Bytes per triangle of the 8-wide BVH the SIMD traversal builds for single rays and 8-wide
+/// packets (measured 91–93 on the bunny, the ogre and the 1 M-triangle sphere, BENCHMARKS.md
+/// issue 18): built during the render, so it counts against the machine's memory.
 pub const WIDE_BVH_BYTES_PER_TRIANGLE: u64 = 96;
 
 /// A render's estimated peak memory, in bytes: a `width × height` image at `per_pixel` bytes a

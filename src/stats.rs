@@ -176,8 +176,8 @@ pub struct RenderStats {
     pub times: PhaseTimes,
     /// Per-system runs, lanes and time (wavefront engine).
     pub stages: Option<StageStats>,
-    /// Traversal kernel per ray queue, chosen by timing both (wavefront engine, SIMD code path;
-    /// camera rays always run packets and are not listed).
+    /// Traversal kernel per ray queue, chosen by timing the candidates (wavefront engine, SIMD
+    /// code path).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub traversal: Vec<crate::traversal_choice::QueueChoice>,
     /// Mean of the beauty image (RGB).

@@ -279,6 +279,12 @@ fn bench_lights_a_bare_mesh_and_measures_one_half() {
         {
             assert_eq!(row[field].is_null(), !cfg!(feature = "embree"), "{field}: {row}");
         }
+        if cfg!(feature = "embree") {
+            // Four calls, the first of them the one `embree_extra_hits` reports.
+            let by_call = row["embree_extra_hits_by_call"].as_array().unwrap();
+            assert_eq!(by_call.len(), 4, "{row}");
+            assert_eq!(by_call[0], row["embree_extra_hits"], "{row}");
+        }
     }
     // The other half alone.
     let v =

@@ -147,10 +147,10 @@ const BUFFER_VERTEX: u32 = 1;
 const FORMAT_UINT3: u32 = 0x5003;
 const FORMAT_FLOAT3: u32 = 0x9003;
 
-/// The instruction set Embree is asked to use: the widest this build was compiled for (AVX2
-/// under `.cargo/config.toml`'s x86-64-v3), so that both sides of the comparison run the same
-/// vector width. Left to itself Embree picks the widest the CPU has, AVX-512 on an Intel Xeon,
-/// whose registers and mask instructions our `f32x8` code does not use.
+/// The widest instruction set Embree may use: the widest this build was compiled for (AVX2 under
+/// `.cargo/config.toml`'s x86-64-v3), so that both sides of the comparison run the same
+/// instruction set. Left to itself Embree picks the widest the CPU has, AVX-512 on an Intel
+/// Xeon, whose registers and mask instructions our `f32x8` code does not use.
 #[must_use]
 pub fn isa() -> &'static str {
     if cfg!(target_feature = "avx2") {
@@ -188,7 +188,7 @@ impl EmbreeScene {
         // buffers Embree allocates (uninitialised) are written through raw pointers within the
         // sizes asked for, before the geometry is committed.
         unsafe {
-            let config = std::ffi::CString::new(format!("isa={}", isa())).expect("no NUL in the ISA name");
+            let config = std::ffi::CString::new(format!("max_isa={}", isa())).expect("no NUL in the ISA name");
             let device = rtcNewDevice(config.as_ptr());
             if device.is_null() {
                 return Err("Embree: rtcNewDevice failed (is libembree3 usable on this CPU?)".into());

@@ -181,8 +181,8 @@ pub struct Report {
     pub features: Vec<&'static str>,
     /// Worker threads every kernel ran on.
     pub threads: usize,
-    /// The instruction set Embree was limited to (`isa=` of its device config: the widest this
-    /// build targets); `null` without `--features embree`.
+    /// The widest instruction set Embree was allowed (`max_isa=` of its device config: the
+    /// widest this build targets); `null` without `--features embree`.
     pub embree_isa: Option<&'static str>,
     /// Traversal rows.
     pub traversal: Vec<TraversalRow>,
@@ -255,8 +255,12 @@ pub fn table(traversal: &[TraversalRow], density: &[DensityRow]) -> String {
                 (r.embree_robust1_mrays, r.embree_robust8_mrays, r.renderer_vs_embree_robust),
             ) {
                 ((Some(e1), Some(e8), Some(x), Some(y), Some(d)), (Some(r1), Some(r8), Some(ry))) => format!(
-                    "1-ray {e1:.2}, 8-ray {e8:.2} Mrays/s, packet ×{x:.2}, renderer's {} ×{y:.2} ({d:+} hits); robust 1-ray {r1:.2}, 8-ray {r8:.2}, renderer's ×{ry:.2}",
-                    r.renderer_kernel
+                    "1-ray {e1:.2}, 8-ray {e8:.2} Mrays/s, packet ×{x:.2}, renderer's {} ×{y:.2} ({d:+} hits{}); robust 1-ray {r1:.2}, 8-ray {r8:.2}, renderer's ×{ry:.2}",
+                    r.renderer_kernel,
+                    match r.embree_extra_hits_by_call {
+                        Some(e) if e.iter().any(|&v| v != d) => format!("; by call {e:?}"),
+                        _ => String::new(),
+                    }
                 ),
                 _ => "– (build with --features embree)".to_string(),
             }

@@ -34,8 +34,8 @@ pub struct Hit {
 pub struct Bvh {
     bvh: Bvh2,
     /// The SAH tree over the same triangles ([`super::sah`]) collapsed to 8-wide nodes, built
-    /// on first use: by `photonwave bench`, and by renders whose ray queues try single rays
-    /// ([`crate::traversal_choice`]).
+    /// on first use: by `photonwave bench`, and by renders whose ray queues try single rays or
+    /// 8-wide packets ([`crate::traversal_choice`]).
     wide: std::sync::OnceLock<Bvh8>,
     /// [`shared_pad`] of the triangles: the padding of the boxes hits are settled against.
     pad: f32,

@@ -10,10 +10,11 @@
 //! checks it. Closest-hit traversal visits children nearest first by the entry distance of the
 //! first lane that enters them. Any-hit traversal tests a node's leaf children as soon as the
 //! node is reached, before entering any inner child, as the other traversals do, and takes
-//! children in slot order, unsorted, as the single ray's does (any occluder ends a lane); its
-//! stack holds only inner nodes and their lanes, no entry distances (Embree's occlusion walk
-//! keeps no more: 0.98–1.19× the speed of the sorted walk's key and distance arrays on the
-//! boxes, the bunny and the ogre, BENCHMARKS.md, issue 18, eighteenth part).
+//! children unsorted (any occluder ends a lane): it tests them in slot order and pushes the inner
+//! ones in slot order, so the last is entered first; its stack holds only inner nodes and their
+//! lanes, no entry distances (Embree's occlusion walk keeps no more), 0.98–1.19× the speed of a
+//! walk that built every node's keys, distances and lanes on the boxes, the bunny and the ogre
+//! (BENCHMARKS.md, issue 18, eighteenth part).
 //!
 //! Hand-over (Embree's hybrid traversal, Benthin et al. 2012): a stack entry reached by at most
 //! [`THIN_LANES`] active lanes is finished by each of those lanes alone, with the 8-wide single

@@ -1,42 +1,66 @@
 //! Intersect: closest hits for every lane of the photon or path queue, and any-hit tests for
-//! the shadow queue, with the configured kernels: the SIMD set runs packets (chunks traced in
-//! coherence-key order) or single rays, chosen per queue by timing
-//! ([`crate::traversal_choice`]). Reads rays; writes hit columns (and, for shadow rays, the
+//! the shadow queue, with the configured kernels: the SIMD set runs BVH2 packets, single rays or
+//! 8-wide packets (packets trace closest-hit chunks in coherence-key order), chosen per queue by
+//! timing ([`crate::traversal_choice`]). Reads rays; writes hit columns (and, for shadow rays, the
 //! unblocked contributions into the wave's terms, in lane order).
 
 use super::queues::PathKind;
 use super::queues::{HitColumns, RayColumns};
 use super::{par_lanes, par_pieces, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
 use crate::geometry::RayQuery;
+use crate::job::Job;
 use crate::rng::Domain;
-use crate::traversal_choice::Queue;
+use crate::scene::camera::CameraRays;
+use crate::scene::Scene;
+use crate::transport::camera::camera_sample;
+use crate::traversal_choice::{Queue, TRIAL_CHUNKS};
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
 /// Fills `hits` with the closest hits of `rays` (of `queue`), each chunk writing its own lanes
 /// in place (per-chunk columns appended afterwards cost `intersect_paths` ~6 % of its samples:
-/// the copy and fresh pages for every bounce). `span` places the queue in its pass, for the
-/// kernel trial ([`crate::traversal_choice`]): its first lane's index and the pass's lane count
-/// (the camera queue: the wave's first sample and the image's samples).
-fn closest_hits(shared: &Shared, queue: Queue, span: (u64, u64), rays: &RayColumns, hits: &mut HitColumns) {
+/// the copy and fresh pages for every bounce).
+fn closest_hits(shared: &Shared, queue: Queue, rays: &RayColumns, hits: &mut HitColumns) {
     let scene = &*shared.scene;
     let n = rays.len();
     par_pieces(n, CHUNK, shared.job.threads, hits.pieces(n, CHUNK), |r, piece| {
-        let at = (span.0 + r.start as u64) as f32 / span.1.max(1) as f32;
         let queries: Vec<RayQuery> =
             r.map(|i| RayQuery::new(rays.origin(i), rays.direction(i), f32::INFINITY)).collect();
         let job = &shared.job;
-        let found = job.traversal.closest(
-            queue,
-            at,
-            job.settings.code_path,
-            scene.bvh(),
-            scene.columns(),
-            &queries,
-            scene.bounds,
-        );
+        let found =
+            job.traversal.closest(queue, job.settings.code_path, scene.bvh(), scene.columns(), &queries, scene.bounds);
         piece.write(&found);
     });
+}
+
+/// Chooses the camera queue's kernel before the first camera pass
+/// ([`crate::traversal_choice::TraversalChoice::choose_camera`]): a chunk of the pass's own
+/// camera rays (the same samples, jittered as [`super::emit::emit_camera_rays`] jitters them)
+/// from the middle of each sixth of the image, so that the whole pass runs the faster packet
+/// kernel and the choice does not rest on the image's top rows, often sky. Later passes find the
+/// choice made.
+pub fn choose_camera_kernel(scene: &Scene, camera: &CameraRays, job: &Job) {
+    let settings = &job.settings;
+    let spp = u64::from(settings.spp);
+    let total = u64::from(settings.width) * u64::from(settings.height) * spp;
+    let parts = u64::from(TRIAL_CHUNKS);
+    let chunks: Vec<Vec<RayQuery>> = (0..parts)
+        .map(|b| {
+            let first = ((2 * b + 1) * total / (2 * parts)).saturating_sub(CHUNK as u64 / 2);
+            let first = first.min(total.saturating_sub(CHUNK as u64));
+            (first..(first + CHUNK as u64).min(total))
+                .map(|g| {
+                    let pixel = g / spp;
+                    let (x, y) =
+                        ((pixel % u64::from(settings.width)) as f32, (pixel / u64::from(settings.width)) as f32);
+                    let (_, (fx, fy)) = camera_sample(job, g);
+                    let (o, d) = camera.ray(x + fx, y + fy);
+                    RayQuery::new(o, d, f32::INFINITY)
+                })
+                .collect()
+        })
+        .collect();
+    job.traversal.choose_camera(settings.code_path, scene.bvh(), scene.columns(), &chunks, scene.bounds);
 }
 
 /// Closest hits of the photon queue.
@@ -52,8 +76,7 @@ pub fn intersect_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut 
         (_, true) => Queue::Emitted,
         (_, false) => Queue::Photons,
     };
-    // Photon queues choose on their first chunks, wherever they lie.
-    closest_hits(&shared, queue, (0, 1), &q.rays, &mut q.hits);
+    closest_hits(&shared, queue, &q.rays, &mut q.hits);
     let n = q.len();
     work.rays += n as u64;
     stats.record("intersect_photons", n, t);
@@ -66,11 +89,7 @@ pub fn intersect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut st
     // The first bounce's queue holds the primary rays, and later ones none.
     let primary = w.paths.kind.first() == Some(&PathKind::Camera) && w.paths.depth.first() == Some(&0);
     let queue = if primary { Queue::Camera } else { Queue::Secondary };
-    // A primary queue holds the wave's samples in order: the camera trial spreads over the image.
-    let samples = u64::from(shared.job.settings.width)
-        * u64::from(shared.job.settings.height)
-        * u64::from(shared.job.settings.spp);
-    closest_hits(&shared, queue, (w.first_sample, samples), &w.paths.rays, &mut w.paths.hits);
+    closest_hits(&shared, queue, &w.paths.rays, &mut w.paths.hits);
     for k in &w.paths.kind {
         match k {
             PathKind::Camera => w.rays.camera += 1,

@@ -185,8 +185,9 @@ pub fn render_job(scene: Arc<Scene>, camera: &CameraRays, job: &Job, progress: &
     let maps = photon_pass(&mut world, &scene, job, &mut stats, progress);
     world.insert_resource(Maps(Arc::new(maps)));
 
-    // Camera pass, wave by wave.
+    // Camera pass, wave by wave, with the camera rays' kernel chosen first.
     let t = Instant::now();
+    intersect::choose_camera_kernel(&scene, camera, job);
     let pixels = settings.width as usize * settings.height as usize;
     let total = pixels as u64 * settings.spp as u64;
     world.insert_resource(CameraWork {
