@@ -7,9 +7,10 @@
 //! that 8-wide BVH, handing thin nodes to single rays ([`crate::geometry::wide_packet`],
 //! Embree's hybrid traversal). Which is fastest depends on the scene, the queue and the machine,
 //! not on the triangle count alone (BENCHMARKS.md, "Packets or single rays, chosen per queue by
-//! timing", and issue 18's eighteenth part): on an Intel Xeon BVH2 packets win on the camera rays
-//! of the boxes, 8-wide packets on those of the meshes (+16–50 % on the bunny and the ogre) and
-//! on some boxes' shadow rays, single rays on photon rays and on many final-gather rays. So each
+//! timing", and issue 18's eighteenth part): on an Intel Xeon's bench rays BVH2 packets win on
+//! the camera rays of the boxes, 8-wide packets on those of the meshes (+16–50 % on the bunny and
+//! the ogre) and on some boxes' shadow rays, single rays on photon rays and on many final-gather
+//! rays. So each
 //! queue traces its first chunks with every candidate and keeps the fastest for the rest of the
 //! render (every later pass included); the camera queue's trial runs before the camera pass, on
 //! chunks of camera rays from the middle of each sixth of the image
