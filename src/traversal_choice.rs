@@ -10,10 +10,9 @@
 //! timing", and issue 18's eighteenth part): on an Intel Xeon's bench rays BVH2 packets win on
 //! the camera rays of the boxes, 8-wide packets on those of the meshes (+16–50 % on the bunny and
 //! the ogre) and on some boxes' shadow rays, single rays on photon rays and on many final-gather
-//! rays. So each
-//! queue traces its first chunks with every candidate and keeps the fastest for the rest of the
-//! render (every later pass included); the camera queue's trial runs before the camera pass, on
-//! chunks of camera rays from the middle of each sixth of the image
+//! rays. So each queue traces its first chunks with every candidate and keeps the fastest for the
+//! rest of the render (every later pass included); the camera queue's trial runs before the
+//! camera pass, on chunks of camera rays from the middle of each sixth of the image
 //! ([`TraversalChoice::choose_camera`]). Hits are identical whichever kernel runs and whatever
 //! tree it walks (every hit's t is settled into its triangle's box:
 //! [`crate::geometry::slab::settle`]), so the choice changes speed only, never an image. Reads

@@ -209,21 +209,17 @@ fn the_bench_command_checks_its_input_and_prints_one_json_object() {
     // A small generated sphere, one repetition: the report's shape, not its speed.
     let v = bench_json(&["bench", "generated:sphere", "--rings", "8", "--reps", "1", "--json"]);
     assert!(v["target_cpu"].is_string() && v["threads"] == 1, "{v}");
-    // Embree, when built in, runs at the widest instruction set this build targets.
-    if cfg!(feature = "embree") {
-        let widest = if cfg!(target_feature = "avx2") {
-            "avx2"
-        } else if cfg!(target_feature = "avx") {
-            "avx"
-        } else if cfg!(target_feature = "sse4.2") {
-            "sse4.2"
-        } else {
-            "sse2"
-        };
-        assert_eq!(v["embree_isa"], widest, "{v}");
-    } else {
-        assert!(v["embree_isa"].is_null(), "{v}");
+    // Embree, when built in, is limited to the widest instruction set this build targets.
+    #[cfg(feature = "embree")]
+    {
+        assert_eq!(v["embree_isa"], photonwave::bench::embree::isa(), "{v}");
+        // The configured build (x86-64-v3, `.cargo/config.toml`) targets AVX2.
+        if cfg!(target_feature = "avx2") {
+            assert_eq!(v["embree_isa"], "avx2", "{v}");
+        }
     }
+    #[cfg(not(feature = "embree"))]
+    assert!(v["embree_isa"].is_null(), "{v}");
     let traversal = v["traversal"].as_array().unwrap();
     assert_eq!(traversal.len(), 6, "three ray sets × closest/any");
     for row in traversal {

@@ -35,6 +35,18 @@ pub fn camera_sample(job: &Job, index: u64) -> (Sampler, (f32, f32)) {
     (sampler, offset)
 }
 
+/// Camera sample `index` of `job`'s pass as a ray: [`camera_sample`]'s random stream, and the
+/// origin and direction of the ray through its jittered position in pixel `index / spp`
+/// (row-major). Every engine makes its camera rays here.
+#[must_use]
+pub fn camera_ray(job: &Job, camera: &CameraRays, index: u64) -> (Sampler, Vec3, Vec3) {
+    let pixel = index / u64::from(job.settings.spp);
+    let width = u64::from(job.settings.width);
+    let (sampler, (fx, fy)) = camera_sample(job, index);
+    let (o, d) = camera.ray((pixel % width) as f32 + fx, (pixel / width) as f32 + fy);
+    (sampler, o, d)
+}
+
 /// Per-pixel probes (the pixel radii, the diagnostic layers): each pixel's first camera sample
 /// of `job`'s pass, followed through mirrors and glass to its first non-specular point as camera
 /// paths go ([`first_non_specular`]), is handed to `probe(pixel, sampler, point, direction that
@@ -47,8 +59,7 @@ pub fn probe_first_surfaces<T: Send + Sync + Clone>(
     miss: T,
     probe: impl Fn(usize, &Sampler, &SurfacePoint, Vec3, &mut Nearest, &mut RayCounts) -> T + Sync,
 ) -> Vec<T> {
-    let w = job.settings.width as usize;
-    let pixels = w * job.settings.height as usize;
+    let pixels = job.settings.width as usize * job.settings.height as usize;
     let chunks = map_chunks(
         pixels,
         256,
@@ -57,8 +68,7 @@ pub fn probe_first_surfaces<T: Send + Sync + Clone>(
             let (mut scratch, mut counts) = (Nearest::default(), RayCounts::default());
             range
                 .map(|pixel| {
-                    let (s, (fx, fy)) = camera_sample(job, pixel as u64 * u64::from(job.settings.spp));
-                    let (o, d) = rays.ray((pixel % w) as f32 + fx, (pixel / w) as f32 + fy);
+                    let (s, o, d) = camera_ray(job, rays, pixel as u64 * u64::from(job.settings.spp));
                     match first_non_specular(ctx, o, d, &s, CAMERA_CHAIN_BOUNCE, &mut counts) {
                         Some(end) => probe(pixel, &s, &end.point, end.dir, &mut scratch, &mut counts),
                         None => miss.clone(),
@@ -98,8 +108,7 @@ pub fn render_pixels(
                     let mut mean = PixelMean::default();
                     for s in 0..spp {
                         let index = ((y * w + x) as u64) * u64::from(spp) + u64::from(s);
-                        let (sampler, (fx, fy)) = camera_sample(job, index);
-                        let (o, d) = camera.ray(x as f32 + fx, y as f32 + fy);
+                        let (sampler, o, d) = camera_ray(job, camera, index);
                         let t = radiance(y * w + x, o, d, &sampler, &mut rays, &mut scratch);
                         mean.add(t, 1.0 / spp as f32);
                     }

@@ -5,7 +5,7 @@ use super::queues::{PathKind, PhotonLane, PhotonQueue, Segment};
 use super::{par_columns, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
 use crate::film::{Term, Terms};
 use crate::rng::Domain;
-use crate::transport::camera::camera_sample;
+use crate::transport::camera::camera_ray;
 use crate::transport::photon::{start_photon, Start, BATCH};
 use crate::transport::streams;
 use bevy_ecs::prelude::*;
@@ -57,20 +57,14 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
 /// (stratified when spp is a square) exactly as the reference engine does.
 pub fn emit_camera_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
-    let settings = &shared.job.settings;
     let w = &mut *work;
-    let spp = settings.spp as u64;
     w.paths.clear();
     w.next.clear();
     w.shadows.clear();
     w.terms.clear();
     w.terms.resize(w.count, Terms::default());
     for lane in 0..w.count {
-        let g = w.first_sample + lane as u64;
-        let pixel = g / spp;
-        let (x, y) = ((pixel % settings.width as u64) as f32, (pixel / settings.width as u64) as f32);
-        let (sampler, (fx, fy)) = camera_sample(&shared.job, g);
-        let (origin, dir) = w.camera.ray(x + fx, y + fy);
+        let (sampler, origin, dir) = camera_ray(&shared.job, &w.camera, w.first_sample + lane as u64);
         w.paths.push(Segment {
             origin,
             dir,

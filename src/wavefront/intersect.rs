@@ -12,7 +12,7 @@ use crate::job::Job;
 use crate::rng::Domain;
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
-use crate::transport::camera::camera_sample;
+use crate::transport::camera::camera_ray;
 use crate::traversal_choice::{Queue, TRIAL_CHUNKS};
 use bevy_ecs::prelude::*;
 use std::time::Instant;
@@ -41,8 +41,7 @@ fn closest_hits(shared: &Shared, queue: Queue, rays: &RayColumns, hits: &mut Hit
 /// choice made.
 pub fn choose_camera_kernel(scene: &Scene, camera: &CameraRays, job: &Job) {
     let settings = &job.settings;
-    let spp = u64::from(settings.spp);
-    let total = u64::from(settings.width) * u64::from(settings.height) * spp;
+    let total = u64::from(settings.width) * u64::from(settings.height) * u64::from(settings.spp);
     let parts = u64::from(TRIAL_CHUNKS);
     let chunks: Vec<Vec<RayQuery>> = (0..parts)
         .map(|b| {
@@ -50,11 +49,7 @@ pub fn choose_camera_kernel(scene: &Scene, camera: &CameraRays, job: &Job) {
             let first = first.min(total.saturating_sub(CHUNK as u64));
             (first..(first + CHUNK as u64).min(total))
                 .map(|g| {
-                    let pixel = g / spp;
-                    let (x, y) =
-                        ((pixel % u64::from(settings.width)) as f32, (pixel / u64::from(settings.width)) as f32);
-                    let (_, (fx, fy)) = camera_sample(job, g);
-                    let (o, d) = camera.ray(x + fx, y + fy);
+                    let (_, o, d) = camera_ray(job, camera, g);
                     RayQuery::new(o, d, f32::INFINITY)
                 })
                 .collect()
