@@ -7,8 +7,11 @@
 //!
 //! Writes: [`replace`] writes a file under a temporary name beside its destination, syncs it
 //! to disk and renames it into place, so a full disk, a crash or Ctrl-C leaves the previous
-//! file intact. [`check_outputs`] checks every output path of a command before any work: the
-//! extension, a writable folder, no input file of the scene and no two outputs the same file.
+//! file intact. What is not a regular file is never replaced: a character device or a FIFO
+//! that the output names (or a symbolic link to one) is written into as a stream, as
+//! `cat > /dev/null` would; a block device or a socket is refused. [`check_outputs`] checks
+//! every output path of a command before any work: the extension, a writable folder, no input
+//! file of the scene, no two outputs the same file, and no block device or socket.
 
 use crate::error::{Error, Result};
 use std::io::{Read, Write};
@@ -99,8 +102,12 @@ pub fn normalise_line_ends(text: &str) -> String {
 /// extension, so that writers choosing a format by extension still work). The temporary file is
 /// synced and renamed over `path` only when `write` succeeded; otherwise it is removed and the
 /// previous `path`, if any, is untouched.
-/// A symbolic link is written through: its target is replaced, not the link.
+/// A symbolic link is written through: its target is replaced, not the link. A target that is
+/// not a regular file is never replaced ([`write_into_special`]).
 pub fn replace(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    if let Some(kind) = special_target(path) {
+        return write_into_special(path, kind, write);
+    }
     let is_link = path.symlink_metadata().is_ok_and(|m| m.file_type().is_symlink());
     let dest = if is_link { path.canonicalize().unwrap_or_else(|_| path.to_path_buf()) } else { path.to_path_buf() };
     let tmp = temporary_beside(&dest);
@@ -119,6 +126,76 @@ pub fn replace(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<(
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
+    result
+}
+
+/// What an existing output's final target (links followed) is, where it is not a regular file
+/// or a directory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Special {
+    /// A character device (`/dev/null`, `/dev/full`, a terminal): written into.
+    CharDevice,
+    /// A named pipe: written into (the write waits for a reader, as `cat > fifo` does).
+    Fifo,
+    /// A block device: refused (its bytes are a disk's).
+    BlockDevice,
+    /// A socket: refused (it cannot be opened as a file).
+    Socket,
+}
+
+/// The kind of `path`'s final target when it exists and is neither a regular file nor a
+/// directory.
+fn special_target(path: &Path) -> Option<Special> {
+    let meta = std::fs::metadata(path).ok()?;
+    if meta.is_file() || meta.is_dir() {
+        return None;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        Some(if t.is_char_device() {
+            Special::CharDevice
+        } else if t.is_fifo() {
+            Special::Fifo
+        } else if t.is_block_device() {
+            Special::BlockDevice
+        } else {
+            Special::Socket
+        })
+    }
+    #[cfg(not(unix))]
+    {
+        Some(Special::BlockDevice)
+    }
+}
+
+/// Why an output that names a block device or a socket is refused, or `None`.
+fn refusal(path: &Path, kind: Special) -> Option<String> {
+    let what = match kind {
+        Special::BlockDevice => "a block device",
+        Special::Socket => "a socket",
+        Special::CharDevice | Special::Fifo => return None,
+    };
+    Some(format!("`{}` is {what}, not a regular file: it is neither replaced nor written into", path.display()))
+}
+
+/// Writes an output whose target is a character device or a FIFO into it, as a stream: `write`
+/// writes a temporary file in the system's temporary folder (never beside a device in `/dev`),
+/// whose bytes are then copied into the target opened for writing — never created, truncated,
+/// renamed over or removed. A block device or a socket is refused.
+fn write_into_special(path: &Path, kind: Special, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    if let Some(why) = refusal(path, kind) {
+        return Err(Error::output(path, why));
+    }
+    let tmp = temporary_beside(&std::env::temp_dir().join(path.file_name().unwrap_or("output".as_ref())));
+    let result = write(&tmp).and_then(|()| {
+        let mut from = std::fs::File::open(&tmp).map_err(|e| Error::output(path, e))?;
+        let mut to = std::fs::OpenOptions::new().write(true).open(path).map_err(|e| Error::output(path, e))?;
+        std::io::copy(&mut from, &mut to).and_then(|_| to.flush()).map_err(|e| Error::output(path, e))?;
+        Ok(())
+    });
+    let _ = std::fs::remove_file(&tmp);
     result
 }
 
@@ -199,6 +276,9 @@ pub fn check_outputs(outputs: &[Output], inputs: &[PathBuf]) -> Result<()> {
         }
         if path.is_dir() {
             return Err(Error::setting(flag, format!("`{}` is a directory; name a file in it", path.display())));
+        }
+        if let Some(why) = special_target(path).and_then(|kind| refusal(path, kind)) {
+            return Err(Error::setting(flag, why));
         }
         check_folder(flag, path)?;
         let id = identity(path);
@@ -332,6 +412,54 @@ mod tests {
         write_bytes(&link, b"new").unwrap();
         assert!(link.symlink_metadata().unwrap().file_type().is_symlink());
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
+    }
+
+    /// An output that is (or links to) a character device or a FIFO is written into, never
+    /// replaced: private device nodes made with `mknod` (as root, which CI and many containers
+    /// are; skipped, saying so, where `mknod` is refused), never the system's.
+    #[cfg(unix)]
+    #[test]
+    fn devices_and_fifos_are_written_into_never_replaced() {
+        use std::os::unix::fs::FileTypeExt;
+        let d = scratch("special");
+        let is_char = |p: &Path| std::fs::metadata(p).unwrap().file_type().is_char_device();
+        let made = |name: &str, minor: &str| {
+            let node = d.join(name);
+            let ok = std::process::Command::new("mknod")
+                .arg(&node)
+                .args(["c", "1", minor])
+                .status()
+                .is_ok_and(|s| s.success());
+            ok.then_some(node)
+        };
+        // Major 1, minor 3: a null device; minor 7: a full one (every write fails with ENOSPC).
+        match (made("null", "3"), made("full", "7")) {
+            (Some(null), Some(full)) => {
+                let link = d.join("out.exr");
+                std::os::unix::fs::symlink(&full, &link).unwrap();
+                let e = write_bytes(&link, &[7u8; 100_000]).unwrap_err().to_string();
+                assert!(e.contains("out.exr") && e.contains("No space"), "{e}");
+                assert!(is_char(&full), "the full device was replaced");
+                assert!(link.symlink_metadata().unwrap().file_type().is_symlink());
+                write_bytes(&null, b"written into").unwrap();
+                assert!(is_char(&null), "the null device was replaced");
+                check_outputs(&[out("-o", &link, "exr")], &[]).unwrap();
+            }
+            _ => println!("mknod refused (not root?): the device half of this test is skipped"),
+        }
+        // A FIFO: the bytes reach its reader, and it stays a FIFO.
+        let fifo = d.join("pipe.json");
+        if std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success()) {
+            let reader = {
+                let fifo = fifo.clone();
+                std::thread::spawn(move || std::fs::read(&fifo).unwrap())
+            };
+            write_bytes(&fifo, b"{\"through\": \"the pipe\"}").unwrap();
+            assert_eq!(reader.join().unwrap(), b"{\"through\": \"the pipe\"}");
+            assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+        }
+        // Nothing was left in the folder but what the test made.
+        assert!(std::fs::read_dir(&d).unwrap().all(|e| !e.unwrap().file_name().to_string_lossy().contains("partial")));
     }
 
     #[test]
