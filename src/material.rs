@@ -405,6 +405,21 @@ impl Bsdf {
         })
     }
 
+    /// The factor refraction from `wo` into `wi` puts on radiance, (η_wo / η_wi)² — 1 for
+    /// reflection and for materials that do not refract. A chain's Russian roulette divides it
+    /// out: it is not absorption (it cancels when the ray leaves the medium again), and a
+    /// survival probability of 1/1.5² on entering glass would kill most paths for nothing.
+    #[must_use]
+    pub fn radiance_scale(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> f32 {
+        let (Bsdf::Glass { ior } | Bsdf::RoughDielectric { ior, .. }) = *self else { return 1.0 };
+        let (o, i) = (wo.dot(frame.ng), wi.dot(frame.ng));
+        if (o > 0.0) == (i > 0.0) {
+            return 1.0;
+        }
+        let eta = if o > 0.0 { ior } else { 1.0 / ior };
+        1.0 / (eta * eta)
+    }
+
     /// Samples the glossy lobe alone (radiance): for Phong, weight `ks·(n+2)/(n+1)·cos θi`; for
     /// the rough conductor and dielectric, the whole BSDF; for the rough plastic, its coat (its
     /// base is the final gather's). `None` for other materials.

@@ -43,6 +43,10 @@ impl std::ops::BitOr for PerPass {
     }
 }
 
+/// The default [`Settings::max_depth`]: high enough that the paths it cuts are a negligible
+/// share (counted in `--stats`), where Russian roulette has not ended them.
+pub const DEFAULT_MAX_DEPTH: u32 = 64;
+
 /// Render settings. Radii are fractions of the scene's bounding-box diagonal, so that a scene
 /// renders the same at any unit scale.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -91,7 +95,12 @@ pub struct Settings {
     /// that close averages the light of its disk into the corner the gather leaves, which
     /// brightens dark corners. 0 turns it off.
     pub secondary_gather: f32,
-    /// Longest photon path and longest specular chain of a camera path (bounces).
+    /// Longest photon path and longest specular chain of a camera path (bounces): a safety cap.
+    /// Russian roulette ends paths that lose light (photons at every bounce, camera-side chains
+    /// from [`CHAIN_ROULETTE_DEPTH`](crate::transport::specular::CHAIN_ROULETTE_DEPTH) on), so
+    /// the default cuts almost nothing, and what it cuts is counted
+    /// (`numerics.photon_depth_cut`, `camera_depth_cut`): light trapped between glass and water
+    /// (CornellBox-Water) took more than the 10 bounces that were once the default.
     pub max_depth: u32,
     /// Area-light samples per shading point.
     pub light_samples: u32,
@@ -165,7 +174,7 @@ impl Default for Settings {
             final_gather: true,
             precompute_irradiance: true,
             secondary_gather: SECONDARY_GATHER,
-            max_depth: 10,
+            max_depth: DEFAULT_MAX_DEPTH,
             light_samples: 1,
             seed: 1,
             threads: 0,

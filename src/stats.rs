@@ -34,6 +34,7 @@ impl std::ops::AddAssign for RayCounts {
 
 /// One photon map: whether it was built, why, and what it holds.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(default)]
 pub struct MapStats {
     /// Whether the map was built.
     pub built: bool,
@@ -43,13 +44,19 @@ pub struct MapStats {
     pub emitted: u64,
     /// Photons stored.
     pub stored: u64,
+    /// The largest stored photon's power over the median photon's (each photon's largest
+    /// channel): 1 where every photon keeps its path's emitted power; a spike shows as a large
+    /// ratio. The largest over the passes of a progressive render; 0 for an empty map.
+    pub power_max_over_median: f64,
 }
 
 impl std::ops::AddAssign<&MapStats> for MapStats {
-    /// Adds another pass's counts (progressive renders report totals over their passes).
+    /// Adds another pass's counts (progressive renders report totals over their passes, and
+    /// the largest power ratio of any pass).
     fn add_assign(&mut self, o: &MapStats) {
         self.emitted += o.emitted;
         self.stored += o.stored;
+        self.power_max_over_median = self.power_max_over_median.max(o.power_max_over_median);
     }
 }
 
@@ -76,6 +83,7 @@ impl MapStats {
 /// Values that could not be used, per stage of the pipeline where they were caught. Nothing
 /// counted here reaches the film or a photon map.
 #[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(default)]
 pub struct Numerics {
     /// Load: vertex normals given with zero length, replaced by their face's geometric normal
     /// (non-finite ones are refused with an error naming the line).
@@ -97,6 +105,16 @@ pub struct Numerics {
     /// Density estimates: photons within the search radius that the normal filter turned away
     /// (another surface's photons, around a corner or across a thin wall), at shading points.
     pub photons_filtered: u64,
+    /// Photon scattering: bounces whose power would have exceeded the stated bound
+    /// ([`POWER_GROWTH_MAX`](crate::transport::photon::POWER_GROWTH_MAX) times the path's
+    /// emitted power) and were clamped to it.
+    pub photon_power_capped: u64,
+    /// Photon paths still going after `max_depth` bounces, cut there (Russian roulette ends
+    /// the others; the cut is a safety cap, and what it cuts is a bias this counts).
+    pub photon_depth_cut: u64,
+    /// Camera-side chains through mirrors and glass (camera, gather and glossy rays) still going
+    /// after `max_depth` bounces, cut there.
+    pub camera_depth_cut: u64,
 }
 
 impl std::ops::AddAssign for Numerics {
@@ -109,6 +127,9 @@ impl std::ops::AddAssign for Numerics {
         self.pixel_overflow += o.pixel_overflow;
         self.photon_escaped += o.photon_escaped;
         self.photons_filtered += o.photons_filtered;
+        self.photon_power_capped += o.photon_power_capped;
+        self.photon_depth_cut += o.photon_depth_cut;
+        self.camera_depth_cut += o.camera_depth_cut;
     }
 }
 

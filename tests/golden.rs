@@ -18,16 +18,16 @@ use std::sync::Arc;
 
 /// (scene, engine, passes) → FNV-1a 64 of the film's f32 bits.
 const GOLDEN: &[(&str, &str, u32, u64)] = &[
-    ("cornell-box.toml", "wavefront", 1, 0x9f5591f3eaedbb36),
-    ("cornell-box.toml", "reference", 1, 0xbcdd6e556e63406f),
+    ("cornell-box.toml", "wavefront", 1, 0x65db47bab6e2e1c3),
+    ("cornell-box.toml", "reference", 1, 0xa59e48a3f41b6ca0),
     ("cornell-box.toml", "path", 1, 0xd3159bbc928efad9),
-    ("cornell-spheres.toml", "wavefront", 1, 0xde2b603c9395a260),
-    ("cornell-spheres.toml", "reference", 1, 0xfdc0d5f3c05d1eeb),
-    ("cornell-spheres.toml", "wavefront", 3, 0x6bd7632c75ac9b09),
-    ("cornell-spheres.toml", "reference", 3, 0x6cbe9a5f6836119d),
-    ("hard/furnace-materials.toml", "wavefront", 1, 0xd9a53996592b365d),
-    ("hard/furnace-materials.toml", "reference", 1, 0x8b2a713759699258),
-    ("hard/nested.toml", "wavefront", 2, 0xb991a05c2d28d3cd),
+    ("cornell-spheres.toml", "wavefront", 1, 0x40cd9a681fd1fe77),
+    ("cornell-spheres.toml", "reference", 1, 0x0450b051cc1bf9cc),
+    ("cornell-spheres.toml", "wavefront", 3, 0x662c89e3e7e999b3),
+    ("cornell-spheres.toml", "reference", 3, 0x7e4c361acb8b96d9),
+    ("hard/furnace-materials.toml", "wavefront", 1, 0x93e4e7301afa4d9b),
+    ("hard/furnace-materials.toml", "reference", 1, 0x9eb570813f5e4066),
+    ("hard/nested.toml", "wavefront", 2, 0x0896f03bd3da855a),
 ];
 
 /// FNV-1a over the bits of every term of every pixel, in film order.

@@ -237,8 +237,8 @@ fn scale_changes_nothing() {
     for domain in [Domain::GlobalPhoton, Domain::CausticPhoton] {
         let paths = trace_photons(&unit.2, &common::job(&unit.2, &s), domain, 20_000, &NoProgress).emitted;
         let trace = |scene: &photonwave::scene::Scene, job: &photonwave::job::Job, path: u64| {
-            let (mut out, mut rays, mut numerics) = (Vec::new(), 0, photonwave::stats::Numerics::default());
-            trace_path(scene, job, domain, path, &mut out, &mut rays, &mut numerics);
+            let mut out = Vec::new();
+            trace_path(scene, job, domain, path, &mut out);
             let diagonal = scene.diagonal();
             out.iter().map(|p| p.position / diagonal).collect::<Vec<Vec3>>()
         };

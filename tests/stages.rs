@@ -42,7 +42,10 @@ fn world(settings: Settings) -> World {
 
 fn photon_world(domain: Domain) -> World {
     let mut w = world(Settings::default());
-    let mut work = PhotonWork { domain: Some(domain), ..Default::default() };
+    // Paths 100.. of a wave that starts there, each with its counts.
+    let n = lanes().len();
+    let mut work = PhotonWork { domain: Some(domain), first_path: 100, ..Default::default() };
+    work.counts.resize(n, Default::default());
     for (i, (o, d)) in lanes().into_iter().enumerate() {
         work.queue.push(PhotonLane {
             origin: o,
@@ -50,6 +53,7 @@ fn photon_world(domain: Domain) -> World {
             path: 100 + i as u64,
             bounce: 0,
             power: Vec3::splat(2.0),
+            emitted: 2.0,
             specular_only: true,
         });
     }

@@ -132,7 +132,8 @@ pub struct RenderArgs {
     /// Radius reduction of progressive passes, r²ᵢ₊₁ = r²ᵢ·(i+α)/(i+1) [0.6667].
     #[arg(long)]
     pub alpha: Option<f32>,
-    /// Longest photon path / specular chain [10].
+    /// Longest photon path / specular chain, a safety cap: Russian roulette ends paths before
+    /// it, and `--stats` counts what it cuts [64].
     #[arg(long)]
     pub max_depth: Option<u32>,
     /// Seed of all random streams [1].

@@ -22,7 +22,7 @@ use crate::transport::camera::render_pixels;
 use crate::transport::direct::{delta_light, direct_light};
 use crate::transport::estimate::{camera_indirect_estimate, caustic_estimate, indirect_estimate, map_radiance};
 use crate::transport::gather::{glossy_ray, lands_near, trace_gather_rays};
-use crate::transport::specular::{continue_ray, emission_toward, first_non_specular, ChainEnd};
+use crate::transport::specular::{continue_chain, emission_toward, first_non_specular, ChainEnd};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
 
@@ -39,6 +39,7 @@ pub fn render_image(
         trace_camera_path(&ctx, pixel, o, d, s, rays, scratch)
     });
     numerics.photons_filtered += ctx.filtered();
+    numerics.camera_depth_cut += ctx.cuts();
     (film, rays, numerics)
 }
 
@@ -81,9 +82,12 @@ pub fn trace_camera_path(
                 terms.add(Term::Direct.seen(through_specular), beta * d);
             }
             if depth == ctx.settings.max_depth {
+                ctx.cut();
                 break;
             }
-            let Some(next) = continue_ray(&sp, &bsdf, wo, s, streams::CAMERA_CHAIN_BOUNCE + depth) else { break };
+            let Some(next) = continue_chain(&sp, &bsdf, wo, s, streams::CAMERA_CHAIN_BOUNCE + depth, depth) else {
+                break;
+            };
             beta *= next.weight;
             through_specular = true;
             (o, d) = (next.origin, next.dir);

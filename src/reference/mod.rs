@@ -18,6 +18,7 @@ use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::Settings;
 use crate::stats::{MapStats, RenderStats};
+use crate::transport::photon::power_max_over_median;
 use crate::transport::PhotonMaps;
 use std::time::Instant;
 
@@ -72,6 +73,7 @@ pub fn photon_passes(scene: &Scene, job: &Job, progress: &dyn Progress, stats: &
         let map = if domain == Domain::CausticPhoton { &mut stats.caustic_map } else { &mut stats.global_map };
         map.emitted = p.emitted;
         map.stored = p.photons.len() as u64;
+        map.power_max_over_median = power_max_over_median(&p.photons);
         p.photons
     };
     let mut times = (0.0, 0.0);

@@ -57,6 +57,9 @@ pub struct Context<'a> {
     /// Photons the normal filter turned away in this context's estimates
     /// ([`Numerics::photons_filtered`](crate::stats::Numerics::photons_filtered)).
     pub filtered: AtomicU64,
+    /// Chains through mirrors and glass cut at `max_depth` in this context
+    /// ([`Numerics::camera_depth_cut`](crate::stats::Numerics::camera_depth_cut)).
+    pub depth_cut: AtomicU64,
 }
 
 impl<'a> Context<'a> {
@@ -74,7 +77,19 @@ impl<'a> Context<'a> {
             caustic_radius: job.settings.caustic_radius * d,
             secondary_gather: gather::secondary_gather_distance(scene, job),
             filtered: AtomicU64::new(0),
+            depth_cut: AtomicU64::new(0),
         }
+    }
+
+    /// Counts a chain cut at `max_depth`.
+    pub fn cut(&self) {
+        self.depth_cut.fetch_add(1, Ordering::Relaxed);
+    }
+
+    /// Chains cut at `max_depth` in this context so far.
+    #[must_use]
+    pub fn cuts(&self) -> u64 {
+        self.depth_cut.load(Ordering::Relaxed)
     }
 
     /// Photons the normal filter has turned away in this context's estimates so far.

@@ -1,6 +1,20 @@
 //! Photon transport, one vertex at a time: emission from the lights in proportion to power,
 //! deposit at non-specular hits, scattering with Russian roulette at constant power, and the
-//! tally that stops emission at exactly the photons a map asks for.
+//! tally that stops emission at exactly the photons a map asks for (and counts only the paths
+//! it keeps).
+//!
+//! **Bounded power.** Every photon keeps the power its path was emitted with (Jensen's rule):
+//! Russian roulette compares the power after a bounce with the path's emitted power (its
+//! largest channel), kills the photon with the probability of the shortfall and scales the
+//! survivor back up to it. Power grows only where a bounce's weight exceeds 1 — Veach's
+//! shading-normal correction, a Phong lobe's (n+2)/(n+1) — and then decays again at the next
+//! bounces that would take it below. Each factor of the correction is bounded by
+//! [`CORRECTION_MAX`] and the power by [`POWER_GROWTH_MAX`] times the emitted power, so **every
+//! stored photon's largest channel is at most `POWER_GROWTH_MAX · Φ_path / N`**, `Φ_path` the
+//! path's emitted power (`Φ/N` of the whole scene for every unaimed photon of an area light of
+//! uniform radiance; `Φ_light / (p_light · p_aim)` for an aimed caustic photon) and `N` the paths
+//! emitted. Both bounds are biases, derived at [`CORRECTION_MAX`] and [`POWER_GROWTH_MAX`];
+//! `--stats` counts the bounces the second one clamped (`numerics.photon_power_capped`).
 //!
 //! Global map: every non-specular hit (paths L{S|D}*D). Caustic map: photons whose every bounce
 //! so far was specular (LS+D); their paths are discarded at the first hit when it is not
@@ -15,10 +29,43 @@ use crate::photon_map::{flags, Photon};
 use crate::rng::{Domain, Sampler};
 use crate::scene::{Scene, SurfacePoint};
 use crate::settings::MAX_PATHS_PER_PHOTON;
+use crate::stats::Numerics;
 use glam::Vec3;
 
 /// Paths per batch: emission runs batch by batch until a map reaches its target.
 pub const BATCH: usize = 16_384;
+
+/// The most each of the two factors of Veach's shading-normal correction may be (see
+/// [`shading_normal_correction`]).
+///
+/// Unbounded, the arrival factor `|wo·ns| / |wo·ng|` grows without limit as a photon arrives
+/// grazing the triangle's plane, and the departure factor `|wi·ng| / |wi·ns|` as it leaves
+/// grazing the shading plane: both have a finite mean (arrivals are rare in proportion to
+/// `|wo·ng|`, departures to `|wi·ns|`) but a logarithmically divergent variance, and a seed of
+/// the white furnace (`scenes/hard/furnace-materials.toml --seed 11`) met a departure with
+/// `wi·ns = −1.8·10⁻⁸`: one photon of 5·10⁶ times its path's power, an image mean of 13.2
+/// where 2 is the most.
+///
+/// The bias of the bound, for shading normals θ from the geometric one and incident light of
+/// equal radiance from every direction (a furnace; the worst case, grazing light being as
+/// strong as any): the clamped arrival factor loses
+/// `sin²θ · C / (2 cos θ (C² − cos²θ)) ≈ θ² / (2C)` of the reflected power (the energy in the
+/// grazing bands `|wo·ng| < |wo·ns| / C` on both sides of the tilt), and the departure factor
+/// the same to first order. At C = 4: 0.1 % at θ = 5°, 0.4 % at 10°, 1.6 % at 20° (a numerical
+/// check over 4·10⁶ directions gave 0.10, 0.40 and 1.55 %); the bundled and public scenes'
+/// smooth meshes have θ below 5°. Light that actually arrives grazing and leaves the same way
+/// is rarer than in a furnace, so the loss in a lit room is smaller still.
+pub const CORRECTION_MAX: f32 = 4.0;
+
+/// The most a photon's power (its largest channel) may be, in multiples of its path's emitted
+/// power: a bounce that would take it higher is clamped to it and counted
+/// (`numerics.photon_power_capped`). Russian roulette returns a photon to its emitted power
+/// whenever a bounce takes it below, so only a run of bounces each weighing more than 1 can
+/// reach the bound: at most [`CORRECTION_MAX`]² = 16 for the shading normals times 2 for a
+/// Phong lobe at exponent 0 (its (n+2)/(n+1)) in one bounce. None of the bundled or hard-case
+/// scenes reaches it at any of the seeds `benches/photon-power.sh` tries; where a scene does,
+/// the clamped power is a bias the count measures.
+pub const POWER_GROWTH_MAX: f32 = 16.0;
 
 /// A map's photons as batches of paths come in, and the stopping rule: emission stops at the
 /// path that stores the target's last photon, so a map holds exactly the photons asked for and
@@ -26,12 +73,18 @@ pub const BATCH: usize = 16_384;
 /// stored (as in Jensen 1996, where emission stops when the map is full): one path of thousands,
 /// a bias far below the estimate's noise. Emission also stops after
 /// [`MAX_PATHS_PER_PHOTON`] paths per wanted photon, for scenes that store almost nothing.
+///
+/// The counts of [`PathCounts`] are summed over the kept paths only: the paths of the last
+/// batch past the one that stores the last photon are traced but their rays and numerics are
+/// not counted, so both engines count what the map holds, however a wave is cut.
 #[derive(Debug, Default)]
 pub struct Tally {
     target: u64,
     cap: u64,
     photons: Vec<Photon>,
     emitted: u64,
+    rays: u64,
+    numerics: Numerics,
 }
 
 impl Tally {
@@ -39,7 +92,14 @@ impl Tally {
     #[must_use]
     pub fn new(target: u32) -> Self {
         let target = u64::from(target);
-        Tally { target, cap: (target * MAX_PATHS_PER_PHOTON).max(BATCH as u64), photons: Vec::new(), emitted: 0 }
+        Tally {
+            target,
+            cap: (target * MAX_PATHS_PER_PHOTON).max(BATCH as u64),
+            photons: Vec::new(),
+            emitted: 0,
+            rays: 0,
+            numerics: Numerics::default(),
+        }
     }
 
     /// Whether another batch should be emitted.
@@ -67,26 +127,96 @@ impl Tally {
     }
 
     /// Adds the next batch, paths `emitted()..emitted() + BATCH`: the photons its paths stored,
-    /// in path order (and bounce order within a path), each with its path index.
-    pub fn add_batch(&mut self, stored: impl IntoIterator<Item = (u64, Photon)>) {
-        let end = self.emitted + BATCH as u64;
+    /// in path order (and bounce order within a path), each with its path index, and what each
+    /// path of the batch counted (`counts[j]` for path `emitted() + j`; only the kept paths'
+    /// are summed).
+    pub fn add_batch(&mut self, stored: impl IntoIterator<Item = (u64, Photon)>, counts: &[PathCounts]) {
+        let start = self.emitted;
+        let end = start + BATCH as u64;
+        self.emitted = end;
         for (path, photon) in stored {
-            debug_assert!((self.emitted..end).contains(&path), "path {path} is not in this batch");
+            debug_assert!((start..end).contains(&path), "path {path} is not in this batch");
             self.photons.push(photon);
             if self.photons.len() as u64 == self.target {
                 self.emitted = path + 1;
-                return;
+                break;
             }
         }
-        self.emitted = end;
+        let kept = ((self.emitted - start) as usize).min(counts.len());
+        for c in &counts[..kept] {
+            self.rays += u64::from(c.rays);
+            c.add_to(&mut self.numerics);
+        }
     }
 
-    /// The stored photons, each carrying its path's power over the paths emitted, and the paths
-    /// emitted.
+    /// The stored photons, each carrying its path's power over the paths emitted, with the
+    /// paths emitted and what they counted.
     #[must_use]
-    pub fn finish(mut self) -> (Vec<Photon>, u64) {
+    pub fn finish(mut self) -> TracedPhotons {
         normalise_power(&mut self.photons, self.emitted);
-        (self.photons, self.emitted)
+        TracedPhotons { photons: self.photons, emitted: self.emitted, rays: self.rays, numerics: self.numerics }
+    }
+}
+
+/// What a photon pass produced for one map.
+#[derive(Debug)]
+pub struct TracedPhotons {
+    /// Stored photons, power already divided by `emitted`.
+    pub photons: Vec<Photon>,
+    /// Paths emitted.
+    pub emitted: u64,
+    /// Ray segments traced by those paths.
+    pub rays: u64,
+    /// Those paths' photon counters (the photon fields of [`Numerics`]).
+    pub numerics: Numerics,
+}
+
+/// What one photon path counted, kept per path until the tally knows whether the path is kept.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PathCounts {
+    /// Ray segments traced.
+    pub rays: u16,
+    /// Bounces whose power [`POWER_GROWTH_MAX`] clamped.
+    pub capped: u16,
+    /// How the path ended, where that is counted.
+    pub end: PathEnd,
+}
+
+/// How a photon path ended, for the counters of [`Numerics`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PathEnd {
+    /// Absorbed, stored its last photon, or still going: nothing counted.
+    #[default]
+    Quiet,
+    /// Its emission was not finite (`photon_emission`).
+    EmissionNonFinite,
+    /// Its power stopped being finite at a bounce (`photon_scatter`).
+    ScatterNonFinite,
+    /// A BSDF sample of zero pdf (`photon_zero_pdf`).
+    ZeroPdf,
+    /// It left a scene closed around its lights (`photon_escaped`).
+    Escaped,
+    /// Still going after `max_depth` bounces (`photon_depth_cut`).
+    DepthCut,
+}
+
+impl PathCounts {
+    /// One more ray segment.
+    pub fn ray(&mut self) {
+        self.rays = self.rays.saturating_add(1);
+    }
+
+    /// Adds this path's counts to `n`.
+    pub fn add_to(&self, n: &mut Numerics) {
+        n.photon_power_capped += u64::from(self.capped);
+        match self.end {
+            PathEnd::Quiet => {}
+            PathEnd::EmissionNonFinite => n.photon_emission += 1,
+            PathEnd::ScatterNonFinite => n.photon_scatter += 1,
+            PathEnd::ZeroPdf => n.photon_zero_pdf += 1,
+            PathEnd::Escaped => n.photon_escaped += 1,
+            PathEnd::DepthCut => n.photon_depth_cut += 1,
+        }
     }
 }
 
@@ -107,6 +237,9 @@ pub struct PhotonRay {
     pub dir: Vec3,
     /// Power (not yet divided by the paths emitted).
     pub power: Vec3,
+    /// The largest channel of the power the path was emitted with: Russian roulette keeps the
+    /// photon at it, and [`POWER_GROWTH_MAX`] bounds the power by a multiple of it.
+    pub emitted: f32,
     /// True while every bounce so far was specular.
     pub specular_only: bool,
 }
@@ -158,7 +291,7 @@ pub fn start_photon(scene: &Scene, seed: u64, domain: Domain, index: u64, aim: b
         }
         _ => em.origin,
     };
-    Start::Photon(PhotonRay { origin, dir: em.direction, power, specular_only: true })
+    Start::Photon(PhotonRay { origin, dir: em.direction, power, emitted: power.max_element(), specular_only: true })
 }
 
 /// At a non-specular hit: stores the photon where its map wants it; returns whether the path
@@ -200,6 +333,8 @@ pub fn deposit_photon(
 pub enum Scattered {
     /// It goes on.
     Continue(PhotonRay),
+    /// It goes on, its power clamped to [`POWER_GROWTH_MAX`] times its emitted power (counted).
+    Capped(PhotonRay),
     /// Absorbed (Russian roulette or no valid direction).
     Absorbed,
     /// Its power stopped being finite; dropped and counted.
@@ -208,8 +343,9 @@ pub enum Scattered {
     ZeroPdf,
 }
 
-/// Scatters a photon at `sp` (BSDF sample, shading-normal correction, Russian roulette) with the
-/// random numbers of bounce `bounce + 1`.
+/// Scatters a photon at `sp` (BSDF sample, bounded shading-normal correction, Russian roulette
+/// at the path's emitted power, the power bound) with the random numbers of bounce
+/// `bounce + 1`.
 #[must_use]
 pub fn scatter_photon(s: &Sampler, sp: &SurfacePoint, bsdf: &Bsdf, photon: &PhotonRay, bounce: u32) -> Scattered {
     let wo = -photon.dir;
@@ -220,41 +356,99 @@ pub fn scatter_photon(s: &Sampler, sp: &SurfacePoint, bsdf: &Bsdf, photon: &Phot
         Err(_) => return Scattered::ZeroPdf,
     };
     // Photons carry power, the adjoint of radiance: with shading normals the BSDF is not
-    // symmetric, and Veach's correction |wo·ns||wi·ng| / (|wo·ng||wi·ns|) makes photon
-    // transport agree with camera paths (Veach 1997 §5.3; pbrt-v4 CorrectShadingNormal).
-    let weight = bs.weight * shading_normal_correction(&sp.frame, wo, bs.wi);
-    // Russian roulette keeps the largest channel's power constant: never gains energy.
-    let p_survive = weight.max_element().min(1.0);
-    if !(p_survive > 0.0) || s.get(bounce + 1, 3) >= p_survive {
-        return Scattered::Absorbed;
-    }
-    let power = photon.power * weight / p_survive;
+    // symmetric, and Veach's correction makes photon transport agree with camera paths (Veach
+    // 1997 §5.3; pbrt-v3 CorrectShadingNormal), each factor bounded by CORRECTION_MAX.
+    let power = photon.power * (bs.weight * shading_normal_correction(&sp.frame, wo, bs.wi));
     if !power.is_finite() {
         return Scattered::NonFinite;
     }
-    Scattered::Continue(PhotonRay {
+    let next = |power| PhotonRay {
         origin: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi),
         dir: bs.wi,
         power,
+        emitted: photon.emitted,
         specular_only: photon.specular_only && (bs.delta || bsdf.photon_specular()),
-    })
+    };
+    match roulette(power, photon.emitted, s.get(bounce + 1, 3)) {
+        Roulette::Absorbed => Scattered::Absorbed,
+        Roulette::Survives(p) => Scattered::Continue(next(p)),
+        Roulette::Capped(p) => Scattered::Capped(next(p)),
+    }
 }
 
-/// Veach's adjoint correction for shading normals, `|wo·ns||wi·ng| / (|wo·ng||wi·ns|)`; 1 where
-/// the shading normal is the geometric one, 0 where a denominator vanishes.
+/// What Russian roulette did to a photon's power.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Roulette {
+    /// Absorbed.
+    Absorbed,
+    /// It goes on with this power.
+    Survives(Vec3),
+    /// It goes on with this power, clamped to the bound.
+    Capped(Vec3),
+}
+
+/// Russian roulette at the path's emitted power `emitted` (a largest channel) with the uniform
+/// number `u`: a photon whose largest channel `m` fell below it survives with probability
+/// `m / emitted` and is scaled back up to it (unbiased: the expected power is unchanged); one at
+/// or above it goes on as it is, up to [`POWER_GROWTH_MAX`]` · emitted`, where it is clamped.
+/// Zero power is absorbed.
+#[must_use]
+pub fn roulette(power: Vec3, emitted: f32, u: f32) -> Roulette {
+    let m = power.max_element();
+    if !(m > 0.0) {
+        Roulette::Absorbed
+    } else if m < emitted {
+        let survive = m / emitted;
+        if u < survive {
+            Roulette::Survives(power * (emitted / m))
+        } else {
+            Roulette::Absorbed
+        }
+    } else if m > POWER_GROWTH_MAX * emitted {
+        Roulette::Capped(power * (POWER_GROWTH_MAX * emitted / m))
+    } else {
+        Roulette::Survives(power)
+    }
+}
+
+/// Veach's adjoint correction for shading normals, `|wo·ns||wi·ng| / (|wo·ng||wi·ns|)`, as the
+/// arrival factor `|wo·ns| / |wo·ng|` times the departure factor `|wi·ng| / |wi·ns|`, each at
+/// most [`CORRECTION_MAX`] (whose bias is derived there); 1 where the shading normal is the
+/// geometric one. A vanishing denominator gives the bound, a vanishing numerator 0.
 #[must_use]
 pub fn shading_normal_correction(frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> f32 {
     let (ng, ns) = frame.oriented(wo);
     if ns == ng {
         return 1.0;
     }
-    let num = wo.dot(ns).abs() * wi.dot(ng).abs();
-    let den = wo.dot(ng).abs() * wi.dot(ns).abs();
-    if den > 0.0 {
+    bounded_ratio(wo.dot(ns).abs(), wo.dot(ng).abs()) * bounded_ratio(wi.dot(ng).abs(), wi.dot(ns).abs())
+}
+
+/// `num / den` for non-negative operands, at most [`CORRECTION_MAX`] (also where `den` is 0).
+fn bounded_ratio(num: f32, den: f32) -> f32 {
+    if !(num > 0.0) {
+        0.0
+    } else if num < CORRECTION_MAX * den {
         num / den
     } else {
-        0.0
+        CORRECTION_MAX
     }
+}
+
+/// The largest photon power over the median one (each photon's largest channel), for the
+/// stats: how far the heaviest photon stands above a typical one. 0 for no photons.
+#[must_use]
+pub fn power_max_over_median(photons: &[Photon]) -> f64 {
+    let mut power: Vec<f32> = photons.iter().map(|p| p.power.max_element()).collect();
+    if power.is_empty() {
+        return 0.0;
+    }
+    let mid = power.len() / 2;
+    let (_, &mut median, _) = power.select_nth_unstable_by(mid, f32::total_cmp);
+    let max = power.iter().copied().fold(median, f32::max);
+    // A median of zero (most photons black) would divide by zero: the ratio to the smallest
+    // positive float instead, finite in the JSON.
+    f64::from(max) / f64::from(median.max(f32::MIN_POSITIVE))
 }
 
 /// Powers of the first-hit photons of a global pass, for flux checks: their sum should be the
@@ -279,20 +473,87 @@ mod tests {
         let cuts: Vec<u64> = (1..=6)
             .map(|need| {
                 let mut t = Tally::new(need);
-                t.add_batch(batch.iter().copied());
+                t.add_batch(batch.iter().copied(), &[]);
                 assert_eq!(t.stored(), u64::from(need));
                 t.emitted()
             })
             .collect();
         assert_eq!(cuts, [2, 2, 4, 4, 4, 5]);
         let mut short = Tally::new(100_000);
-        short.add_batch(batch.iter().copied());
+        short.add_batch(batch.iter().copied(), &[]);
         assert_eq!((short.stored(), short.emitted(), short.wants_more()), (6, BATCH as u64, true));
         // A map of 10 photons may emit one batch at most (the path cap is at least a batch).
         let mut capped = Tally::new(10);
-        capped.add_batch(batch.iter().copied());
+        capped.add_batch(batch.iter().copied(), &[]);
         assert!(!capped.wants_more());
-        let (photons, emitted) = short.finish();
-        assert_eq!((photons[0].power, emitted), (Vec3::splat(1.0 / BATCH as f32), BATCH as u64));
+        let traced = short.finish();
+        assert_eq!((traced.photons[0].power, traced.emitted), (Vec3::splat(1.0 / BATCH as f32), BATCH as u64));
+    }
+
+    /// Only the kept paths' counts are summed: with 3 photons wanted the tally stops at path 3
+    /// (paths 0..4 kept), so path 4's rays and its escape are not counted.
+    #[test]
+    fn only_kept_paths_are_counted() {
+        let p = Photon { position: Vec3::ZERO, power: Vec3::ONE, wi: Vec3::Z, normal: Vec3::Z, flags: 0 };
+        let batch: Vec<(u64, Photon)> = [1u64, 1, 3, 3, 3, 4].iter().map(|&path| (path, p)).collect();
+        let mut counts = vec![PathCounts { rays: 2, ..Default::default() }; BATCH];
+        counts[1].end = PathEnd::ScatterNonFinite;
+        counts[2].capped = 3;
+        counts[4].end = PathEnd::Escaped;
+        let mut t = Tally::new(3);
+        t.add_batch(batch.iter().copied(), &counts);
+        let traced = t.finish();
+        assert_eq!((traced.emitted, traced.rays), (4, 8));
+        assert_eq!(
+            (traced.numerics.photon_scatter, traced.numerics.photon_power_capped, traced.numerics.photon_escaped),
+            (1, 3, 0)
+        );
+    }
+
+    /// Russian roulette at the emitted power: below it a photon survives with probability
+    /// m / emitted at exactly the emitted power (so the expected power is unchanged), at or
+    /// above it goes on unchanged, above the bound is clamped; zero power is absorbed.
+    #[test]
+    fn roulette_keeps_the_emitted_power() {
+        let p = Vec3::new(0.2, 0.5, 0.1);
+        assert_eq!(roulette(p, 1.0, 0.49), Roulette::Survives(p * 2.0));
+        assert_eq!(roulette(p, 1.0, 0.5), Roulette::Absorbed);
+        // The expected power over the uniform numbers is the power.
+        let n = 1000;
+        let mean: Vec3 = (0..n)
+            .map(|i| match roulette(p, 1.0, (i as f32 + 0.5) / n as f32) {
+                Roulette::Survives(q) => q,
+                _ => Vec3::ZERO,
+            })
+            .sum::<Vec3>()
+            / n as f32;
+        assert!((mean - p).abs().max_element() < 1e-6, "{mean}");
+        assert_eq!(roulette(p * 3.0, 1.0, 0.99), Roulette::Survives(p * 3.0));
+        let Roulette::Capped(q) = roulette(p * 100.0, 1.0, 0.0) else { panic!() };
+        assert!((q.max_element() - POWER_GROWTH_MAX).abs() < 1e-5, "{q}");
+        assert_eq!(roulette(Vec3::ZERO, 1.0, 0.0), Roulette::Absorbed);
+        assert_eq!(roulette(Vec3::splat(f32::NAN), 1.0, 0.0), Roulette::Absorbed);
+    }
+
+    /// The correction's factors are each at most CORRECTION_MAX: a departure grazing the shading
+    /// plane (the furnace's spike: wi·ns = −1.8e-8) gives the bound, not 5·10⁶; with equal
+    /// normals it is exactly 1, and it is the unbounded ratio where both factors are moderate.
+    #[test]
+    fn the_shading_normal_correction_is_bounded() {
+        let ng = Vec3::Z;
+        let ns = Vec3::new(0.2, 0.0, 1.0).normalize();
+        let frame = SurfaceFrame { ng, ns };
+        let wo = Vec3::new(0.3, 0.4, 0.8).normalize();
+        let grazing = Vec3::new(-ns.z, 0.3, ns.x).normalize();
+        assert!(grazing.dot(ns).abs() < 1e-6 && grazing.dot(ng) > 0.1);
+        let c = shading_normal_correction(&frame, wo, grazing);
+        let arrival = wo.dot(ns) / wo.dot(ng);
+        assert!((c - arrival * CORRECTION_MAX).abs() < 1e-5, "{c}");
+        let wi = Vec3::new(-0.5, 0.1, 0.8).normalize();
+        let full = wo.dot(ns) * wi.dot(ng) / (wo.dot(ng) * wi.dot(ns));
+        assert!((shading_normal_correction(&frame, wo, wi) - full).abs() < 1e-6);
+        assert_eq!(shading_normal_correction(&SurfaceFrame { ng, ns: ng }, wo, grazing), 1.0);
+        let along = Vec3::new(1.0, 0.0, 0.0);
+        assert!(shading_normal_correction(&frame, along, wi) <= CORRECTION_MAX * CORRECTION_MAX);
     }
 }

@@ -38,6 +38,42 @@ pub fn continue_ray(sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler, bounc
     })
 }
 
+/// Chain depth (specular bounces so far) from which camera-side chains play Russian roulette
+/// ([`continue_chain`]). Below it every chain goes on: a camera ray seeing a mirror of
+/// reflectance 0.95 would otherwise be killed one time in twenty, each kill adding noise (a
+/// survivor's weight of 1/0.95) for no work saved; from it on, chains that lose light (mirrors
+/// facing each other) end by roulette rather than at the `max_depth` safety cap.
+pub const CHAIN_ROULETTE_DEPTH: u32 = 3;
+
+/// [`continue_ray`] for a camera-side chain (camera, gather or glossy ray) at chain depth
+/// `depth`: from [`CHAIN_ROULETTE_DEPTH`] on, Russian roulette on the bounce's weight without
+/// refraction's radiance scale ([`Bsdf::radiance_scale`]): the chain survives with probability
+/// min(1, its largest channel) — dimension 3 of `bounce` — and the survivor's weight is divided
+/// by it (unbiased). Glass and water (weight 1) always go on; they end where the ray leaves
+/// them.
+#[must_use]
+#[inline]
+pub fn continue_chain(
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    s: &Sampler,
+    bounce: u32,
+    depth: u32,
+) -> Option<Bounce> {
+    let mut next = continue_ray(sp, bsdf, wo, s, bounce)?;
+    if depth >= CHAIN_ROULETTE_DEPTH {
+        let kept = (next.weight / bsdf.radiance_scale(&sp.frame, wo, next.dir)).max_element();
+        if kept < 1.0 {
+            if !(kept > 0.0) || s.get(bounce, 3) >= kept {
+                return None;
+            }
+            next.weight /= kept;
+        }
+    }
+    Some(next)
+}
+
 /// Where a chain through mirrors and glass ends: its first non-specular hit.
 #[derive(Clone, Copy, Debug)]
 pub struct ChainEnd {
@@ -54,10 +90,11 @@ pub struct ChainEnd {
 }
 
 /// Follows a ray through mirrors and glass (at most `max_depth` bounces, sampling each with `s`
-/// at bounce `first_bounce + depth`) to its first non-specular hit. `None` if it escapes or is
-/// absorbed. It also passes what photons pass ([`Bsdf::photon_specular`]: frosted glass,
-/// smooth rough metal), sampling their BSDF: every path ends where photons are stored, so the
-/// maps read there hold the light that came through.
+/// at bounce `first_bounce + depth`, [`continue_chain`]'s roulette included) to its first
+/// non-specular hit. `None` if it escapes, is absorbed, or is cut at `max_depth` (counted in
+/// `ctx`). It also passes what photons pass ([`Bsdf::photon_specular`]: frosted glass, smooth
+/// rough metal), sampling their BSDF: every path ends where photons are stored, so the maps
+/// read there hold the light that came through.
 pub fn first_non_specular(
     ctx: &Context,
     mut o: Vec3,
@@ -76,7 +113,11 @@ pub fn first_non_specular(
         if !(bsdf.is_delta() || bsdf.photon_specular()) {
             return Some(ChainEnd { point: sp, dir: d, beta, t: hit.t, bounces: depth });
         }
-        let next = continue_ray(&sp, bsdf, -d, s, first_bounce + depth)?;
+        if depth == ctx.settings.max_depth {
+            ctx.cut();
+            return None;
+        }
+        let next = continue_chain(&sp, bsdf, -d, s, first_bounce + depth, depth)?;
         beta *= next.weight;
         (o, d) = (next.origin, next.dir);
     }

@@ -7,6 +7,7 @@ use super::{CameraWork, PhotonWork, Shared, StageStats};
 use crate::material::Bsdf;
 use crate::scene::Scene;
 use crate::transport::gather::{lands_near, secondary_gather_distance};
+use crate::transport::photon::PathEnd;
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
@@ -38,7 +39,10 @@ pub fn classify_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut s
     let w = &mut *work;
     classify(&shared.scene, &w.queue.hits, false, &mut w.classified);
     if shared.scene.encloses_lights {
-        w.numerics.photon_escaped += w.classified.escaped.len() as u64;
+        for &l in &w.classified.escaped {
+            let path = w.queue.path[l as usize];
+            w.counts[(path - w.first_path) as usize].end = PathEnd::Escaped;
+        }
     }
     stats.record("classify_photons", w.queue.len(), t);
 }

@@ -46,6 +46,7 @@ pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
                     origin: queue.rays.origin(i),
                     dir: queue.rays.direction(i),
                     power: queue.power[i],
+                    emitted: queue.emitted[i],
                     specular_only: queue.specular_only[i],
                 };
                 out.clear();

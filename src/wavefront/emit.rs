@@ -6,7 +6,7 @@ use super::{par_columns, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
 use crate::film::{Term, Terms};
 use crate::rng::Domain;
 use crate::transport::camera::camera_ray;
-use crate::transport::photon::{start_photon, Start, BATCH};
+use crate::transport::photon::{start_photon, PathCounts, PathEnd, Start, BATCH};
 use crate::transport::streams;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -21,13 +21,15 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
     let n = work.batches.max(1) * BATCH;
     let w = &mut *work;
     w.queue.clear();
-    let (queue, mut non_finite) = (&mut w.queue, 0);
+    w.counts.clear();
+    w.counts.resize(n, PathCounts::default());
+    let (queue, counts) = (&mut w.queue, &mut w.counts);
     // Each chunk fills its own queue; chunks are appended in lane order.
     par_columns(
         n,
         CHUNK,
         shared.job.threads,
-        |r, part: &mut (PhotonQueue, u64)| {
+        |r, part: &mut (PhotonQueue, Vec<usize>)| {
             for i in r {
                 let path = first + i as u64;
                 match start_photon(scene, seed, domain, path, shared.job.settings.aim_caustics) {
@@ -37,19 +39,21 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
                         path,
                         bounce: 0,
                         power: p.power,
+                        emitted: p.emitted,
                         specular_only: true,
                     }),
                     Start::Dark => {}
-                    Start::NonFinite => part.1 += 1,
+                    Start::NonFinite => part.1.push(i),
                 }
             }
         },
         |part| {
             queue.append(&mut part.0);
-            non_finite += part.1;
+            for &i in &part.1 {
+                counts[i].end = PathEnd::EmissionNonFinite;
+            }
         },
     );
-    w.numerics.photon_emission += non_finite;
     stats.record("emit_photons", n, t);
 }
 

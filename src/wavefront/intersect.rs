@@ -73,7 +73,10 @@ pub fn intersect_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut 
     };
     closest_hits(&shared, queue, &q.rays, &mut q.hits);
     let n = q.len();
-    work.rays += n as u64;
+    let w = &mut *work;
+    for &path in &w.queue.path {
+        w.counts[(path - w.first_path) as usize].ray();
+    }
     stats.record("intersect_photons", n, t);
 }
 

@@ -10,7 +10,7 @@ use crate::progress::Progress;
 use crate::rng::Domain;
 use crate::scene::Scene;
 use crate::stats::RenderStats;
-use crate::transport::photon::{Tally, BATCH};
+use crate::transport::photon::{power_max_over_median, Tally, BATCH};
 use crate::transport::PhotonMaps;
 use bevy_ecs::prelude::*;
 use std::time::Instant;
@@ -66,13 +66,13 @@ pub fn photon_pass(
             let mut deposits = std::mem::take(&mut w.deposits);
             deposits.sort_by_key(|(path, bounce, _)| (*path, *bounce));
             let mut rest = deposits.as_slice();
-            for _ in 0..batches {
+            for counts in w.counts.chunks(BATCH) {
                 if !tally.wants_more() {
                     break;
                 }
                 let end = tally.emitted() + BATCH as u64;
                 let n = rest.partition_point(|(path, _, _)| *path < end);
-                tally.add_batch(rest[..n].iter().map(|(path, _, p)| (*path, *p)));
+                tally.add_batch(rest[..n].iter().map(|(path, _, p)| (*path, *p)), counts);
                 rest = &rest[n..];
             }
             per_batch = tally.stored() as f64 / (tally.emitted() / BATCH as u64) as f64;
@@ -81,10 +81,10 @@ pub fn photon_pass(
             reported = now;
         }
         progress.finish();
-        let (photons, emitted) = tally.finish();
-        let w = world.resource::<PhotonWork>();
-        stats.rays.photon += w.rays;
-        stats.numerics += w.numerics;
+        let traced = tally.finish();
+        stats.rays.photon += traced.rays;
+        stats.numerics += traced.numerics;
+        let (photons, emitted) = (traced.photons, traced.emitted);
         let (map, time) = if k == 0 {
             (&mut stats.global_map, &mut stats.times.global_photons_s)
         } else {
@@ -92,6 +92,7 @@ pub fn photon_pass(
         };
         map.emitted = emitted;
         map.stored = photons.len() as u64;
+        map.power_max_over_median = power_max_over_median(&photons);
         *time = t.elapsed().as_secs_f64();
         stats.phases.push(format!("{name} (wavefront)"));
         maps_photons[k] = photons;

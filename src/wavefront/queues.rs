@@ -8,7 +8,7 @@
 //! - rays: origin 12, direction 12 (f32 columns, as traversal reads them);
 //! - hits: triangle 4 (u32::MAX = escaped), t 4, barycentrics 12 (all three, exactly as the
 //!   triangle test returned them, so surface points match the reference engine's bit for bit);
-//! - photons: path index 8, bounce 4, power 12, specular-only flag 1 → 69 B a lane with ray and hit;
+//! - photons: path index 8, bounce 4, power 12, emitted power 4, specular-only flag 1 → 73 B a lane with ray and hit;
 //! - camera-pass paths: sample 4, kind 1, sampler key 8, bounce base 1, depth 4, term 1,
 //!   throughput 12, through-specular flag 1 → 76 B a lane with ray and hit;
 //! - shadow rays: sample 4, term 1, t_max 4, contribution 12, plus the ray.
@@ -290,6 +290,8 @@ soa_queue! {
         bounce: u32,
         /// Power per channel.
         power: Vec3,
+        /// Largest channel of the path's emitted power (Russian roulette's reference).
+        emitted: f32,
         /// True while every bounce so far was specular.
         specular_only: bool,
     }

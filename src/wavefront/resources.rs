@@ -9,6 +9,7 @@ use crate::rng::Domain;
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::stats::{Numerics, RayCounts};
+use crate::transport::photon::PathCounts;
 use crate::transport::PhotonMaps;
 use bevy_ecs::prelude::*;
 use std::sync::Arc;
@@ -45,11 +46,16 @@ pub struct PhotonWork {
     pub survivors: Vec<u32>,
     /// Stored photons keyed by (path, bounce), the reference engine's order.
     pub deposits: Vec<(u64, u32, Photon)>,
-    /// Ray segments traced.
-    pub rays: u64,
-    /// Paths dropped for non-finite power, at emission and at a bounce (the photon fields of
-    /// [`Numerics`](Numerics)).
-    pub numerics: Numerics,
+    /// What each path of the wave counted (rays, clamped bounces, how it ended), indexed by
+    /// path − `first_path`: the tally sums the kept paths' only.
+    pub counts: Vec<PathCounts>,
+}
+
+impl PhotonWork {
+    /// The counts of path `path` of this wave.
+    pub fn count(&mut self, path: u64) -> &mut PathCounts {
+        &mut self.counts[(path - self.first_path) as usize]
+    }
 }
 
 /// Camera-pass state for one wave of samples.

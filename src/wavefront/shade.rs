@@ -9,18 +9,17 @@ use super::queues::{PathKind, PathQueue, PhotonLane, PhotonQueue, Segment, Shado
 use super::{par_columns, par_lanes, CameraWork, Maps, PhotonWork, Shared, StageStats, CHUNK};
 use crate::film::{PixelMean, Term};
 use crate::rng::{Domain, Sampler};
-use crate::stats::Numerics;
 use crate::transport::direct::{direct_light_rays, ShadowRay};
 use crate::transport::gather::{gather_rays, glossy_ray};
-use crate::transport::photon::{scatter_photon, PhotonRay, Scattered};
-use crate::transport::specular::continue_ray;
+use crate::transport::photon::{scatter_photon, PathEnd, PhotonRay, Scattered};
+use crate::transport::specular::continue_chain;
 use crate::transport::{streams, Context};
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
-/// Scatters the photon lanes `lanes` into `next`; returns the paths dropped (the photon fields of
-/// [`Numerics`](crate::stats::Numerics)).
-fn scatter_lanes(shared: &Shared, work: &PhotonWork, lanes: &[u32], next: &mut PhotonQueue) -> Numerics {
+/// Scatters the photon lanes `lanes` into `next`, counting per path what the bounce clamped,
+/// dropped or cut.
+fn scatter_lanes(shared: &Shared, work: &mut PhotonWork, lanes: &[u32], next: &mut PhotonQueue) {
     let scene = &*shared.scene;
     let domain = work.domain.unwrap_or(Domain::GlobalPhoton);
     let q = &work.queue;
@@ -33,6 +32,7 @@ fn scatter_lanes(shared: &Shared, work: &PhotonWork, lanes: &[u32], next: &mut P
                 origin: q.rays.origin(i),
                 dir: q.rays.direction(i),
                 power: q.power[i],
+                emitted: q.emitted[i],
                 specular_only: q.specular_only[i],
             };
             let s = Sampler::new(shared.job.pass.seed, domain, q.path[i]);
@@ -40,25 +40,40 @@ fn scatter_lanes(shared: &Shared, work: &PhotonWork, lanes: &[u32], next: &mut P
         })
         .collect()
     });
-    let mut dropped = Numerics::default();
     for (i, r) in results {
-        match r {
-            Scattered::Continue(p) if q.bounce[i] + 1 < shared.job.settings.max_depth => {
-                next.push(PhotonLane {
-                    origin: p.origin,
-                    dir: p.dir,
-                    path: q.path[i],
-                    bounce: q.bounce[i] + 1,
-                    power: p.power,
-                    specular_only: p.specular_only,
-                });
+        let (path, bounce) = (work.queue.path[i], work.queue.bounce[i]);
+        let counts = work.count(path);
+        let p = match r {
+            Scattered::Continue(p) => p,
+            Scattered::Capped(p) => {
+                counts.capped = counts.capped.saturating_add(1);
+                p
             }
-            Scattered::NonFinite => dropped.photon_scatter += 1,
-            Scattered::ZeroPdf => dropped.photon_zero_pdf += 1,
-            _ => {}
+            Scattered::NonFinite => {
+                counts.end = PathEnd::ScatterNonFinite;
+                continue;
+            }
+            Scattered::ZeroPdf => {
+                counts.end = PathEnd::ZeroPdf;
+                continue;
+            }
+            Scattered::Absorbed => continue,
+        };
+        // Russian roulette did not end it within max_depth bounces: the safety cap does.
+        if bounce + 1 >= shared.job.settings.max_depth {
+            counts.end = PathEnd::DepthCut;
+            continue;
         }
+        next.push(PhotonLane {
+            origin: p.origin,
+            dir: p.dir,
+            path,
+            bounce: bounce + 1,
+            power: p.power,
+            emitted: p.emitted,
+            specular_only: p.specular_only,
+        });
     }
-    dropped
 }
 
 /// Photons at mirrors and surviving diffuse photons scatter into the next queue.
@@ -66,8 +81,7 @@ pub fn scatter_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
     let t = Instant::now();
     let lanes: Vec<u32> = work.classified.mirror.iter().chain(&work.survivors).copied().collect();
     let mut next = std::mem::take(&mut work.next);
-    let dropped = scatter_lanes(&shared, &work, &lanes, &mut next);
-    work.numerics += dropped;
+    scatter_lanes(&shared, &mut work, &lanes, &mut next);
     work.next = next;
     stats.record("scatter_photons", lanes.len(), t);
 }
@@ -77,8 +91,7 @@ pub fn refract_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
     let t = Instant::now();
     let lanes = work.classified.glass.clone();
     let mut next = std::mem::take(&mut work.next);
-    let dropped = scatter_lanes(&shared, &work, &lanes, &mut next);
-    work.numerics += dropped;
+    scatter_lanes(&shared, &mut work, &lanes, &mut next);
     work.next = next;
     stats.record("refract_photons", lanes.len(), t);
 }
@@ -260,8 +273,9 @@ pub fn spawn_glossy_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
 }
 
 /// Continues the lanes `lanes` (at mirrors or glass) by sampling the delta BSDF with the
-/// random numbers of bounce `base + depth`; chains stop after `max_depth` bounces.
-fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32]) -> PathQueue {
+/// random numbers of bounce `base + depth` ([`continue_chain`]'s roulette included); chains
+/// stop after `max_depth` bounces, and those cut there are counted in `cuts`.
+fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32], cuts: &mut u64) -> PathQueue {
     let scene = &*shared.scene;
     let max_depth = shared.job.settings.max_depth;
     let w = work;
@@ -270,18 +284,19 @@ fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32]) -> PathQ
         lanes.len(),
         CHUNK,
         shared.job.threads,
-        |r, part: &mut PathQueue| {
-            part.reserve(r.len());
+        |r, part: &mut (PathQueue, u64)| {
+            part.0.reserve(r.len());
             for s in r.filter_map(|j| {
                 let i = lanes[j] as usize;
+                let sp = scene.surface(&w.paths.hits.get(i)?);
                 if w.paths.depth[i] >= max_depth {
+                    part.1 += 1;
                     return None;
                 }
-                let sp = scene.surface(&w.paths.hits.get(i)?);
                 let bsdf = &scene.bsdf(&sp);
                 let s = Sampler::from_key(w.paths.key[i]);
-                let bounce = u32::from(w.paths.base[i]) + w.paths.depth[i];
-                let next = continue_ray(&sp, bsdf, -w.paths.rays.direction(i), &s, bounce)?;
+                let (depth, bounce) = (w.paths.depth[i], u32::from(w.paths.base[i]) + w.paths.depth[i]);
+                let next = continue_chain(&sp, bsdf, -w.paths.rays.direction(i), &s, bounce, depth)?;
                 Some(Segment {
                     origin: next.origin,
                     dir: next.dir,
@@ -295,10 +310,13 @@ fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32]) -> PathQ
                     through_specular: w.paths.kind[i] == PathKind::Camera,
                 })
             }) {
-                part.push(s);
+                part.0.push(s);
             }
         },
-        |part| out.append(part),
+        |part| {
+            out.append(&mut part.0);
+            *cuts += part.1;
+        },
     );
     out
 }
@@ -307,7 +325,9 @@ fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32]) -> PathQ
 pub fn reflect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let lanes = work.classified.mirror.clone();
-    let mut segments = continue_specular(&shared, &work, &lanes);
+    let mut cuts = 0;
+    let mut segments = continue_specular(&shared, &work, &lanes, &mut cuts);
+    work.numerics.camera_depth_cut += cuts;
     work.next.append(&mut segments);
     stats.record("reflect_paths", lanes.len(), t);
 }
@@ -316,7 +336,9 @@ pub fn reflect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stat
 pub fn refract_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = Instant::now();
     let lanes = work.classified.glass.clone();
-    let mut segments = continue_specular(&shared, &work, &lanes);
+    let mut cuts = 0;
+    let mut segments = continue_specular(&shared, &work, &lanes, &mut cuts);
+    work.numerics.camera_depth_cut += cuts;
     work.next.append(&mut segments);
     stats.record("refract_paths", lanes.len(), t);
 }
