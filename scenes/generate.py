@@ -369,6 +369,33 @@ def furnace_materials(folder):
 target = [0.0, 0.0, -0.35]
 fov = 60''')
 
+    scene_toml(f"{folder}/furnace-rough.toml", '''# Energy, written by scenes/generate.py: furnace-materials.obj's spheres made rough — a white
+# rough plastic (the coat over a white base), a rough conductor whose photons are stored on it
+# (roughness 0.5), a frosted glass (roughness 0.4) and a grey Lambertian (0.5). Lossless surfaces
+# return Le / (1 - 0.5) = 2; the microfacets' shadowing loses a little; nothing may exceed 2.''', 'file = "furnace-materials.obj"', '''eye = [0.0, 0.0, 0.6]
+target = [0.0, 0.0, -0.35]
+fov = 60''', '''
+[materials.white]
+type = "rough_plastic"
+kd = [1.0, 1.0, 1.0]
+ior = 1.5
+roughness = 0.3
+
+[materials.mirror]
+type = "rough_conductor"
+ks = [1.0, 1.0, 1.0]
+roughness = 0.5
+
+[materials.glass]
+type = "rough_dielectric"
+ior = 1.5
+roughness = 0.4
+
+[materials.glossy]
+type = "lambert"
+kd = [0.5, 0.5, 0.5]
+''')
+
 furnace_materials("hard")
 
 def watertight(folder):

@@ -70,52 +70,6 @@ fn thin_wall_lets_nothing_through() {
     }
 }
 
-/// Case 5: a directional light θ from a plane's normal gives irradiance E⊥·cos θ (catches a
-/// doubled or missing cosine), at θ = 0°, 60°, 85° and 89°:
-/// - light sampling, both engines: every pixel's direct term is kd/π · cos θ (a delta light —
-///   one unblocked shadow ray per sample — so only rounding separates them: 1e-5 relative);
-/// - photons, both engines' maps: a box-kernel estimate of radius 0.8 at the plane's centre. It
-///   holds ≈ 40 000 · π·0.8²/4 ≈ 20 000 photons of equal power, so its relative standard deviation
-///   is ≈ 1/√20 000 = 0.7 %; the 2 % is 2.8 of them.
-#[test]
-fn grazing_light_follows_the_cosine_law() {
-    use photonwave::code_path::CodePath;
-    use photonwave::photon_map::{Filter, Lookup, Reflectance};
-    use photonwave::settings::Kernel;
-    for deg in [0u32, 60, 85, 89] {
-        let loaded = hard(&format!("grazing-{deg}.toml"));
-        let cos = (deg as f32).to_radians().cos();
-        let scene = Arc::new(loaded.scene);
-        let rays = loaded.camera.unwrap().prepare(16, 16).unwrap();
-        let s = Settings { width: 16, height: 16, spp: 1, photons: 40_000, final_gather: false, ..Default::default() };
-        let expected = 0.5 * cos / std::f32::consts::PI;
-        for engine in ENGINES {
-            let film = render(&scene, &rays, &s, engine, None, &NoProgress).unwrap().0;
-            for (i, t) in film.pixels.iter().enumerate() {
-                let err = (t.direct - Vec3::splat(expected)).abs().max_element();
-                assert!(err <= 1e-5 * expected, "{deg}°, {engine:?}, pixel {i}: direct {} for {expected}", t.direct);
-                // A lone plane reflects nothing back onto itself.
-                assert_eq!(t.indirect + t.caustic + t.specular, Vec3::ZERO, "{deg}°, {engine:?}, pixel {i}");
-            }
-        }
-        let (reference, _, _) = photonwave::reference::build_maps(&scene, &s).unwrap();
-        let (wavefront, _) = photonwave::wavefront::build_maps(scene.clone(), &s).unwrap();
-        for (name, map) in [("reference", &reference.global), ("wavefront", &wavefront.global)] {
-            let q = Lookup {
-                p: Vec3::ZERO,
-                k: 0,
-                r_max: 0.8,
-                kernel: Kernel::Box,
-                filter: Filter { n: Vec3::Y, flags_mask: 0 },
-            };
-            let e = map.estimate_radius(CodePath::Simd, &q, Reflectance::Constant(Vec3::ONE));
-            let ratio = e.radiance / cos;
-            println!("{deg}°, {name}: photon irradiance / cos θ = {ratio} from {} photons", e.count);
-            assert!((ratio - Vec3::ONE).abs().max_element() < 0.02, "{deg}°, {name}: {ratio} ({} photons)", e.count);
-        }
-    }
-}
-
 /// Case 10: a light mesh holding a zero-area triangle renders exactly as the same light without
 /// it, on both engines: the triangle is dropped with a warning, never sampled (each remaining
 /// emitter has a positive probability and the light's power is unchanged).
@@ -141,50 +95,7 @@ fn a_zero_area_emitter_triangle_changes_nothing() {
     }
 }
 
-/// Case 2: a point light (I = 1 W/sr) at the centre of a glass sphere in a closed room. Rays leave
-/// the sphere along radii, unbent, so direct light is exactly 0 everywhere (shadow rays meet the
-/// glass) and the caustic map carries it all: irradiance I·cos θ/D² on the walls. Over a disk of
-/// radius r centred on a wall at distance 1 that averages (2/r²)·(1 − 1/√(1 + r²)) = 0.7917 for
-/// r = 0.6. The box-kernel estimate counts photons of equal power (Fresnel choices are sampled,
-/// not weighted), so its relative standard deviation is 1/√count (≈ 1 % here); the tolerance is
-/// 3 of them plus 1 % for the tessellated sphere's shading normals bending rays slightly.
-#[test]
-fn light_inside_glass_reaches_the_walls_only_as_caustics() {
-    use photonwave::code_path::CodePath;
-    use photonwave::photon_map::{Filter, Lookup, Reflectance};
-    use photonwave::settings::Kernel;
-    let loaded = hard("light-in-glass.toml");
-    let scene = Arc::new(loaded.scene);
-    let rays = loaded.camera.unwrap().prepare(16, 16).unwrap();
-    let s = Settings {
-        width: 16,
-        height: 16,
-        spp: 1,
-        photons: 5_000,
-        caustic_photons: 150_000,
-        gather_rays: 4,
-        ..Default::default()
-    };
-    for engine in ENGINES {
-        let film = render(&scene, &rays, &s, engine, None, &NoProgress).unwrap().0;
-        assert!(film.pixels.iter().all(|t| t.direct == Vec3::ZERO), "{engine:?}: direct light through glass");
-        assert!(film.pixels.iter().filter(|t| t.caustic.min_element() > 0.0).count() > 200, "{engine:?}");
-    }
-    let r = 0.6f32;
-    let expected = 2.0 / (r * r) * (1.0 - 1.0 / (1.0 + r * r).sqrt());
-    let (reference, _, _) = photonwave::reference::build_maps(&scene, &s).unwrap();
-    let (wavefront, _) = photonwave::wavefront::build_maps(scene.clone(), &s).unwrap();
-    for (name, map) in [("reference", &reference.caustic), ("wavefront", &wavefront.caustic)] {
-        for (wall, p, n) in [("back", -Vec3::Z, Vec3::Z), ("floor", -Vec3::Y, Vec3::Y)] {
-            let q = Lookup { p, k: 0, r_max: r, kernel: Kernel::Box, filter: Filter { n, flags_mask: 0 } };
-            let e = map.estimate_radius(CodePath::Simd, &q, Reflectance::Constant(Vec3::ONE));
-            let ratio = e.radiance / expected;
-            let tol = 3.0 / (e.count as f32).sqrt() + 0.01;
-            println!("{name}, {wall}: caustic irradiance / I·cos θ/D² = {ratio} from {} photons (± {tol})", e.count);
-            assert!((ratio - Vec3::ONE).abs().max_element() < tol, "{name}, {wall}: {ratio} ({} photons)", e.count);
-        }
-    }
-}
+// Cases 2, 5, 6 (light pipe), 7 and 9 (photons) are in tests/optics.rs, at every seed.
 
 /// Case 1: the mirror-and-glass Cornell box at 1e-4, 1 and 1e5 units, on both engines. Ray
 /// offsets, error bounds and search radii follow the scene's size, and radiance is invariant
@@ -199,30 +110,34 @@ fn light_inside_glass_reaches_the_walls_only_as_caustics() {
 ///   and 0–2 paths part (global path 11 625 with lights listed in input order: drift 1.2·10⁻⁵
 ///   after seven bounces, then the roulette flips on a facet edge). So a path *parts* if its
 ///   photon count differs or a photon lands more than 10⁻³ of the diagonal from its twin; at most
-///   one path in 1 000 may part (at the measured 10⁻⁵ per path, 0.1–0.2 are expected among the
-///   12 000–23 000 traced here, and more than 12 has Poisson probability < 10⁻¹⁸), and agreeing
+///   one path in 1 000 may part, over 640 paths of each of the 32 seeds (at the measured 10⁻⁵
+///   per path, 0.2 are expected among those 20 480, and more than 20 has Poisson probability
+///   < 10⁻³⁰), and agreeing
 ///   photons may drift by 10⁻⁵ on average. A step that depends on the scale (an absolute offset
 ///   or radius) parts most paths at their first bounce: an offset of 10⁻⁴ added to every ray
 ///   origin parted 9 759 of 12 269. Each map holds the same count with the same power / s²;
-/// - light sampling: no pixel of the emitted and direct layers moves by more than 10⁻³ of its
-///   value (or of the layer's mean, where darker). None does; before the triangle test's error
-///   bound took lengths for the shear, shadow rays slipped through the spheres at 1e-4 and 14
-///   pixels moved (the direct layer's mean by +0.7 %);
-/// - photon-map layers within 1 % (measured at most 0.4 % over seeds 0–4): where rounding flips
+/// - light sampling: at most one pixel in 1 000 of the emitted and direct layers (over the seeds)
+///   moves by more than 10⁻³ of its value (or of the layer's mean, where darker): 2 of 16 384 do,
+///   each one shadow ray of 2 that grazes a silhouette and flips with the rounding; before the
+///   triangle test's error bound took lengths for the shear, shadow rays slipped through the
+///   spheres at 1e-4 and 14 pixels of 1 024 moved at one seed (the direct layer's mean by +0.7 %);
+/// - photon-map layers within 1 % at every seed (16², 15 000 global and 5 000 caustic photons;
+///   measured at most 0.43 %, and 1.7 % with 5 000 global photons): where rounding flips
 ///   a k-NN set or a nearest precomputed point, a whole neighbourhood moves together, so the
 ///   pixel-to-pixel standard error does not bound these. Acne, a lost caustic or light through an
 ///   object would be ten times that; and no row may lose half its light (black rows).
 #[test]
 fn scale_changes_nothing() {
-    use photonwave::reference::photons::{trace_path, trace_photons};
+    use photonwave::reference::photons::trace_path;
     use photonwave::rng::Domain;
     let s = Settings {
-        width: 32,
-        height: 32,
-        spp: 4,
-        photons: 20_000,
-        caustic_photons: 20_000,
-        gather_rays: 8,
+        width: 16,
+        height: 16,
+        spp: 2,
+        photons: 15_000,
+        caustic_photons: 5_000,
+        gather_rays: 4,
+        threads: 1,
         ..Default::default()
     };
     let scenes: Vec<(&str, f32, Arc<photonwave::scene::Scene>, photonwave::scene::Camera)> =
@@ -234,33 +149,36 @@ fn scale_changes_nothing() {
             })
             .collect();
     let (unit, rest) = scenes.split_first().unwrap();
+    // Photons, path by path: 640 paths of each map's stream at each seed (20 480 in all).
+    const PATHS: u64 = 640;
     for domain in [Domain::GlobalPhoton, Domain::CausticPhoton] {
-        let paths = trace_photons(&unit.2, &common::job(&unit.2, &s), domain, 20_000, &NoProgress).emitted;
         let trace = |scene: &photonwave::scene::Scene, job: &photonwave::job::Job, path: u64| {
             let mut out = Vec::new();
             trace_path(scene, job, domain, path, &mut out);
             let diagonal = scene.diagonal();
             out.iter().map(|p| p.position / diagonal).collect::<Vec<Vec3>>()
         };
-        let unit_job = common::job(&unit.2, &s);
-        let unit_paths: Vec<Vec<Vec3>> = (0..paths).map(|path| trace(&unit.2, &unit_job, path)).collect();
         for (label, _, scene, _) in rest {
-            let job = common::job(scene, &s);
-            let (mut parted, mut drift, mut agreeing) = (Vec::new(), 0.0f64, 0u32);
-            for (path, a) in (0..paths).zip(&unit_paths) {
-                let b = trace(scene, &job, path);
-                let d: Vec<f32> = a.iter().zip(&b).map(|(p, q)| (*q - *p).length()).collect();
-                if a.len() != b.len() || d.iter().any(|&d| d >= 1e-3) {
-                    parted.push(path);
-                } else {
-                    drift += d.iter().map(|&d| f64::from(d)).sum::<f64>();
-                    agreeing += d.len() as u32;
+            let (mut parted, mut drift, mut agreeing, mut paths) = (Vec::new(), 0.0f64, 0u32, 0u64);
+            for seed in common::SEEDS {
+                let at = Settings { seed, ..s.clone() };
+                let (unit_job, job) = (common::job(&unit.2, &at), common::job(scene, &at));
+                for path in 0..PATHS {
+                    let (a, b) = (trace(&unit.2, &unit_job, path), trace(scene, &job, path));
+                    let d: Vec<f32> = a.iter().zip(&b).map(|(p, q)| (*q - *p).length()).collect();
+                    if a.len() != b.len() || d.iter().any(|&d| d >= 1e-3) {
+                        parted.push((seed, path));
+                    } else {
+                        drift += d.iter().map(|&d| f64::from(d)).sum::<f64>();
+                        agreeing += d.len() as u32;
+                    }
+                    paths += 1;
                 }
             }
             let drift = drift / f64::from(agreeing.max(1));
             let first = &parted[..parted.len().min(8)];
             println!(
-                "{domain:?}, scale {label}: {} of {paths} paths parted (first {first:?}), mean drift {drift:.1e}",
+                "{domain:?}, scale {label}: {} of {paths} paths parted (first (seed, path) {first:?}), mean drift {drift:.1e}",
                 parted.len()
             );
             assert!(
@@ -271,47 +189,62 @@ fn scale_changes_nothing() {
             assert!(drift <= 1e-5, "{domain:?}, scale {label}: photons drift by {drift} of the diagonal on average");
         }
     }
-    for engine in ENGINES {
+    // Images at every seed, the engines in turn; the maps' counts and power at every eighth.
+    let (mut worst, mut light_moved) = (0.0f64, 0usize);
+    for seed in common::SEEDS {
+        let at = Settings { seed, ..s.clone() };
+        let engine = ENGINES[seed as usize % 2];
         let image = |(_, _, scene, camera): &(&str, f32, Arc<photonwave::scene::Scene>, photonwave::scene::Camera)| {
-            render(scene, &camera.prepare(32, 32).unwrap(), &s, engine, None, &NoProgress).unwrap().0
+            render(scene, &camera.prepare(16, 16).unwrap(), &at, engine, None, &NoProgress).unwrap().0
         };
         let unit_film = image(unit);
-        let (unit_maps, _) = photonwave::wavefront::build_maps(unit.2.clone(), &s).unwrap();
+        let unit_maps = (seed % 8 == 1).then(|| photonwave::wavefront::build_maps(unit.2.clone(), &at).unwrap().0);
         for scaled in rest {
             let (label, scale) = (scaled.0, scaled.1);
-            if engine == Engine::Wavefront {
-                let (maps, _) = photonwave::wavefront::build_maps(scaled.2.clone(), &s).unwrap();
+            if let Some(unit_maps) = &unit_maps {
+                let (maps, _) = photonwave::wavefront::build_maps(scaled.2.clone(), &at).unwrap();
                 for (a, b) in [(&unit_maps.global, &maps.global), (&unit_maps.caustic, &maps.caustic)] {
-                    assert_eq!(a.len(), b.len(), "scale {label}");
+                    assert_eq!(a.len(), b.len(), "seed {seed}, scale {label}");
                     let total = |m: &photonwave::photon_map::PhotonMap| (0..m.len()).map(|i| m.power(i)).sum::<Vec3>();
                     let ratio = total(b) / (total(a) * scale * scale);
-                    assert!((ratio - Vec3::ONE).abs().max_element() < 1e-2, "scale {label}: map power ratio {ratio}");
+                    assert!(
+                        (ratio - Vec3::ONE).abs().max_element() < 1e-2,
+                        "seed {seed}, scale {label}: map power ratio {ratio}"
+                    );
                 }
             }
             let film = image(scaled);
-            assert!(film.pixels.iter().all(|t| t.is_finite()), "{engine:?}, scale {label}: a non-finite pixel");
+            let what = format!("seed {seed}, {engine:?}, scale {label}");
+            assert!(film.pixels.iter().all(|t| t.is_finite()), "{what}: a non-finite pixel");
             for ((name, a), (_, b)) in unit_film.layers().into_iter().zip(film.layers()) {
                 let grey = |v: &[Vec3]| v.iter().map(|c| c.element_sum() / 3.0).collect::<Vec<f32>>();
                 let (ga, gb) = (grey(&a), grey(&b));
                 let diff: Vec<f32> = ga.iter().zip(&gb).map(|(x, y)| y - x).collect();
-                let (d, se) = common::mean_and_se(&diff);
+                let (d, _) = common::mean_and_se(&diff);
                 let (m, _) = common::mean_and_se(&ga);
                 let moved = ga.iter().zip(&gb).filter(|(x, y)| (*y - *x).abs() > 1e-3 * x.abs().max(m as f32)).count();
-                println!("{engine:?}, scale {label}, {name}: mean {m:.5}, difference {d:+.2e} ± {se:.1e}, {moved} pixels moved");
                 if matches!(name.as_str(), "emitted" | "direct") {
-                    assert_eq!(moved, 0, "{engine:?}, scale {label}, {name}: pixels moved by more than 10⁻³");
-                } else {
-                    assert!(d.abs() <= 0.01 * m, "{engine:?}, scale {label}, {name}: mean differs by {d} from {m}");
+                    if moved > 0 {
+                        println!("{what}, {name}: {moved} pixels moved by more than 10⁻³");
+                    }
+                    light_moved += moved;
+                } else if m > 0.0 {
+                    worst = worst.max(d.abs() / m);
+                    assert!(d.abs() <= 0.01 * m, "{what}, {name}: mean differs by {d} from {m}");
                 }
             }
             let rows = |f: &photonwave::film::Film| -> Vec<f32> {
-                f.beauty().chunks(32).map(|r| r.iter().map(|c| c.element_sum()).sum()).collect()
+                f.beauty().chunks(16).map(|r| r.iter().map(|c| c.element_sum()).sum()).collect()
             };
             for (y, (a, b)) in rows(&unit_film).iter().zip(rows(&film)).enumerate() {
-                assert!(b > 0.5 * a, "{engine:?}, scale {label}: row {y} holds {b} against {a} at scale 1");
+                assert!(b > 0.5 * a, "{what}: row {y} holds {b} against {a} at scale 1");
             }
         }
     }
+    println!("photon-map layers: the largest change of a layer's mean {:.3} %", 100.0 * worst);
+    let pixels = 16 * 16 * rest.len() * common::SEEDS.count();
+    println!("emitted and direct layers: {light_moved} of {pixels} pixels moved");
+    assert!(light_moved * 1000 <= pixels, "{light_moved} of {pixels} pixels of light sampling moved");
 }
 
 /// Both engines' photon maps for `s`.
@@ -322,62 +255,6 @@ fn both_maps(
     let (reference, _, _) = photonwave::reference::build_maps(scene, s).unwrap();
     let (wavefront, _) = photonwave::wavefront::build_maps(scene.clone(), s).unwrap();
     [("reference", reference), ("wavefront", wavefront)]
-}
-
-/// Case 7: a collimated beam (a directional light through a 0.2 × 0.2 hole) through a glass ball
-/// (n = 1.5, R = 1) focuses on the axis at nR/(2(n − 1)) = 1.5 from the centre. The screen lies in
-/// the plane y = 0 along the axis, so each ray of the beam lands on it where it crosses that
-/// plane — at its focus. The median landing depth must be 1.5 within 2 %. Rays at height h focus
-/// short of the paraxial focus (spherical aberration: 0.28 % at h = 0.1, 0.55 % at the hole's
-/// corners, from an exact trace), so the median sits a little short of 1.5.
-#[test]
-fn a_ball_lens_focuses_at_n_r_over_2_n_minus_1() {
-    let loaded = hard("ball-lens.toml");
-    let scene = Arc::new(loaded.scene);
-    let s = Settings { photons: 1_000, caustic_photons: 4_000, ..Default::default() };
-    for (name, maps) in both_maps(&scene, &s) {
-        let map = &maps.caustic;
-        let mut depth: Vec<f32> = (0..map.len())
-            .map(|i| map.photon(i).position)
-            .filter(|p| p.y.abs() < 1e-6 && p.z < -1.0)
-            .map(|p| -p.z)
-            .collect();
-        depth.sort_by(f32::total_cmp);
-        let n = depth.len();
-        assert!(n > 1_000, "{name}: {n} photons on the screen");
-        let (median, q10, q90) = (depth[n / 2], depth[n / 10], depth[9 * n / 10]);
-        println!("{name}: {n} photons on the screen; depth median {median}, 10–90 % {q10}–{q90}");
-        assert!((median / 1.5 - 1.0).abs() < 0.02, "{name}: the beam focuses at {median}, not 1.5");
-    }
-}
-
-/// Case 6, light pipe: a narrow spot (2°) lights the near end of a glass rod 30° off its axis.
-/// Inside, the beam meets the side faces at 70.5°, past the critical angle (41.8°), so they
-/// reflect all of it; the far end lets out T(30°) of what reaches it, and what it reflects comes
-/// back after another reflection at the near end: flux out / flux in = T²/(1 − R²), R the
-/// unpolarised Fresnel reflectance at 30° (T = 1 − R). Every caustic photon carries Φ/N, so the
-/// screen's share is a binomial proportion: tolerance 4 of its standard errors plus 0.2 % for the
-/// spread of angles within the cone. Without total reflection most light would leave the sides.
-#[test]
-fn a_light_pipe_loses_only_the_fresnel_reflections_at_its_ends() {
-    use photonwave::material::fresnel_dielectric;
-    let loaded = hard("light-pipe.toml");
-    let scene = Arc::new(loaded.scene);
-    let s = Settings { photons: 1_000, caustic_photons: 40_000, ..Default::default() };
-    let r = fresnel_dielectric(30f32.to_radians().cos(), 1.5);
-    let expected = (1.0 - r) * (1.0 - r) / (1.0 - r * r);
-    let flux = scene.total_power();
-    for (name, maps) in both_maps(&scene, &s) {
-        let map = &maps.caustic;
-        let on_screen: Vec<usize> = (0..map.len()).filter(|&i| (map.photon(i).position.z + 2.0).abs() < 1e-4).collect();
-        let out: Vec3 = on_screen.iter().map(|&i| map.power(i)).sum();
-        let ratio = out / flux;
-        let emitted = (on_screen.len() as f32 / ratio.x).round();
-        let se = (expected * (1.0 - expected) / emitted).sqrt();
-        let tol = 4.0 * se + 0.002;
-        println!("{name}: flux out / in = {ratio} ({} photons), T²/(1 − R²) = {expected} ± {tol}", on_screen.len());
-        assert!((ratio - Vec3::splat(expected)).abs().max_element() < tol, "{name}: {ratio} against {expected}");
-    }
 }
 
 /// Case 6, slab: a spot inside a glass slab aims at its top face 48–52° from the normal, past the
@@ -396,116 +273,7 @@ fn total_internal_reflection_lets_nothing_out() {
     }
 }
 
-/// Case 12: the white furnace (a closed sphere emitting Le = 1, reflecting 0.5) holding a white
-/// Lambertian, a mirror, a glass and a glossy sphere. Where every surface is lossless radiance is
-/// Le/(1 − 0.5) = 2 (less the depth cut: 1 − 2⁻¹¹ at max_depth 10); the glossy lobe loses what it
-/// sends below the horizon, so it and what sees it are darker — and nothing may be brighter.
-/// Per object (pixels whose 3 × 3 neighbourhood sees only it), on both photon-mapping engines and
-/// the path tracer: the mean must not exceed 2 by more than 4 standard errors + 0.5 % (the
-/// photon maps' correlated noise), and the two engines must agree with the path tracer within
-/// 4 standard errors of the difference + 1.5 %.
-#[test]
-fn a_furnace_of_every_material_never_gains_energy() {
-    let objects = furnace_objects("furnace-materials.toml");
-    assert_eq!(objects.len(), 5, "{objects:?}");
-}
-
-/// Renders a white-furnace scene (Le = 1, albedo 0.5) with the path tracer (512 spp, paths of up
-/// to 64 bounces: light trapped between dielectric faces takes many) and both
-/// photon-mapping engines (32 spp) and checks, per object seen in at least 9 pixels whose 3 × 3
-/// neighbourhood sees only it: no mean exceeds 2 by more than 4 standard errors + 0.5 %, and both
-/// engines agree with the path tracer within 4 standard errors of the difference + 1.5 %.
-/// Returns the path tracer's (object, mean).
-fn furnace_objects(name: &str) -> Vec<(String, f64)> {
-    let loaded = hard(name);
-    let scene = Arc::new(loaded.scene);
-    let (w, h) = (32usize, 32usize);
-    let rays = loaded.camera.unwrap().prepare(w as u32, h as u32).unwrap();
-    // Which object each pixel's centre sees.
-    let seen: Vec<Option<u32>> = (0..w * h)
-        .map(|i| {
-            let (o, d) = rays.ray((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
-            scene.intersect(o, d, f32::INFINITY).map(|hit| scene.surface(&hit).material)
-        })
-        .collect();
-    let interior = |i: usize| {
-        let (x, y) = ((i % w) as i64, (i / w) as i64);
-        (-1..=1).all(|dy| {
-            (-1..=1).all(|dx| {
-                let (u, v) = (x + dx, y + dy);
-                (0..w as i64).contains(&u) && (0..h as i64).contains(&v) && seen[(v * w as i64 + u) as usize] == seen[i]
-            })
-        })
-    };
-    let s = Settings {
-        width: 32,
-        height: 32,
-        spp: 32,
-        photons: 40_000,
-        caustic_photons: 40_000,
-        gather_rays: 16,
-        ..Default::default()
-    };
-    let path = photonwave::path::render_path_traced(
-        &scene,
-        &rays,
-        &Settings { spp: 512, max_depth: 64, ..s.clone() },
-        &NoProgress,
-    )
-    .unwrap()
-    .0;
-    let regions = |film: &photonwave::film::Film| -> Vec<(String, f64, f64)> {
-        let grey = common::grey(film);
-        scene
-            .materials
-            .iter()
-            .enumerate()
-            .filter_map(|(m, mat)| {
-                let v: Vec<f32> =
-                    (0..w * h).filter(|&i| seen[i] == Some(m as u32) && interior(i)).map(|i| grey[i]).collect();
-                let (mean, se) = common::mean_and_se(&v);
-                (v.len() >= 9).then(|| (mat.name.clone(), mean, se))
-            })
-            .collect()
-    };
-    let truth = regions(&path);
-    for (object, mean, se) in &truth {
-        println!("{name}, path tracer, {object}: {mean:.4} ± {se:.4}");
-        assert!(*mean <= 2.0 + 4.0 * se + 0.01, "{name}, path tracer, {object}: {mean} > 2");
-    }
-    for engine in ENGINES {
-        let film = render(&scene, &rays, &s, engine, None, &NoProgress).unwrap().0;
-        for ((object, mean, se), (_, want, want_se)) in regions(&film).into_iter().zip(&truth) {
-            println!("{name}, {engine:?}, {object}: {mean:.4} ± {se:.4} (path tracer {want:.4})");
-            assert!(mean <= 2.0 + 4.0 * se + 0.01, "{name}, {engine:?}, {object}: {mean} > 2");
-            let tol = 4.0 * (se * se + want_se * want_se).sqrt() + 0.015 * want;
-            assert!(
-                (mean - want).abs() <= tol,
-                "{name}, {engine:?}, {object}: {mean} against the path tracer's {want} ± {tol}"
-            );
-        }
-    }
-    truth.into_iter().map(|(object, mean, _)| (object, mean)).collect()
-}
-
-/// Case 8: a glass slab under water in the white furnace, the boundary between them one face with
-/// `ior` 1.33 and `outside_ior` 1.5 (the documented model: one face per boundary, indices on both
-/// sides). Every surface is lossless, so radiance is 2 wherever the camera looks, through any
-/// number of interfaces (less the depth cut: the tolerance is 2 %; measured 0.6 % at most); nothing
-/// exceeds 2, on both engines and the path tracer (64 bounces). The same slabs
-/// closed each on its own put coincident faces of glass and water at the boundary, which the
-/// loader reports.
-#[test]
-fn nested_dielectrics_conserve_energy() {
-    assert!(hard("nested.toml").scene.warnings.is_empty());
-    let coincident = hard("nested-coincident.toml").scene.warnings;
-    assert!(coincident.iter().any(|w| w.contains("triangle pairs of `glass` and `water`")), "{coincident:?}");
-    let objects = furnace_objects("nested.toml");
-    assert!(objects.iter().any(|(o, _)| o == "water") && objects.iter().any(|(o, _)| o == "glass"), "{objects:?}");
-    for (object, mean) in objects {
-        assert!(mean > 2.0 * 0.98, "{object}: {mean}, not 2");
-    }
-}
+// Cases 8 and 12, the white furnaces, are in tests/furnace.rs (at every seed).
 
 /// `--stats` counts the photons the normal filter turns away in density estimates at shading
 /// points (here the global map read at the first hit; precomputed irradiance reads make none): on
@@ -521,33 +289,6 @@ fn photons_turned_away_are_counted_alike() {
         .collect();
     println!("photons turned away: {counts:?}");
     assert!(counts[0] > 100 && counts[0] == counts[1], "{counts:?}");
-}
-
-/// Case 9 (the ray-level half is in tests/packet.rs): a point light inside the closed cube of
-/// grid-triangulated faces with sliver strips and zero-area triangles. Every photon path lands
-/// inside, so the first-hit photons of both engines' global maps carry the light's whole power
-/// (each Φ/N; only the dithered power packing, 2⁻⁸/√N relative, separates the sum from Φ), and
-/// both engines' images are finite and lit.
-#[test]
-fn no_photon_leaves_a_watertight_mesh() {
-    use photonwave::photon_map::flags;
-    let loaded = hard("watertight.toml");
-    let scene = Arc::new(loaded.scene);
-    let s = Settings { width: 16, height: 16, spp: 2, photons: 50_000, gather_rays: 4, ..Default::default() };
-    let phi = scene.total_power();
-    for (name, maps) in both_maps(&scene, &s) {
-        let map = &maps.global;
-        let first: Vec<usize> = (0..map.len()).filter(|&i| map.photon(i).flags & flags::DIRECT != 0).collect();
-        let sum: Vec3 = first.iter().map(|&i| map.power(i)).sum();
-        let tol = 5.0 * 2f32.powi(-8) / (first.len() as f32).sqrt();
-        println!("{name}: first-hit power / Φ = {} from {} paths (± {tol})", sum / phi, first.len());
-        assert!((sum / phi - Vec3::ONE).abs().max_element() < tol, "{name}: {} of the light's power landed", sum / phi);
-    }
-    let rays = loaded.camera.unwrap().prepare(16, 16).unwrap();
-    for engine in ENGINES {
-        let film = render(&scene, &rays, &s, engine, None, &NoProgress).unwrap().0;
-        assert!(film.pixels.iter().all(|t| t.is_finite() && t.beauty().min_element() > 0.0), "{engine:?}");
-    }
 }
 
 /// Case 4: a lit floor meets a wall that the light (straight down) never reaches directly. The 64
@@ -728,6 +469,56 @@ fn visibility_is_what_stops_the_leak() {
             println!("{engine:?}, {layer}: visibility on / off = {ratio}");
             assert!((ratio - 1.0).abs() < 0.02, "{engine:?}, {layer}: {ratio}");
         }
+    }
+}
+
+/// Every stored photon's largest channel is at most `POWER_GROWTH_MAX` times its own path's
+/// emitted power (the bound stated in `transport::photon`; the map then divides both by the
+/// paths emitted), in every hard-case scene at every seed: the first 2 000 paths of each map's
+/// stream, traced one by one with the transport core both engines share, each photon checked
+/// against its path's emission recomputed from the stream. tir-slab.toml is left out: no photon
+/// reaches a diffuse surface there, so it stores none.
+#[test]
+fn no_stored_photon_exceeds_the_power_bound() {
+    use photonwave::reference::photons::trace_path;
+    use photonwave::rng::Domain;
+    use photonwave::transport::photon::{start_photon, Start, POWER_GROWTH_MAX};
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/hard");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".toml") && n != "tir-slab.toml")
+        .collect();
+    names.sort();
+    assert!(names.len() >= 20, "{names:?}");
+    for name in names {
+        let loaded = hard(&name);
+        let scene = &loaded.scene;
+        let (mut worst, mut stored) = (0.0f32, 0usize);
+        for seed in common::SEEDS {
+            let job = photonwave::job::Job::photon_mapping(scene, &Settings { seed, ..Default::default() }).unwrap();
+            for (domain, on) in
+                [(Domain::GlobalPhoton, job.plan.global_map.on), (Domain::CausticPhoton, job.plan.caustic_map.on)]
+            {
+                let mut out = Vec::new();
+                for path in (0..2_000).filter(|_| on) {
+                    let Start::Photon(start) = start_photon(scene, job.pass.seed, domain, path, true) else { continue };
+                    out.clear();
+                    trace_path(scene, &job, domain, path, &mut out);
+                    stored += out.len();
+                    for p in &out {
+                        let ratio = p.power.max_element() / start.emitted;
+                        worst = worst.max(ratio);
+                        assert!(
+                            ratio <= POWER_GROWTH_MAX * (1.0 + 1e-6),
+                            "{name}, seed {seed}, {domain:?} path {path}: a photon of {ratio} times its emitted power"
+                        );
+                    }
+                }
+            }
+        }
+        println!("{name}: {stored} photons, the heaviest {worst:.3} times its path's emitted power (bound {POWER_GROWTH_MAX})");
+        assert!(stored > 0, "{name}: no photon stored");
     }
 }
 

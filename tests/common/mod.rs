@@ -9,6 +9,10 @@ use photonwave::scene::file::{load_scene, LoadedScene};
 use photonwave::settings::Settings;
 use std::path::PathBuf;
 
+/// The seeds a statistical test runs over: its claim must hold at every one of them (the worst
+/// seed is asserted), not at one lucky stream.
+pub const SEEDS: std::ops::Range<u64> = 1..33;
+
 /// Path of a bundled scene file.
 pub fn bundled(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name)
