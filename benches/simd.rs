@@ -68,8 +68,13 @@ fn density(c: &mut Criterion) {
     g.throughput(Throughput::Elements(queries.len() as u64));
     for set in [CodePath::Simd, CodePath::Scalar] {
         let name = format!("{set:?}").to_lowercase();
-        let lookup =
-            |p, n, k, r_max| Lookup { p, k, r_max, kernel: settings.kernel, filter: Filter { n, flags_mask: 0 } };
+        let lookup = |p, n, k, r_max| Lookup {
+            p,
+            k,
+            r_max,
+            kernel: settings.kernel,
+            filter: Filter { n, flags_mask: 0, plane: 0.0 },
+        };
         let f = |n| Reflectance::Hemisphere { value: Vec3::splat(0.2), ng: n };
         g.bench_function(BenchmarkId::new("knn", &name), |b| {
             let mut scratch = Nearest::default();

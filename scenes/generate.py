@@ -185,6 +185,64 @@ import os
 os.makedirs("hard", exist_ok=True)
 thin_wall("hard/thin-wall.obj")
 
+def closed_room(folder):
+    """Back-to-back surfaces: a closed 2 x 1.2 x 2 room (x, z in [-1, 1], y in [0, 1.2]) of
+    zero-thickness walls (single quads facing in), lit inside by a 0.5 x 0.5 ceiling panel, with a
+    box on the floor. Three variants: the room alone (room.obj); the same room far above a 10 x 10
+    ground lit by a sun (room-sunlit: ground at y = -4); and the same room 1 cm above the sunlit
+    ground (room-on-ground: a floor thinner than any search radius). Nothing outside can reach the
+    inside, so the inside must render the same in all three. The sun's power (its irradiance over
+    the disk of the scene's bounding sphere, 37 W against the panel's 4.7 W) takes 89 % of the
+    photons and of the light samples chosen by power: the inside holds fewer photons, which tests
+    must allow for; everything else must be the same."""
+    def room(o):
+        c = (0.0, 0.6, 0.0)
+        def face(name, pts):
+            m = tuple(sum(p[i] for p in pts) / 4 for i in range(3))
+            o.quad(name, "floor" if name == "floor" else "wall", pts, sub(c, m))
+        face("floor", [(-1, 0, -1), (1, 0, -1), (1, 0, 1), (-1, 0, 1)])
+        face("ceiling", [(-1, 1.2, -1), (1, 1.2, -1), (1, 1.2, 1), (-1, 1.2, 1)])
+        face("back", [(-1, 0, -1), (1, 0, -1), (1, 1.2, -1), (-1, 1.2, -1)])
+        face("front", [(-1, 0, 1), (1, 0, 1), (1, 1.2, 1), (-1, 1.2, 1)])
+        face("left", [(-1, 0, -1), (-1, 0, 1), (-1, 1.2, 1), (-1, 1.2, -1)])
+        face("right", [(1, 0, -1), (1, 0, 1), (1, 1.2, 1), (1, 1.2, -1)])
+        o.quad("panel", "light", [(-0.25, 1.199, -0.25), (0.25, 1.199, -0.25), (0.25, 1.199, 0.25), (-0.25, 1.199, 0.25)], (0, -1, 0))
+        o.box("box", "box", (0.1, 0.0, -0.6), (0.6, 0.5, -0.1))
+    materials = [("wall", "illum 1\nKd 0.7 0.7 0.7"), ("floor", "illum 1\nKd 0.5 0.45 0.4"),
+                 ("box", "illum 1\nKd 0.3 0.5 0.7"), ("light", "illum 1\nKd 0 0 0\nKe 6 6 6"),
+                 ("ground", "illum 1\nKd 0.5 0.5 0.5")]
+    camera = """eye = [-0.8, 0.9, 0.9]
+target = [0.3, 0.3, -0.6]
+fov = 60"""
+    sun = """
+[[light]]
+type = "sun"
+direction = [-0.3, -1.0, -0.4]
+irradiance = [0.2, 0.2, 0.2]
+"""
+    comments = {
+        "room": """# Back-to-back surfaces, written by scenes/generate.py: a closed room of zero-thickness walls
+# lit by a ceiling panel, alone. With a sun outside (room-sunlit.toml, room-on-ground.toml) the
+# inside renders the same: no light from outside can reach it (README, "Hard cases").""",
+        "room-sunlit": """# Back-to-back surfaces, written by scenes/generate.py: a closed room of zero-thickness walls
+# lit by a ceiling panel, 4 m above a 10 x 10 ground under a sun. No light from outside can
+# reach the inside: it renders the same with or without the sun (tests/rooms.rs).""",
+        "room-on-ground": """# Back-to-back surfaces, written by scenes/generate.py: a closed room of zero-thickness walls
+# lit by a ceiling panel, 1 cm above a 10 x 10 ground under a sun: a floor thinner than any
+# search radius. No light from outside can reach the inside: it renders the same with or
+# without the sun (tests/rooms.rs).""",
+    }
+    for name, ground in [("room", None), ("room-sunlit", -4.0), ("room-on-ground", -0.01)]:
+        o = RawObj(f"{name}.mtl")
+        room(o)
+        if ground is not None:
+            o.quad("ground", "ground", [(-5, ground, -5), (5, ground, -5), (5, ground, 5), (-5, ground, 5)], (0, 1, 0))
+        o.write(f"{folder}/{name}.obj")
+        mtl(f"{folder}/{name}.mtl", materials)
+        scene_toml(f"{folder}/{name}.toml", comments[name], f'file = "{name}.obj"', camera, sun if ground is not None else "")
+
+closed_room("hard")
+
 def grazing(folder):
     """A 2 x 2 Lambertian plane (kd 0.5) at y = 0 facing +y, seen from straight above, lit by a
     directional light of perpendicular irradiance 1 at theta = 0, 60, 85 and 89 degrees to the

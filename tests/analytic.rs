@@ -146,8 +146,13 @@ fn every_kernel_returns_a_uniform_density() {
     let map = PhotonMap::build(photons);
     let mut scratch = Nearest::default();
     for kernel in [Kernel::Box, Kernel::Cone, Kernel::Epanechnikov] {
-        let q =
-            Lookup { p: Vec3::ZERO, k: 100_000, r_max: 50.0 * h, kernel, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
+        let q = Lookup {
+            p: Vec3::ZERO,
+            k: 100_000,
+            r_max: 50.0 * h,
+            kernel,
+            filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+        };
         let e = map.estimate(CodePath::Simd, &q, Reflectance::Constant(Vec3::ONE), &mut scratch);
         let rel = e.radiance.x * h * h;
         assert!((rel - 1.0).abs() < 0.005, "{kernel:?}: {rel}");
@@ -177,8 +182,13 @@ fn knn_estimate_is_unbiased_on_a_uniform_plane() {
     for i in 0..80 {
         for j in 0..80 {
             let p = Vec3::new(0.1 + i as f32 * 0.01, 0.0, 0.1 + j as f32 * 0.01);
-            let look =
-                Lookup { p, k: 16, r_max: 0.1, kernel: Kernel::Box, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
+            let look = Lookup {
+                p,
+                k: 16,
+                r_max: 0.1,
+                kernel: Kernel::Box,
+                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+            };
             let e = map.estimate(CodePath::Simd, &look, Reflectance::Constant(Vec3::ONE), &mut scratch);
             sum += e.radiance.x as f64 / n as f64;
             q += 1;
@@ -229,6 +239,7 @@ fn quad_light_irradiance_matches_lamberts_formula() {
             material: 0,
             tri: 0,
             uv: Vec2::ZERO,
+            flat: true,
         };
         let mut rays = Default::default();
         // E = π·L_reflected for a white Lambertian; each call averages 256 light samples.
@@ -262,6 +273,7 @@ fn point_light_irradiance_is_inverse_square_cosine() {
         material: 0,
         tri: 0,
         uv: Vec2::ZERO,
+        flat: true,
     };
     let l = direct_light(
         &ctx,
@@ -333,6 +345,7 @@ fn directional_light_irradiance_is_cosine_weighted_by_both_methods() {
                     material: 0,
                     tri: 0,
                     uv: Vec2::ZERO,
+                    flat: true,
                 };
                 let direct = direct_light(
                     &ctx,
@@ -347,8 +360,13 @@ fn directional_light_irradiance_is_cosine_weighted_by_both_methods() {
                     "θ={deg}: light sampling {} vs {want}",
                     direct.x
                 );
-                let q =
-                    Lookup { p, k: 400, r_max: 1.0, kernel: Kernel::Box, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
+                let q = Lookup {
+                    p,
+                    k: 400,
+                    r_max: 1.0,
+                    kernel: Kernel::Box,
+                    filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+                };
                 let eval = |wi| mat.bsdf.eval(&sp.frame, Vec3::Y, wi);
                 let e = maps.global.estimate(CodePath::Simd, &q, Reflectance::PerPhoton(&eval), &mut scratch);
                 photon_sum += e.radiance.x;
@@ -398,7 +416,13 @@ fn boundary_corrected_estimates_do_not_darken_edges_and_corners() {
     for kernel in [Kernel::Box, Kernel::Cone] {
         for (corner, edge_share) in [(false, 0.5f32), (true, 0.25)] {
             let map = room(corner);
-            let q = |p: Vec3| Lookup { p, k: 0, r_max: r, kernel, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
+            let q = |p: Vec3| Lookup {
+                p,
+                k: 0,
+                r_max: r,
+                kernel,
+                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+            };
             let f = Reflectance::Constant(Vec3::ONE);
             let inner = Vec3::new(-0.5, 0.0, -0.5);
             let interior = map.estimate_radius(CodePath::Scalar, &q(inner), f).radiance.x;
@@ -438,7 +462,13 @@ fn open_edges_cut_the_disk_where_no_photons_show_it() {
         })
         .collect();
     let map = PhotonMap::build(photons);
-    let q = |p: Vec3| Lookup { p, k: 0, r_max: r, kernel: Kernel::Cone, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
+    let q = |p: Vec3| Lookup {
+        p,
+        k: 0,
+        r_max: r,
+        kernel: Kernel::Cone,
+        filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+    };
     let f = Reflectance::Constant(Vec3::ONE);
     let interior = map.estimate_radius(CodePath::Scalar, &q(Vec3::new(-0.5, 0.0, 0.0)), f).radiance.x;
     let edge = [Cut { point: Vec3::ZERO, inward: Vec3::NEG_X }];
@@ -484,7 +514,7 @@ fn bias_estimates_return_the_kernel_bias_of_quadratic_radiance() {
     for (kernel, mu2) in [(Kernel::Box, 0.25f32), (Kernel::Cone, 0.15), (Kernel::Epanechnikov, 1.0 / 6.0)] {
         let want = 2.0 * c * mu2 * r * r;
         for p in [Vec3::ZERO, Vec3::new(0.03, 0.0, -0.05)] {
-            let q = Lookup { p, k: 0, r_max: r, kernel, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
+            let q = Lookup { p, k: 0, r_max: r, kernel, filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 } };
             let scalar = map.estimate_radius(CodePath::Scalar, &q, f);
             let simd = map.estimate_radius(CodePath::Simd, &q, f);
             let what = format!("{kernel:?} at {p}");
@@ -512,7 +542,7 @@ fn bias_estimates_return_the_kernel_bias_of_quadratic_radiance() {
     let map = PhotonMap::build(photons);
     for kernel in [Kernel::Box, Kernel::Cone] {
         for p in [Vec3::ZERO, Vec3::new(-0.05, 0.0, 0.0), Vec3::new(-0.15, 0.0, 0.0)] {
-            let q = Lookup { p, k: 0, r_max: r, kernel, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
+            let q = Lookup { p, k: 0, r_max: r, kernel, filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 } };
             for set in [CodePath::Scalar, CodePath::Simd] {
                 let e = map.estimate_radius_on_surface(set, &q, f, &[]);
                 let what = format!("{kernel:?} at {p}, {set:?}");

@@ -315,7 +315,13 @@ fn no_photon_crosses_a_corner() {
             let others = all.iter().filter(|q| q.normal.dot(n) <= 0.9 && (q.position - p).length() < 0.2).count();
             assert!(others > 100, "{name}, {side}: only {others} photons of the other surface nearby");
             for set in [CodePath::Simd, CodePath::Scalar] {
-                let q = Lookup { p, k: 64, r_max: 0.2, kernel: Kernel::Box, filter: Filter { n, flags_mask: 0 } };
+                let q = Lookup {
+                    p,
+                    k: 64,
+                    r_max: 0.2,
+                    kernel: Kernel::Box,
+                    filter: Filter { n, flags_mask: 0, plane: 0.0 },
+                };
                 let mut scratch = Nearest::default();
                 let near = map.nearest(set, &q, &mut scratch);
                 assert!(!near.is_empty(), "{name}, {side}: no photon found");

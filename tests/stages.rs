@@ -80,7 +80,7 @@ fn photon_stages_intersect_classify_deposit_scatter() {
     let stored: Vec<(u64, u32)> = work.deposits.iter().map(|d| (d.0, d.1)).collect();
     assert_eq!(stored, vec![(100, 0), (104, 0)]);
     let floor = &work.deposits[0].2;
-    assert_eq!(floor.flags, flags::DIRECT);
+    assert_eq!(floor.flags, flags::DIRECT | flags::FLAT);
     assert!((floor.position - Vec3::ZERO).length() < 1e-5 && floor.normal == Vec3::Y && floor.wi == Vec3::Y);
     assert_eq!(floor.power, Vec3::splat(2.0));
 

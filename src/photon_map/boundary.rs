@@ -93,6 +93,14 @@ impl Neighbours {
         }
     }
 
+    /// Whether photons with a normal opposite to `m` (within 25°) were met: the other face of the
+    /// surface whose photons have normal `m`.
+    fn faces_opposite(&self, map: &PhotonMap, m: Vec3) -> bool {
+        self.planes[..self.len]
+            .iter()
+            .any(|pl| key_normal(map.key[pl.low.0 as usize]).normalize_or_zero().dot(m) < -0.9)
+    }
+
     /// The part of the disk of radius² `r2` around `p` (normal `n`) that lies on the query's
     /// side of every noted surface and of every cut in `extra` ([`Coverage`]); the whole disk
     /// where nothing cuts it.
@@ -133,8 +141,12 @@ impl Neighbours {
             let c = side * m.dot(p - foot) / r;
             // A line at distance ≥ r cuts nothing. A query on the line is half covered (rounding
             // may put it a hair beyond); one clearly beyond it sees an inconsistent plane (not a
-            // flat surface meeting its own), which cuts nothing.
-            if c >= tangential || c < -0.05 * tangential {
+            // flat surface meeting its own), which cuts nothing. Nor does one beyond it at all
+            // when photons with the opposite normal were met too: the far face of a zero-thickness
+            // surface lit from both sides (a room's wall under a sun), whose near face, met as
+            // well, makes the cut. (It used to halve the disk of points within 0.05 r of such a
+            // wall: the daylit room's corners.)
+            if c >= tangential || c < -0.05 * tangential || (c < 0.0 && self.faces_opposite(map, m)) {
                 continue;
             }
             let c = c.max(0.0);

@@ -17,7 +17,7 @@ impl PhotonMap {
     /// (k−1) rule and the scalar kernel sum of [`Self::estimate`].
     pub fn estimate_from_candidates(&self, q: &Lookup, f: Reflectance<'_>, found: &mut Vec<(f32, u32)>) -> Estimate {
         let all = found.len();
-        found.retain(|&(_, i)| Self::test(self.key[i as usize], &q.filter) == Test::Accepted);
+        found.retain(|&(d2, i)| self.test_at(i as usize, q.p, d2, &q.filter) == Test::Accepted);
         // The (k−1) rule applies when the search filled k: the k-th photon sets the radius.
         let q = if all == q.k { Lookup { k: found.len(), ..*q } } else { Lookup { k: usize::MAX, ..*q } };
         let Some(r2) = Self::knn_radius2(&q, found) else {
@@ -36,7 +36,7 @@ impl PhotonMap {
         found: &mut Vec<(f32, u32)>,
     ) -> Estimate {
         let r2 = q.r_max * q.r_max;
-        found.retain(|&(d2, i)| d2 < r2 && Self::test(self.key[i as usize], &q.filter) == Test::Accepted);
+        found.retain(|&(d2, i)| d2 < r2 && self.test_at(i as usize, q.p, d2, &q.filter) == Test::Accepted);
         Estimate { radius: q.r_max, ..self.sum_estimate(CodePath::Scalar, q, r2, f, found) }
     }
 
@@ -94,7 +94,7 @@ mod tests {
                 k: 0,
                 r_max: 0.1,
                 kernel: Kernel::Epanechnikov,
-                filter: Filter { n: Vec3::Y, flags_mask: 0 },
+                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
             };
             let ours = map.estimate_radius_with(CodePath::Scalar, &q, f, None, false);
             let mut found: Vec<(f32, u32)> = (0..map.len())

@@ -37,8 +37,10 @@ pub struct Nearest {
     /// The photons [`PhotonMap::nearest`] lists.
     pub(super) found: Vec<(f32, u32)>,
     /// Squared distances of the photons within the radius (at their block's turn) that the
-    /// normal test turned away.
+    /// surface tests turned away.
     turned: Vec<f32>,
+    /// Squared distances of the photons within the radius set aside off a flat query's plane.
+    off: Vec<f32>,
     /// What the last searches found, for the next ones' first guesses: the last two kinds of
     /// search (map and k), most recent first, so that lookups alternating between two maps (the
     /// global and caustic estimates at each camera hit) each follow their own.
@@ -56,6 +58,9 @@ pub(super) struct Walked {
     /// fewer than k are found) that the normal test turned away (see
     /// [`super::Estimate::rejected`]).
     pub rejected: u32,
+    /// Photons within that radius set aside off a flat query's plane
+    /// ([`super::Estimate::off_plane`]).
+    pub off_plane: u32,
 }
 
 /// The k-th nearest candidate, as (distance², index); the k nearest are those up to it.
@@ -247,12 +252,14 @@ impl PhotonMap {
         });
         let bound = last.map_or(r2_max, |kth| kth.d2);
         walked.rejected = buf.turned.iter().filter(|&&d| d < bound).count() as u32;
+        walked.off_plane = buf.off.iter().filter(|&&d| d < bound).count() as u32;
         (walked, last)
     }
 
     /// Walks toward `q.p` gathering the blocks that hold candidates for its `q.k` nearest
     /// within squared radius `r2` into `buf` (cleared first), adding the photons tested to
-    /// `tested` when `COUNT`. The walk's `rejected` is left 0 (the search counts them).
+    /// `tested` when `COUNT`. The walk's `rejected` and `off_plane` are left 0 (the search
+    /// counts them).
     fn walk_nearest<const COUNT: bool>(
         &self,
         set: CodePath,
@@ -264,10 +271,11 @@ impl PhotonMap {
         buf.d2.clear();
         buf.base.clear();
         buf.turned.clear();
+        buf.off.clear();
         let k = q.k;
         let mut live = 0usize;
         if k == 0 || self.is_empty() {
-            return Walked { r2, live, rejected: 0 };
+            return Walked { r2, live, rejected: 0, off_plane: 0 };
         }
         // The farthest candidate so far (its SIMD form lane by lane).
         let (mut far, mut far8) = (0.0f32, f32x8::ZERO);
@@ -279,12 +287,16 @@ impl PhotonMap {
             let mut lanes = [f32::INFINITY; 8];
             let found = if set == CodePath::Simd {
                 let v = self.accepts8(lo, q.p, r2, &q.filter);
-                let mut turned = v.turned;
-                if turned != 0 {
+                let (mut turned, mut off) = (v.turned, v.off_plane);
+                if turned | off != 0 {
                     let d2 = v.d2.to_array();
                     while turned != 0 {
                         buf.turned.push(d2[turned.trailing_zeros() as usize]);
                         turned &= turned - 1;
+                    }
+                    while off != 0 {
+                        buf.off.push(d2[off.trailing_zeros() as usize]);
+                        off &= off - 1;
                     }
                 }
                 lanes = v.inside.select(v.d2, f32x8::splat(f32::INFINITY)).to_array();
@@ -295,13 +307,14 @@ impl PhotonMap {
                 for i in lo..hi {
                     let d2 = self.d2(i, q.p);
                     if d2 < r2 {
-                        match Self::test(self.key[i], &q.filter) {
+                        match self.test_at(i, q.p, d2, &q.filter) {
                             Test::Accepted => {
                                 lanes[i - lo] = d2;
                                 far = far.max(d2);
                                 found += 1;
                             }
                             Test::Normal => buf.turned.push(d2),
+                            Test::OffPlane => buf.off.push(d2),
                             Test::Flags => {}
                         }
                     }
@@ -336,7 +349,7 @@ impl PhotonMap {
                 }
             }
         }
-        Walked { r2, live, rejected: 0 }
+        Walked { r2, live, rejected: 0, off_plane: 0 }
     }
 }
 
@@ -381,7 +394,7 @@ mod tests {
                     k,
                     r_max: 0.5,
                     kernel: Kernel::Epanechnikov,
-                    filter: Filter { n: Vec3::Y, flags_mask: 0 },
+                    filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
                 };
                 let a = map.estimate(set, &q, f, &mut guided);
                 let b = map.estimate(set, &q, f, &mut Nearest::default());
@@ -413,8 +426,13 @@ mod tests {
             for p in [Vec3::new(0.15, 0.0, 0.15), Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.123, 0.0, 0.071)] {
                 for r_max in [0.05, 0.3, f32::INFINITY] {
                     for k in [1, 2, 7, 64, 500, 5000] {
-                        let q =
-                            Lookup { p, k, r_max, kernel: Kernel::Box, filter: Filter { n: Vec3::Y, flags_mask: 0 } };
+                        let q = Lookup {
+                            p,
+                            k,
+                            r_max,
+                            kernel: Kernel::Box,
+                            filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+                        };
                         let mut want: Vec<(u32, u32)> = (0..map.len())
                             .map(|i| ((map.position(i) - p).length_squared(), i as u32))
                             .filter(|&(d2, _)| d2 < r_max * r_max)

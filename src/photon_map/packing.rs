@@ -28,13 +28,13 @@ pub(super) const NORMAL_STEPS: u32 = 62;
 
 pub(super) const DIR_STEPS: u32 = 254;
 
-/// Packs normal, flags (2 bits) and incoming direction into a key (bits 14 and 15 spare).
+/// Packs normal, flags (3 bits) and incoming direction into a key (bit 15 spare).
 pub(super) fn pack_key(normal: Vec3, flags: u8, wi: Vec3) -> u32 {
     let (nu, nv) = oct_encode(normal);
     let (wu, wv) = oct_encode(wi);
     quantise(nu, NORMAL_STEPS)
         | quantise(nv, NORMAL_STEPS) << 6
-        | u32::from(flags & 3) << 12
+        | u32::from(flags & 7) << 12
         | quantise(wu, DIR_STEPS) << 16
         | quantise(wv, DIR_STEPS) << 24
 }
@@ -87,7 +87,7 @@ pub(super) fn key_wi(key: u32) -> Vec3 {
 /// Flags of a key.
 #[inline]
 pub(super) fn key_flags(key: u32) -> u8 {
-    (key >> 12 & 3) as u8
+    (key >> 12 & 7) as u8
 }
 
 /// RGBE: three 8-bit mantissas sharing the exponent of the largest channel. Each mantissa is

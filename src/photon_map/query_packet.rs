@@ -63,6 +63,7 @@ struct Sums {
     bias: [f32x8; 3],
     count: u32,
     rejected: u32,
+    off_plane: u32,
     neighbours: Neighbours,
 }
 
@@ -175,9 +176,11 @@ impl PhotonMap {
             let (dx, dy, dz) = (x - f32x8::splat(q.p.x), y - f32x8::splat(q.p.y), z - f32x8::splat(q.p.z));
             let d2 = dx * dx + dy * dy + dz * dz;
             let near = d2.simd_lt(f32x8::splat(r2[j]));
-            let (inside, turned) = Self::filter8(&mut normals, near, &q.filter);
+            let super::filter::Filtered8 { inside, turned, off_plane } =
+                Self::filter8(&mut normals, near, &q.filter, [dx, dy, dz], d2);
             let s = &mut sums[j];
             s.rejected += turned.count_ones();
+            s.off_plane += off_plane.count_ones();
             if queries[j].edges.is_some() {
                 // Lane order, as the scalar twin meets them.
                 let mut t = turned;
@@ -215,6 +218,7 @@ impl PhotonMap {
             return Estimate { radius: q.r_max, ..Default::default() };
         };
         let sums = [Vec3::ZERO + reduce3(s.radiance), Vec3::ZERO + reduce3(s.bias)];
-        self.fixed_estimate::<BIAS>(q, r2, edges, &s.neighbours, sums, s.count, s.rejected)
+        let found = super::radius::Found { count: s.count, rejected: s.rejected, off_plane: s.off_plane };
+        self.fixed_estimate::<BIAS>(q, r2, edges, &s.neighbours, sums, found)
     }
 }

@@ -54,7 +54,7 @@ impl PhotonMap {
         let Some(r2) = self.fixed_radius2(q) else {
             return Estimate { radius: q.r_max, ..Default::default() };
         };
-        let (mut count, mut rejected) = (0u32, 0u32);
+        let (mut count, mut rejected, mut off_plane) = (0u32, 0u32, 0u32);
         let mut neighbours = Neighbours::default();
         let (mut sum, mut bias) = (Vec3::ZERO, Vec3::ZERO);
         let (mut sum8, mut bias8) = ([f32x8::ZERO; 3], [f32x8::ZERO; 3]);
@@ -63,6 +63,7 @@ impl PhotonMap {
             if set == CodePath::Simd {
                 let v = self.accepts8(lo, q.p, r2, &q.filter);
                 rejected += v.turned.count_ones();
+                off_plane += v.off_plane.count_ones();
                 if on_surface.is_some() {
                     // Lane order, as the scalar twin meets them.
                     let mut left = v.turned;
@@ -97,7 +98,7 @@ impl PhotonMap {
                 for i in lo..hi {
                     let d2 = self.d2(i, q.p);
                     if d2 < r2 {
-                        match Self::test(self.key[i], &q.filter) {
+                        match self.test_at(i, q.p, d2, &q.filter) {
                             Test::Accepted => {
                                 if BIAS {
                                     let (c, b) = self.contribution_and_bias(i, d2, r2, q.kernel, f);
@@ -114,6 +115,7 @@ impl PhotonMap {
                                     neighbours.note(self, i, q.p, q.filter.n);
                                 }
                             }
+                            Test::OffPlane => off_plane += 1,
                             Test::Flags => {}
                         }
                     }
@@ -121,13 +123,13 @@ impl PhotonMap {
             }
         }
         let (sum, bias) = (sum + reduce3(sum8), bias + reduce3(bias8));
-        self.fixed_estimate::<BIAS>(q, r2, on_surface, &neighbours, [sum, bias], count, rejected)
+        let found = Found { count, rejected, off_plane };
+        self.fixed_estimate::<BIAS>(q, r2, on_surface, &neighbours, [sum, bias], found)
     }
 
     /// A fixed-radius estimate from its kernel sum and bias sum over the photons found: normalised,
     /// divided by the part of the disk on the query's surface (`on_surface`: the cuts beyond the
     /// `neighbours` the filter met) and, with `BIAS`, its bias.
-    #[allow(clippy::too_many_arguments)]
     #[inline]
     pub(super) fn fixed_estimate<const BIAS: bool>(
         &self,
@@ -136,8 +138,7 @@ impl PhotonMap {
         on_surface: Option<&[Cut]>,
         neighbours: &Neighbours,
         [sum, bias]: [Vec3; 2],
-        count: u32,
-        rejected: u32,
+        found: Found,
     ) -> Estimate {
         let coverage = match on_surface {
             Some(edges) => neighbours.coverage(self, q.p, q.filter.n, r2, q.kernel, edges),
@@ -151,6 +152,44 @@ impl PhotonMap {
         } else {
             Vec3::ZERO
         };
-        Estimate { radiance, bias, radius: q.r_max, count, rejected }
+        let Found { count, rejected, off_plane } = found;
+        Estimate { radiance, bias, radius: q.r_max, count, rejected, off_plane, coverage: coverage.fraction }
     }
+
+    /// The fixed-radius kernel estimate over `found` (distance², index within `q.r_max`), none
+    /// tested by the filter: for the photons a caller adds to an estimate.
+    #[must_use]
+    pub fn estimate_photons(&self, set: CodePath, q: &Lookup, f: Reflectance<'_>, found: &[(f32, u32)]) -> Estimate {
+        match self.fixed_radius2(q) {
+            Some(r2) => self.sum_estimate(set, q, r2, f, found),
+            None => Estimate { radius: q.r_max, ..Default::default() },
+        }
+    }
+
+    /// The photons within `q.r_max` of `q.p` that `q.filter` sets aside off its flat plane, as
+    /// (distance², index) in walk order: for the caller to add the visible ones to a fixed-radius
+    /// estimate that reported [`Estimate::off_plane`] of them.
+    #[must_use]
+    pub fn off_plane_photons(&self, q: &Lookup) -> Vec<(f32, u32)> {
+        let mut out = Vec::new();
+        let Some(r2) = self.fixed_radius2(q) else { return out };
+        let mut walk = Walk::<false>::new(self, CodePath::Scalar, q.p);
+        while let Some((lo, hi)) = walk.next(self, r2) {
+            for i in lo..hi {
+                let d2 = self.d2(i, q.p);
+                if d2 < r2 && self.test_at(i, q.p, d2, &q.filter) == Test::OffPlane {
+                    out.push((d2, i as u32));
+                }
+            }
+        }
+        out
+    }
+}
+
+/// What a fixed-radius walk counted: photons summed, turned away, and set aside off the plane.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Found {
+    pub count: u32,
+    pub rejected: u32,
+    pub off_plane: u32,
 }

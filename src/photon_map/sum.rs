@@ -87,7 +87,7 @@ impl PhotonMap {
             radius: r2.sqrt(),
             bias: Vec3::ZERO,
             count: found.len() as u32,
-            rejected: 0,
+            ..Default::default()
         }
     }
 

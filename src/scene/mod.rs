@@ -61,6 +61,9 @@ pub struct SurfacePoint {
     pub tri: u32,
     /// Texture coordinates ((0, 0) in a scene without textures).
     pub uv: Vec2,
+    /// The triangle is flat-shaded (its vertex normals are its geometric normal): its photons
+    /// lie in its plane ([`crate::photon_map::Filter::flat`]).
+    pub flat: bool,
 }
 
 /// An assembled, validated scene.
@@ -413,6 +416,7 @@ impl Scene {
             material: self.material[i],
             tri: hit.tri,
             uv,
+            flat: n == [self.ng[i]; 3],
         }
     }
 

@@ -5,12 +5,20 @@
 //! [`Estimate`], or a fixed-radius lookup left to run alone ([`Planned::finish`]) or in a query
 //! packet with its neighbours ([`run_packet`]). With fixed radii the estimate carries its bias
 //! too (not with `visibility`, whose estimates are not boundary-corrected either).
+//!
+//! At a flat-shaded point the map's filter sets aside photons off the point's plane
+//! ([`Filter::flat`]): a parallel surface's — the sunlit ground 1 cm below a room's floor, the
+//! far face of a stair tread — or a neighbouring face's across a crease. Each estimate that met
+//! some is completed with those of them visible from the point ([`complete_off_plane`]): the
+//! ground's photons are behind the floor, a crease's are in plain view. Where none is met (a
+//! flat room's own walls, whose photons lie in their planes) no ray is traced.
 
 use super::Context;
+use crate::code_path::CodePath;
 use crate::material::Bsdf;
 use crate::photon_map::boundary::{Cut, MAX_EXTRA_CUTS};
 use crate::photon_map::query_packet::{RadiusQuery, PACKET};
-use crate::photon_map::{flags, Estimate, Filter, Lookup, Nearest, PhotonMap, Reflectance};
+use crate::photon_map::{flags, Estimate, Filter, Lookup, Nearest, PhotonMap, Reflectance, OFF_PLANE};
 use crate::scene::{Scene, SurfacePoint};
 use glam::Vec3;
 use std::sync::atomic::Ordering;
@@ -85,7 +93,14 @@ pub fn run_packet(ctx: &Context, lookups: &[FixedLookup<'_>], out: &mut [Estimat
     });
     let bias = ctx.fixed.is_some_and(|r| r.bias);
     let n = lookups.len();
-    first.map.estimate_radius_packet(ctx.settings.code_path, &queries[..n], bias, &mut out[..n]);
+    let set = ctx.settings.code_path;
+    first.map.estimate_radius_packet(set, &queries[..n], bias, &mut out[..n]);
+    for (j, q) in lookups.iter().enumerate() {
+        if out[j].off_plane > 0 {
+            let f = queries[j].f;
+            out[j] = complete_off_plane(ctx.scene, set, q.map, &q.lookup, f, out[j], &mut Nearest::default());
+        }
+    }
     let rejected: u64 = out[..n].iter().map(|e| u64::from(e.rejected)).sum();
     if rejected > 0 {
         ctx.filtered.fetch_add(rejected, Ordering::Relaxed);
@@ -119,7 +134,11 @@ fn plan_map<'m>(
         k: k as usize,
         r_max: radius,
         kernel: ctx.settings.kernel,
-        filter: Filter { n: ng, flags_mask: mask },
+        filter: Filter {
+            n: ng,
+            flags_mask: mask,
+            plane: if sp.flat && !ctx.settings.visibility { OFF_PLANE } else { 0.0 },
+        },
     };
     let eval = |wi| if base { bsdf.eval_base(&sp.frame, wo, wi) } else { bsdf.eval(&sp.frame, wo, wi) };
     let f = match *bsdf {
@@ -144,9 +163,14 @@ fn plan_map<'m>(
             let mut buf = [Cut::default(); MAX_EXTRA_CUTS];
             let edges = corrected.then(|| open_edge_cuts(ctx.scene, sp.tri, sp.p, r, &mut buf));
             let cuts = edges.map(|len| &buf[..len]);
-            map.estimate_radius_with(set, &Lookup { r_max: r, ..lookup }, f, cuts, bias)
+            let lookup = Lookup { r_max: r, ..lookup };
+            let e = map.estimate_radius_with(set, &lookup, f, cuts, bias);
+            complete_off_plane(ctx.scene, set, map, &lookup, f, e, scratch)
         }
-        (None, false, _) => map.estimate(set, &lookup, f, scratch),
+        (None, false, _) => {
+            let e = map.estimate(set, &lookup, f, scratch);
+            complete_off_plane(ctx.scene, set, map, &lookup, f, e, scratch)
+        }
         (fixed, true, _) => {
             let lookup = fixed.map_or(lookup, |r| Lookup { r_max: r, k: 0, ..lookup });
             let visible = photon_visibility(ctx.scene, sp.p, ng, lookup.r_max);
@@ -175,6 +199,61 @@ fn open_edge_cuts(scene: &Scene, tri: u32, p: Vec3, r: f32, cuts: &mut [Cut; MAX
         }
     }
     len
+}
+
+/// Completes an estimate `e` of `lookup` that set photons aside off its flat plane
+/// ([`Estimate::off_plane`]) with those of them visible from the point
+/// ([`off_plane_visibility`]): a k-nearest estimate is made again over the photons on the plane
+/// and the visible ones off it (so that the k nearest are counted among those); a fixed-radius
+/// one adds the visible ones' kernel sum, divided by the part of the disk the estimate was
+/// divided by (their share of the bias estimate is left out). Returns `e` when nothing was set
+/// aside.
+pub fn complete_off_plane(
+    scene: &Scene,
+    set: CodePath,
+    map: &PhotonMap,
+    lookup: &Lookup,
+    f: Reflectance<'_>,
+    e: Estimate,
+    scratch: &mut Nearest,
+) -> Estimate {
+    if e.off_plane == 0 {
+        return e;
+    }
+    let keep = off_plane_visibility(scene, lookup.p, lookup.filter.n, lookup.filter.plane);
+    if lookup.k > 0 {
+        let open = Lookup { filter: Filter { plane: 0.0, ..lookup.filter }, ..*lookup };
+        return map.estimate_visible(set, &open, f, scratch, &keep);
+    }
+    let seen: Vec<(f32, u32)> = map
+        .off_plane_photons(lookup)
+        .into_iter()
+        .filter(|&(_, i)| {
+            let p = map.photon(i as usize);
+            keep(p.position, p.normal)
+        })
+        .collect();
+    let extra = map.estimate_photons(set, lookup, f, &seen);
+    Estimate { radiance: e.radiance + extra.radiance / e.coverage, count: e.count + extra.count, off_plane: 0, ..e }
+}
+
+/// Whether a photon (position, normal) near the flat point `q` (normal `n`) belongs in its
+/// estimate: one in the point's plane (to `plane` of its distance, [`Filter::plane`]) always;
+/// one off it only if the segment between them, both lifted off their surfaces, meets nothing.
+/// The lift is ¾ of the photon's height above the plane (at least 10⁻³ of its distance): enough
+/// to clear a convex crease or a curved neighbour between them (a chord dips below a sphere by a
+/// quarter of that height), not enough to lift a photon under a floor above it.
+pub fn off_plane_visibility(scene: &Scene, q: Vec3, n: Vec3, plane: f32) -> impl Fn(Vec3, Vec3) -> bool + '_ {
+    move |p, m| {
+        let d = p - q;
+        let (h, d2) = (d.dot(n), d.length_squared());
+        if h * h <= plane * plane * d2 {
+            return true;
+        }
+        let lift = (0.75 * h.abs()).max(1e-3 * d2.sqrt());
+        let from = q + n * lift;
+        !scene.occluded(from, p + m * lift - from, 1.0)
+    }
 }
 
 /// Whether a photon (position, normal) is visible from the point `q` (normal `n`, on the side
@@ -287,7 +366,8 @@ pub fn map_radiance<'a>(
             k: 1,
             r_max: ctx.global_radius,
             kernel: ctx.settings.kernel,
-            filter: Filter { n: ng, flags_mask: 0 },
+            // At a flat point, a point off its plane (under a thin floor) is never the nearest.
+            filter: Filter { n: ng, flags_mask: 0, plane: if sp.flat { OFF_PLANE } else { 0.0 } },
         };
         if let Some(&(_, i)) = irr.nearest(ctx.settings.code_path, &lookup, scratch).first() {
             // With visibility on, a point behind a wall is not read: the full estimate below is.

@@ -1,10 +1,10 @@
 //! The photon maps of one render: the global and caustic trees, and the irradiance
 //! precomputed at global photons for final gathering (Christensen 1999).
 
-use super::estimate::photon_visibility;
+use super::estimate::{complete_off_plane, photon_visibility};
 use crate::job::Job;
 use crate::parallel::map_chunks;
-use crate::photon_map::{Filter, Lookup, Nearest, Photon, PhotonMap, Reflectance};
+use crate::photon_map::{flags, Filter, Lookup, Nearest, Photon, PhotonMap, Reflectance, OFF_PLANE_QUANTISED};
 use crate::scene::Scene;
 use crate::settings::Settings;
 use glam::Vec3;
@@ -80,19 +80,24 @@ fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings,
             range
                 .map(|j| {
                     let src = global.photon(picks[j]);
+                    // The point's normal is the stored, quantised one: the plane test allows for it.
+                    let flat = src.flags & flags::FLAT != 0 && !settings.visibility;
+                    let plane = if flat { OFF_PLANE_QUANTISED } else { 0.0 };
                     let lookup = Lookup {
                         p: src.position,
                         k: settings.k as usize,
                         r_max: radius,
                         kernel: settings.kernel,
-                        filter: Filter { n: src.normal, flags_mask: 0 },
+                        filter: Filter { n: src.normal, flags_mask: 0, plane },
                     };
                     let f = Reflectance::Constant(Vec3::ONE);
+                    let set = settings.code_path;
                     let e = if settings.visibility {
                         let visible = photon_visibility(scene, src.position, src.normal, radius);
-                        global.estimate_visible(settings.code_path, &lookup, f, &mut scratch, &visible)
+                        global.estimate_visible(set, &lookup, f, &mut scratch, &visible)
                     } else {
-                        global.estimate(settings.code_path, &lookup, f, &mut scratch)
+                        let e = global.estimate(set, &lookup, f, &mut scratch);
+                        complete_off_plane(scene, set, global, &lookup, f, e, &mut scratch)
                     };
                     Photon { position: src.position, power: e.radiance, wi: src.normal, normal: src.normal, flags: 0 }
                 })

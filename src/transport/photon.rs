@@ -315,7 +315,7 @@ pub fn deposit_photon(
     }
     let wo = -photon.dir;
     let (ng, _) = sp.frame.oriented(wo);
-    let mut f = 0;
+    let mut f = if sp.flat { flags::FLAT } else { 0 };
     if bounce == 0 {
         f |= flags::DIRECT;
     }
