@@ -155,6 +155,29 @@ fn the_command_line_merge_writes_the_undivided_file() {
     assert!(beauty.iter().any(|v| v.x > 0.0));
 }
 
+/// A part of a divided render says so, when it starts and where it names its output: a range
+/// from pass 0 (`--passes 0..2`) as much as any other part; a whole progressive render does not.
+#[test]
+fn a_part_says_it_is_a_partial_film() {
+    let dir = scratch("notice");
+    for (extra, part) in [(&["--passes", "0..2"][..], true), (&["--passes", "1..2"], true), (&["--passes", "2"], false)]
+    {
+        let out = dir.join("out.exr");
+        let scene = common::bundled("cornell-box.toml");
+        let o = photonwave()
+            .args(["render", scene.to_str().unwrap(), "--width", "8", "--height", "8", "--photons", "1000"])
+            .args(["-o", out.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let said = String::from_utf8_lossy(&o.stderr).to_string() + &String::from_utf8_lossy(&o.stdout);
+        let starts = said.contains("(a part: ") && said.contains("is a partial film for `photonwave merge`)");
+        let ends = said.contains("(a partial film: merge the parts with `photonwave merge`)");
+        assert_eq!((starts, ends), (part, part), "{extra:?}: {said}");
+    }
+}
+
 /// Partial films of another scene, other settings, another seed, overlapping passes, a
 /// truncated file and an EXR that is no partial film are refused, naming the files, and no
 /// output is written.

@@ -327,7 +327,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
     stats.times.total_s += load_s;
 
     if signal.is_none() {
-        say.info(format!("wrote {}\n", args.output.display()));
+        // A part of a divided render (`--passes A..B` from 0 too, `--pass-set`, `--partial`) is
+        // not an image to look at: say so again where the output is named.
+        let part = if progressive && (flags.divided() || flags.partial) {
+            " (a partial film: merge the parts with `photonwave merge`)"
+        } else {
+            ""
+        };
+        say.info(format!("wrote {}{part}\n", args.output.display()));
     }
     if let Some(p) = &args.png {
         film.write_png(p)?;

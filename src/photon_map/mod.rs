@@ -147,7 +147,8 @@ impl Default for Estimate {
 /// tangent plane), so curved surfaces keep all their photons; for a parallel surface at height
 /// `h` it is `2h`, so that surface's photons within `≈ 6.6 h` of the query are turned away — a
 /// floor 1 cm above a sunlit ground or the far side of a room lies off the query's surface
-/// however large the radius (the leak of `scenes/hard/room-on-ground.toml`). What it must
+/// however large the radius. (At a flat-shaded point the plane test of [`Filter::plane`] takes
+/// its place: nothing off that plane is kept unless visible.) What it must
 /// tolerate: the stored normals' quantisation (at most 3.9°: an offset of 0.034 of the
 /// distance on a flat surface) and a tessellated surface's facets (about a quarter of the
 /// angle between neighbouring facets: 0.13 for a 12-sided cylinder). Across a crease sharper

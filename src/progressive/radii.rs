@@ -5,8 +5,9 @@
 //!
 //! Each map's first radius is the median k-nearest radius where the camera reads the map — at
 //! the camera paths' first non-specular points, and for the global map under final gathering
-//! where one gather ray from each lands — not over the map's photons, most of which may lie
-//! where the camera never looks: a closed room under a sun outside (`scenes/hard/room-sunlit`)
+//! where one gather ray from each lands, weighed by the photon density there as a median over
+//! photons is — not over all the map's photons, most of which may lie where the camera never
+//! looks: a closed room under a sun outside (`scenes/hard/room-sunlit`)
 //! had a first global radius of 0.49 from the sunlit ground's photons against 0.14 from its own,
 //! and its inside rendered 7 % too bright with the edge correction (7 % too dark without). The
 //! median over the map's photons remains the fallback where the camera finds no such point.
@@ -106,9 +107,9 @@ pub fn initial_radii(scene: &Scene, rays: &CameraRays, job: &Job) -> FixedRadii 
 /// pixel's first non-specular point (its first camera sample, through mirrors and glass as that
 /// sample's path goes), the global map there too with final gathering off (without direct and
 /// caustic photons, as read there) or, with it on, where the pixel's first gather ray lands (the
-/// whole map, as read there). A point with fewer than k photons within the maximum radius counts
-/// as the maximum radius (so a sparse map's median is not taken over its dense spots alone);
-/// `None` for a map the camera reads nowhere.
+/// whole map, as read there), weighed by the photon density there ([`density_median`]). Points
+/// with fewer than k photons within the maximum radius are left out, as photons with fewer
+/// neighbours are from the median over photons; `None` where no point has k.
 #[must_use]
 pub fn camera_knn_radii(scene: &Scene, rays: &CameraRays, job: &Job, maps: &PhotonMaps) -> (Option<f32>, Option<f32>) {
     let settings = &job.settings;
@@ -116,7 +117,7 @@ pub fn camera_knn_radii(scene: &Scene, rays: &CameraRays, job: &Job, maps: &Phot
     let knn = |map: &PhotonMap, k: u32, r_max: f32, q: Lookup, scratch: &mut Nearest| {
         let found = map.nearest(settings.code_path, &Lookup { k: k as usize, r_max, ..q }, scratch);
         let r = found.iter().map(|c| c.0).fold(0.0, f32::max).sqrt();
-        Some(if found.len() == k as usize && r > 0.0 && r.is_finite() { r } else { r_max })
+        (found.len() == k as usize && r > 0.0 && r.is_finite()).then_some(r)
     };
     let (global_on, gather) = (ctx.effects.global_map.on, ctx.effects.final_gather.on);
     let found = probe_first_surfaces(&ctx, job, rays, (None, None), |_, s, sp, d, scratch, counts| {
@@ -143,12 +144,24 @@ pub fn camera_knn_radii(scene: &Scene, rays: &CameraRays, job: &Job, maps: &Phot
         };
         (global, caustic)
     });
-    let median = |mut v: Vec<f32>| {
-        let mid = v.len() / 2;
-        (!v.is_empty()).then(|| *v.select_nth_unstable_by(mid, f32::total_cmp).1)
-    };
     let (global, caustic): (Vec<_>, Vec<_>) = found.into_iter().unzip();
-    (median(global.into_iter().flatten().collect()), median(caustic.into_iter().flatten().collect()))
+    (density_median(global.into_iter().flatten().collect()), density_median(caustic.into_iter().flatten().collect()))
+}
+
+/// The median of k-nearest radii found at points of a surface, each weighed by the photon
+/// density there (∝ 1/r²): the median a photon of those regions sees, as the median over the
+/// map's photons was — photons crowd where the light is, and the first radius (hence each
+/// estimate's cost and noise) was tuned on that median. `None` for no radii.
+fn density_median(mut radii: Vec<f32>) -> Option<f32> {
+    radii.retain(|r| *r > 0.0 && r.is_finite());
+    radii.sort_unstable_by(f32::total_cmp);
+    let weight = |r: f32| 1.0 / (f64::from(r) * f64::from(r));
+    let half = 0.5 * radii.iter().map(|&r| weight(r)).sum::<f64>();
+    let mut sum = 0.0;
+    radii.into_iter().find(|&r| {
+        sum += weight(r);
+        sum >= half
+    })
 }
 
 /// Each pixel's first radii: the radius a k-nearest-neighbour estimate would use at the first
