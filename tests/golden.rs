@@ -18,13 +18,13 @@ use std::sync::Arc;
 
 /// (scene, engine, passes) → FNV-1a 64 of the film's f32 bits.
 const GOLDEN: &[(&str, &str, u32, u64)] = &[
-    ("cornell-box.toml", "wavefront", 1, 0x13da05e240f36310),
-    ("cornell-box.toml", "reference", 1, 0xc8b8078049d21cb2),
+    ("cornell-box.toml", "wavefront", 1, 0x65db47bab6e2e1c3),
+    ("cornell-box.toml", "reference", 1, 0xa59e48a3f41b6ca0),
     ("cornell-box.toml", "path", 1, 0xd3159bbc928efad9),
-    ("cornell-spheres.toml", "wavefront", 1, 0xcae142bef77346d6),
-    ("cornell-spheres.toml", "reference", 1, 0xbf871e2bb18619f7),
-    ("cornell-spheres.toml", "wavefront", 3, 0x2329b850062b5b22),
-    ("cornell-spheres.toml", "reference", 3, 0x7c35a4080011cdd0),
+    ("cornell-spheres.toml", "wavefront", 1, 0x40cd9a681fd1fe77),
+    ("cornell-spheres.toml", "reference", 1, 0x0450b051cc1bf9cc),
+    ("cornell-spheres.toml", "wavefront", 3, 0x662c89e3e7e999b3),
+    ("cornell-spheres.toml", "reference", 3, 0x7e4c361acb8b96d9),
     ("hard/furnace-materials.toml", "wavefront", 1, 0x93e4e7301afa4d9b),
     ("hard/furnace-materials.toml", "reference", 1, 0x9eb570813f5e4066),
     ("hard/nested.toml", "wavefront", 2, 0x0896f03bd3da855a),

@@ -15,12 +15,13 @@ const OFFSET2: f32 = 4.0 * SURFACE_OFFSET * SURFACE_OFFSET;
 impl PhotonMap {
     /// Whether photon `key` at `delta` = (x − p), `d2` = |x − p|² from the query passes
     /// `filter`: flags; the normal test n·m > 0.7·|m| evaluated as n·m > 0 ∧ (n·m)² > 0.49·|m|²
-    /// (no square root); then for a flat query the plane test ((x − p)·n)² ≤ plane²·d2
-    /// ([`Filter::plane`]), which sets the photons off the plane aside, and for any other the
-    /// offset test ((x − p)·(n + m̂))² ≤ [`OFFSET2`]·d2 — the same operations as the 8-wide
-    /// form. A rejection says which test failed. (A flat query needs no offset test: what lies
-    /// off its plane is kept only if visible; each test costs a sixth of a dense estimate's
-    /// time, so the two are never both made.)
+    /// (no square root); then for a flat query the plane test, which sets aside the photons
+    /// behind its plane by more than `plane` of their distance ((x − p)·n < 0 and
+    /// ((x − p)·n)² > plane²·d2, [`Filter::plane`]), and for any other the offset test
+    /// ((x − p)·(n + m̂))² ≤ [`OFFSET2`]·d2 — the same operations as the 8-wide form. A
+    /// rejection says which test failed. (Each test adds a sixth to a packet of estimates'
+    /// instructions, so a query makes one: what a flat point's offset test would turn away lies
+    /// behind its plane, set aside, or in front of it, kept as it always was.)
     #[inline]
     pub(super) fn test(key: u32, filter: &Filter, delta: [f32; 3], d2: f32) -> Test {
         if key_flags(key) & filter.flags_mask != 0 {
@@ -34,7 +35,11 @@ impl PhotonMap {
         }
         if filter.plane > 0.0 {
             let height = delta[0] * filter.n.x + delta[1] * filter.n.y + delta[2] * filter.n.z;
-            return if height * height > filter.plane * filter.plane * d2 { Test::OffPlane } else { Test::Accepted };
+            return if height < 0.0 && height * height > filter.plane * filter.plane * d2 {
+                Test::OffPlane
+            } else {
+                Test::Accepted
+            };
         }
         let inv = 1.0 / len2.sqrt();
         let h = [filter.n.x + m.x * inv, filter.n.y + m.y * inv, filter.n.z + m.z * inv];
@@ -92,13 +97,14 @@ impl PhotonMap {
         d2: f32x8,
     ) -> Filtered8 {
         let (pass, flags_ok, [hx, hy, hz]) = normals.masks(filter);
+        let [dx, dy, dz] = delta;
         let facing = near & pass;
         let turned = (near & flags_ok & !pass).to_bitmask();
-        let [dx, dy, dz] = delta;
         if filter.plane > 0.0 {
             let n = filter.n;
             let height = dx * f32x8::splat(n.x) + dy * f32x8::splat(n.y) + dz * f32x8::splat(n.z);
-            let off = facing & (height * height).simd_gt(f32x8::splat(filter.plane * filter.plane) * d2);
+            let below = height.simd_lt(f32x8::ZERO);
+            let off = facing & below & (height * height).simd_gt(f32x8::splat(filter.plane * filter.plane) * d2);
             return Filtered8 { inside: facing & !off, turned, off_plane: off.to_bitmask() };
         }
         let s = dx * hx + dy * hy + dz * hz;

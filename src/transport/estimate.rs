@@ -6,12 +6,12 @@
 //! packet with its neighbours ([`run_packet`]). With fixed radii the estimate carries its bias
 //! too (not with `visibility`, whose estimates are not boundary-corrected either).
 //!
-//! At a flat-shaded point the map's filter sets aside photons off the point's plane
-//! ([`Filter::flat`]): a parallel surface's — the sunlit ground 1 cm below a room's floor, the
-//! far face of a stair tread — or a neighbouring face's across a crease. Each estimate that met
-//! some is completed with those of them visible from the point ([`complete_off_plane`]): the
-//! ground's photons are behind the floor, a crease's are in plain view. Where none is met (a
-//! flat room's own walls, whose photons lie in their planes) no ray is traced.
+//! At a flat-shaded point the map's filter sets aside photons behind the point's plane
+//! ([`Filter::plane`]): a parallel surface's — the sunlit ground 1 cm below a room's floor — or a
+//! neighbouring face's across a convex crease. Each estimate that met some is completed with
+//! those of them visible from the point ([`complete_off_plane`]): the ground's photons are
+//! hidden by the floor, a crease's are in plain view. Where none is met (a flat room's own
+//! walls, whose photons lie in their planes) no ray is traced.
 
 use super::Context;
 use crate::code_path::CodePath;
@@ -98,7 +98,8 @@ pub fn run_packet(ctx: &Context, lookups: &[FixedLookup<'_>], out: &mut [Estimat
     for (j, q) in lookups.iter().enumerate() {
         if out[j].off_plane > 0 {
             let f = queries[j].f;
-            out[j] = complete_off_plane(ctx.scene, set, q.map, &q.lookup, f, out[j], &mut Nearest::default());
+            let fixed = Lookup { k: 0, ..q.lookup };
+            out[j] = complete_off_plane(ctx.scene, set, q.map, &fixed, f, out[j], &mut Nearest::default());
         }
     }
     let rejected: u64 = out[..n].iter().map(|e| u64::from(e.rejected)).sum();
@@ -163,7 +164,7 @@ fn plan_map<'m>(
             let mut buf = [Cut::default(); MAX_EXTRA_CUTS];
             let edges = corrected.then(|| open_edge_cuts(ctx.scene, sp.tri, sp.p, r, &mut buf));
             let cuts = edges.map(|len| &buf[..len]);
-            let lookup = Lookup { r_max: r, ..lookup };
+            let lookup = Lookup { r_max: r, k: 0, ..lookup };
             let e = map.estimate_radius_with(set, &lookup, f, cuts, bias);
             complete_off_plane(ctx.scene, set, map, &lookup, f, e, scratch)
         }
@@ -201,8 +202,9 @@ fn open_edge_cuts(scene: &Scene, tri: u32, p: Vec3, r: f32, cuts: &mut [Cut; MAX
     len
 }
 
-/// Completes an estimate `e` of `lookup` that set photons aside off its flat plane
-/// ([`Estimate::off_plane`]) with those of them visible from the point
+/// Completes an estimate `e` of `lookup` (a k-nearest one, or with `lookup.k == 0` a fixed-radius
+/// one) that set photons aside off its flat plane ([`Estimate::off_plane`]) with those of them
+/// visible from the point
 /// ([`off_plane_visibility`]): a k-nearest estimate is made again over the photons on the plane
 /// and the visible ones off it (so that the k nearest are counted among those); a fixed-radius
 /// one adds the visible ones' kernel sum, divided by the part of the disk the estimate was
