@@ -33,9 +33,10 @@
 //! - [`stats`]: plain records of what a render did (rays, times, maps, numerics);
 //! - [`film`]: the five [`film::Term`]s per pixel, EXR and PNG output;
 //! - [`job`]: one render's validated settings, plan and pass (seed, progressive radii);
-//! - [`pass_set`]: which progressive passes a render runs (all, a range, worker K of N) and has run;
-//! - [`exact`]: per-pixel fixed-point integer sums of passes, the same in any order;
-//! - [`pass_sums`]: the mean, noise and bias of a set of passes from their exact sums;
+//! - [`divided`]'s records: [`divided::pass_set`], which progressive passes a render runs (all, a
+//!   range, worker K of N) and has run; [`divided::exact`], per-pixel fixed-point integer sums of
+//!   passes, the same in any order; [`divided::pass_sums`], the mean, noise and bias of a set of
+//!   passes from their exact sums;
 //!
 //! **Physics** — written once:
 //! - [`transport`]: every vertex both engines and the path tracer share — camera samples,
@@ -49,12 +50,12 @@
 //!
 //! **Drivers and tools**:
 //! - [`progressive`]: progressive passes with shrinking radii, a time budget and a stop request;
-//! - [`partial`] and [`merge`]: partial films of divided or interrupted renders, and their exact
-//!   merge;
+//! - [`divided::partial`] and [`divided::merge`]: partial films of divided or interrupted
+//!   renders, and their exact merge;
 //! - [`engine`]: the one render entry point — a single render or progressive passes;
 //! - [`diagnostics`]: the diagnostic layers — estimate radii and photon counts per pixel;
-//! - [`compare`], [`sweep`], [`plot`], [`bench`], [`fuzzing`]: the CLI's `compare`, `sweep`,
-//!   `bench` and the fuzz targets' entry points.
+//! - [`tools`] ([`tools::compare`], [`tools::sweep`], [`tools::plot`]), [`bench`], [`fuzzing`]:
+//!   the CLI's `compare`, `sweep`, `bench` and the fuzz targets' entry points.
 
 // `!(x > 0.0)` is used on purpose throughout: unlike `x <= 0.0` it is also true for NaN, so a
 // NaN value is rejected by the same test as a non-positive one.
@@ -63,12 +64,11 @@
 
 pub mod bench;
 pub mod code_path;
-pub mod compare;
 pub mod diagnostics;
+pub mod divided;
 pub mod effects;
 pub mod engine;
 pub mod error;
-pub mod exact;
 pub mod files;
 pub mod film;
 pub mod fuzzing;
@@ -76,17 +76,12 @@ pub mod geometry;
 pub mod job;
 pub mod material;
 pub mod memory;
-pub mod merge;
 pub mod microfacet;
 pub mod optics;
 pub mod parallel;
-pub mod partial;
-pub mod pass_set;
-pub mod pass_sums;
 pub mod path;
 pub mod photon_map;
 pub mod plan;
-pub mod plot;
 pub mod progress;
 pub mod progressive;
 pub mod reference;
@@ -95,8 +90,8 @@ pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod stats;
-pub mod sweep;
 pub mod texture;
+pub mod tools;
 pub mod transport;
 pub mod traversal_choice;
 pub mod wavefront;

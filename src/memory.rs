@@ -16,7 +16,7 @@ pub const BYTES_PER_PIXEL: u64 = 160;
 pub const BYTES_PER_PHOTON: u64 = 96;
 /// Bytes per pixel a progressive render adds (measured 390 at 800², peak resident set of
 /// `--passes 2` against one pass, BENCHMARKS.md "Divided renders"): its passes' exact sums
-/// (`crate::exact`, 20 values of 16 bytes), the pass's film beside them and the mean's.
+/// (`crate::divided::exact`, 20 values of 16 bytes), the pass's film beside them and the mean's.
 pub const PROGRESSIVE_BYTES_PER_PIXEL: u64 = 400;
 
 /// Bytes per pixel of a render, progressive or not.
@@ -75,7 +75,7 @@ pub fn check(
         format!(
             "this render needs about {} ({width}×{height} pixels at ~{per_pixel} B, {photons} photons at \
              ~{BYTES_PER_PHOTON} B, {} for the scene's 8-wide BVH), but the machine has {} available of \
-             {}; lower the image size or the photon counts (README, \"Limits\")",
+             {}; lower the image size or the photon counts (docs/src/bad-input.md, \"Limits\")",
             bytes(need),
             bytes(scene_bytes),
             bytes(available),

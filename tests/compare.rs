@@ -4,8 +4,8 @@ mod common;
 
 use common::scratch_dir;
 use glam::Vec3;
-use photonwave::compare::compare_files;
 use photonwave::film::{Film, Terms};
+use photonwave::tools::compare::compare_files;
 use std::process::Command;
 
 /// A 2×1 film whose only non-zero terms are `direct` and `caustic`.

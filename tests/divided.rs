@@ -5,11 +5,11 @@
 
 mod common;
 
+use photonwave::divided::partial::{self, Identity};
+use photonwave::divided::pass_sums::{radius2_scale, RadiusSequence};
 use photonwave::engine::Engine;
 use photonwave::film::Film;
 use photonwave::job::Job;
-use photonwave::partial::{self, Identity};
-use photonwave::pass_sums::{radius2_scale, RadiusSequence};
 use photonwave::progress::NoProgress;
 use photonwave::progressive::Progressive;
 use photonwave::scene::camera::CameraRays;
@@ -93,7 +93,7 @@ fn merges_of_any_split_equal_the_undivided_render() {
             }
             // Any order of the files.
             parts.reverse();
-            let merged = photonwave::merge::merge(parts.into_iter().map(Ok)).unwrap();
+            let merged = photonwave::divided::merge::merge(parts.into_iter().map(Ok)).unwrap();
             assert!(merged.missing.is_none());
             assert_eq!(bits(&merged.film), bits(&whole), "{engine:?}, split {split:?}");
         }

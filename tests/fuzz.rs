@@ -1,6 +1,6 @@
 //! Fuzzing in the normal test run, bounded and with fixed seeds: the properties of
 //! `photonwave::fuzzing` on mutated scene files and on rays through shared edges. The open-ended
-//! twins are the cargo-fuzz targets in fuzz/ (README, "Fuzzing").
+//! twins are the cargo-fuzz targets in fuzz/ (docs/src/bad-input.md, "Fuzzing").
 
 mod common;
 
@@ -185,8 +185,8 @@ fn rays_through_a_shared_edge_hit_one_side() {
         .unwrap();
 }
 
-/// Every input a cargo-fuzz target ever failed on, kept in `fuzz/regressions/TARGET/` (README,
-/// "Fuzzing"), passes its property now.
+/// Every input a cargo-fuzz target ever failed on, kept in `fuzz/regressions/TARGET/`
+/// (docs/src/bad-input.md, "Fuzzing"), passes its property now.
 #[test]
 fn inputs_the_fuzzers_found_stay_fixed() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions");

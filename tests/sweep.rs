@@ -5,13 +5,13 @@
 mod common;
 
 use common::{bundled, load, scratch_dir};
-use photonwave::compare::layer_errors;
 use photonwave::engine::{self, Engine};
 use photonwave::film::Film;
 use photonwave::progress::NoProgress;
 use photonwave::progressive::PerPass;
 use photonwave::settings::{Kernel, Settings};
-use photonwave::sweep::{grid, set_knob, Knob, Metric, Sweep};
+use photonwave::tools::compare::layer_errors;
+use photonwave::tools::sweep::{grid, set_knob, Knob, Metric, Sweep};
 use std::process::Command;
 use std::sync::Arc;
 use std::time::Duration;
@@ -147,10 +147,10 @@ fn rows_are_what_render_and_compare_give() {
     assert!(by_rays.lines.iter().all(|l| l.points.len() == 2 && l.colour.is_none()));
     assert_eq!(by_rays.groups.iter().map(|g| g.points.len()).collect::<Vec<_>>(), [2, 2]);
     assert_eq!(by_rays.groups[1].label, "gather_rays = 4");
-    let caustic = |r: &photonwave::sweep::Row| r.errors.iter().find(|e| e.layer == "caustic").unwrap().rmse;
+    let caustic = |r: &photonwave::tools::sweep::Row| r.errors.iter().find(|e| e.layer == "caustic").unwrap().rmse;
     assert_eq!(by_rays.groups[0].points[0], (rows[0].seconds, caustic(&rows[0])));
 
-    let csv = photonwave::sweep::csv(&sweep.knobs, &rows);
+    let csv = photonwave::tools::sweep::csv(&sweep.knobs, &rows);
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 5);
     assert!(
@@ -231,7 +231,7 @@ fn cli_writes_the_csv_and_a_plot_per_knob() {
     assert!(svg.contains("<svg") && svg.contains("k = 16") && svg.contains("render time (s)"), "{svg}");
     let png = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(out.join("k.png")).unwrap()));
     let info = png.read_info().unwrap().info().clone();
-    assert_eq!((info.width, info.height), photonwave::plot::SIZE);
+    assert_eq!((info.width, info.height), photonwave::tools::plot::SIZE);
     assert!(!out.join("spp.svg").exists() && !out.join("photons.png").exists());
 }
 

@@ -17,7 +17,7 @@ pub struct CompareArgs {
 
 /// Runs `compare`.
 pub fn run(args: &CompareArgs) -> Result<()> {
-    let c = photonwave::compare::compare_files(&args.image, &args.reference)?;
+    let c = photonwave::tools::compare::compare_files(&args.image, &args.reference)?;
     if args.json {
         println!("{}", serde_json::to_string(&c).map_err(|e| Error::output(std::path::Path::new("stdout"), e))?);
     } else {

@@ -1,5 +1,5 @@
 //! `photonwave merge PART.exr… -o OUT.exr`: reads partial films, merges them exactly
-//! (`photonwave::merge`), and writes the EXR, PNG and JSON stats an undivided render writes.
+//! (`photonwave::divided::merge`), and writes the EXR, PNG and JSON stats an undivided render writes.
 
 use super::Say;
 use photonwave::error::{Error, Result};
@@ -43,7 +43,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     outputs.extend(args.png.as_deref().map(|path| Output { flag: "--png", path, ext: "png" }));
     outputs.extend(args.stats.as_deref().map(|path| Output { flag: "--stats", path, ext: "json" }));
     check_outputs(&outputs, &args.parts)?;
-    let merged = photonwave::merge::merge(args.parts.iter().map(|p| photonwave::partial::read(p)))?;
+    let merged = photonwave::divided::merge::merge(args.parts.iter().map(|p| photonwave::divided::partial::read(p)))?;
     if let Some(missing) = &merged.missing {
         let text = format!(
             "passes {missing} are missing (below the largest, {}; `a..b` is a to b−1): the image is the mean of \
@@ -61,7 +61,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     }
     if args.partial {
         let m = &merged;
-        photonwave::partial::write(&args.output, &m.identity, &m.sums, m.spp, &m.film, &m.stats)?;
+        photonwave::divided::partial::write(&args.output, &m.identity, &m.sums, m.spp, &m.film, &m.stats)?;
     } else {
         merged.film.write_exr(&args.output)?;
     }

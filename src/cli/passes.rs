@@ -4,12 +4,12 @@
 
 use super::interrupt::{Interrupt, WritePartial};
 use super::Say;
+use photonwave::divided::partial::{self, Identity};
+use photonwave::divided::pass_set::PassSet;
 use photonwave::engine::{Budget, Engine};
 use photonwave::error::{Error, Result};
 use photonwave::film::Film;
 use photonwave::job::Job;
-use photonwave::partial::{self, Identity};
-use photonwave::pass_set::PassSet;
 use photonwave::progress::Progress;
 use photonwave::progressive::{self, Drive, Ended, Progressive};
 use photonwave::scene::camera::CameraRays;

@@ -25,7 +25,7 @@ pub struct SweepArgs {
     /// global_radius, caustic_radius, kernel, gather_rays, final_gather, precompute_irradiance,
     /// secondary_gather, per_pixel_radii, passes, alpha, max_depth, light_samples, seed, threads, code_path.
     #[arg(long = "knob", required = true)]
-    pub knobs: Vec<photonwave::sweep::Knob>,
+    pub knobs: Vec<photonwave::tools::sweep::Knob>,
     /// Equal-time mode: time budgets, e.g. `1s,4s,16s`; every configuration renders progressive
     /// passes for each budget, and the error it reaches is recorded.
     #[arg(long, value_delimiter = ',', value_parser = parse_duration)]
@@ -40,7 +40,7 @@ pub struct SweepArgs {
     /// The error the plots show: `rmse`, or `relmse` ((a−b)²/(b²+0.01), which weighs dark
     /// regions as much as bright ones).
     #[arg(long, default_value = "rmse")]
-    pub metric: photonwave::sweep::Metric,
+    pub metric: photonwave::tools::sweep::Metric,
     /// Amounts of work the knobs start from (as `render --preset`) [the scene file's settings].
     #[arg(long)]
     pub preset: Option<Preset>,
@@ -54,8 +54,8 @@ pub struct SweepArgs {
 
 /// Runs `sweep`.
 pub fn run(args: SweepArgs) -> Result<()> {
-    use photonwave::sweep::Sweep;
-    let reference = photonwave::compare::read_finite_exr(&args.reference)?;
+    use photonwave::tools::sweep::Sweep;
+    let reference = photonwave::tools::compare::read_finite_exr(&args.reference)?;
     let layer_key = if args.layer == "beauty" { "" } else { args.layer.as_str() };
     if !reference.layers.iter().any(|(n, _)| n == layer_key) {
         let names: Vec<&str> =
@@ -110,23 +110,23 @@ pub fn run(args: SweepArgs) -> Result<()> {
         eprintln!(
             "{:>4} {:<40} {:>9} {:>7} {:>10.3} {:>14.4e}",
             r.config,
-            photonwave::sweep::describe(&sweep.knobs, &r.values),
+            photonwave::tools::sweep::describe(&sweep.knobs, &r.values),
             r.budget_s.map_or("-".into(), |b| format!("{b:.2}")),
             r.passes,
             r.seconds,
             err
         );
     }
-    photonwave::sweep::write_csv(&csv, &sweep.knobs, &rows)?;
+    photonwave::tools::sweep::write_csv(&csv, &sweep.knobs, &rows)?;
     eprintln!("wrote {}", csv.display());
     let name = args.scene.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
     for (knob, fig) in sweep.figures(&rows, &args.layer, args.metric, &name) {
         for ext in ["svg", "png"] {
             let path = args.output.join(format!("{knob}.{ext}"));
             if ext == "svg" {
-                photonwave::plot::write_svg(&fig, &path)?;
+                photonwave::tools::plot::write_svg(&fig, &path)?;
             } else {
-                photonwave::plot::write_png(&fig, &path)?;
+                photonwave::tools::plot::write_png(&fig, &path)?;
             }
             eprintln!("wrote {}", path.display());
         }

@@ -3,10 +3,10 @@
 //! into the finished film and stats.
 
 use super::{Budget, Progressive};
+use crate::divided::pass_set::PassSet;
 use crate::error::Result;
 use crate::film::Film;
 use crate::job::Job;
-use crate::pass_set::PassSet;
 use crate::progress::Progress;
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;

@@ -16,9 +16,9 @@
 //! `per_pixel_radii` (the default) each pixel's own, the k-th-neighbour distance at the pixel's
 //! first non-specular point ([`pixel_radii`]), scaled by the same sequence.
 //!
-//! Any set of passes can be rendered ([`crate::pass_set::PassSet`]): pass i's seed and radii
+//! Any set of passes can be rendered ([`crate::divided::pass_set::PassSet`]): pass i's seed and radii
 //! follow from the user's seed and i alone, and the passes' sums are exact
-//! ([`crate::pass_sums`]), so passes split between machines or runs merge into the image of an
+//! ([`crate::divided::pass_sums`]), so passes split between machines or runs merge into the image of an
 //! undivided render, bit for bit.
 //!
 //! The driver ([`render_passes`], [`drive`]) takes a closure that renders one pass of a [`Job`],
@@ -30,17 +30,17 @@ mod radii;
 pub use driver::{default_set, drive, finish, render_passes, Drive, Ended};
 pub use radii::{initial_radii, median_knn_radius, pass_seed, pilot_seed, pixel_radii, RADIUS_SAMPLES};
 
+use crate::divided::pass_sums::{estimates_bias, PassSums};
 use crate::error::Result;
 use crate::film::Film;
 use crate::job::{FixedRadii, Job, Pass};
-use crate::pass_sums::{estimates_bias, PassSums};
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::Settings;
 use crate::stats::RenderStats;
 use std::time::{Duration, Instant};
 
-pub use crate::pass_sums::{radius2_scale, student_t975, BIAS_EVERY};
+pub use crate::divided::pass_sums::{radius2_scale, student_t975, BIAS_EVERY};
 
 /// A time budget: stop starting passes so that the render ends near `start + limit`.
 #[derive(Clone, Copy, Debug)]

@@ -74,7 +74,7 @@ pub(super) fn coincident_dielectrics(
         format!(
             "overlapping faces of different materials in one plane ({}): which one a ray meets is \
              arbitrary and the ratio of indices across them is lost; model each boundary between two \
-             dielectrics as one face whose glass material has `ior` and `outside_ior` (README, \
+             dielectrics as one face whose glass material has `ior` and `outside_ior` (docs/src/hard-cases.md, \
              \"Nested dielectrics\")",
             list.join(", ")
         )

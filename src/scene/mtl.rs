@@ -1,5 +1,5 @@
 //! MTL files as the spec (Wavefront's, with the PBR extension's keys) and real exporters write
-//! them, and their mapping onto photonwave's materials (documented in README):
+//! them, and their mapping onto photonwave's materials (documented in docs/src/scenes.md):
 //!
 //! | MTL | material |
 //! |---|---|

@@ -166,7 +166,7 @@ fn out_of_range(path: &Path, text: &str, (scale, translate): (f32, Vec3)) -> Err
         format!(
             "the vertex lies at {p} (after scale and translate), outside ±{MAX_COORDINATE:e}, the range in \
              which photonwave's f32 geometry stays watertight; scale the scene down (`scale` in the scene \
-             file; README, \"Limits\")"
+             file; docs/src/bad-input.md, \"Limits\")"
         ),
     )
 }

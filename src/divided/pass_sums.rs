@@ -4,9 +4,9 @@
 //! increasing order, so the same passes give the same image bit for bit however they were
 //! split between machines, threads or runs.
 
-use crate::exact::ExactSums;
+use crate::divided::exact::ExactSums;
+use crate::divided::pass_set::PassList;
 use crate::film::Film;
-use crate::pass_set::PassList;
 use crate::stats::ImageError;
 
 /// Passes 0, 4, 8, … estimate their bias, and the image's bias is extrapolated from them: the

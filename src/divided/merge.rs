@@ -1,14 +1,14 @@
-//! `merge`: reads partial films ([`crate::partial`]) and writes the film and stats of all their
+//! `merge`: reads partial films ([`crate::divided::partial`]) and writes the film and stats of all their
 //! passes together. The sums are integers, so the result does not depend on the order of the
 //! files or on how the passes were split: the merge of any split of passes 0..N is the film of
 //! an undivided `render --passes N`, bit for bit. Files that are not parts of one render, or
 //! that hold a pass twice, are refused by name.
 
+use crate::divided::partial::Partial;
+use crate::divided::pass_set::PassList;
+use crate::divided::pass_sums::PassSums;
 use crate::error::{Error, Result};
 use crate::film::Film;
-use crate::partial::Partial;
-use crate::pass_set::PassList;
-use crate::pass_sums::PassSums;
 use crate::stats::RenderStats;
 
 /// The merged render.
@@ -23,7 +23,7 @@ pub struct Merged {
     /// Passes below the largest that no file holds, as compact text.
     pub missing: Option<String>,
     /// Which render the parts belong to.
-    pub identity: crate::partial::Identity,
+    pub identity: crate::divided::partial::Identity,
     /// Samples per pixel in each pass.
     pub spp: u32,
     /// What went into the film that its user should know (a missing diagnostic layer).

@@ -1,7 +1,7 @@
 //! `photonwave sweep`: what accuracy costs in time. Renders one scene over a grid of settings
 //! (every combination of the knobs' values — at each time budget, in equal-time mode), times
 //! each render, measures the error of every layer against a reference image, and writes
-//! `sweep.csv` and one log-log error-against-time plot per knob ([`crate::plot`]).
+//! `sweep.csv` and one log-log error-against-time plot per knob ([`crate::tools::plot`]).
 //!
 //! A knob is any field of [`Settings`] but the image size (the reference fixes it) and `force`;
 //! its values are parsed as the field's own type, so `kernel=box,cone` and `final_gather=true,false`
@@ -9,16 +9,16 @@
 //! knob), so rows differ by their settings and not by their random numbers, and each is what
 //! `photonwave render` gives with the same settings and flags.
 
-use crate::compare::{layer_errors, LayerError};
 use crate::engine::{Budget, Engine};
 use crate::error::{Error, Result};
 use crate::film::ExrLayers;
-use crate::plot::{Figure, Line, PointGroup};
 use crate::progress::{NoProgress, Progress};
 use crate::progressive::{per_pass, PerPass};
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::Settings;
+use crate::tools::compare::{layer_errors, LayerError};
+use crate::tools::plot::{Figure, Line, PointGroup};
 use serde::Deserialize;
 use std::path::Path;
 use std::sync::Arc;

@@ -1,6 +1,6 @@
 //! Partial films: the passes of a divided or interrupted progressive render, as an EXR that
 //! any viewer shows (the mean of its passes, with every layer a render writes) and that holds
-//! what [`crate::pass_sums`] needs to continue or merge it exactly — the per-pixel exact sums as
+//! what [`crate::divided::pass_sums`] needs to continue or merge it exactly — the per-pixel exact sums as
 //! u32 channels (`sum.<value>.w0` … `w3`, the words of each i128, least significant first), the
 //! per-pixel sample count (`samples`), and one header attribute, `photonwave`, a JSON record of
 //! the passes, the seed, the engine, the version, hashes of the scene's files and of every
@@ -8,11 +8,11 @@
 //!
 //! Reads partial films, checks that they belong to one render, and writes a partial film.
 
+use crate::divided::exact::{ExactSums, NAMES, VALUES};
+use crate::divided::pass_set::PassList;
+use crate::divided::pass_sums::PassSums;
 use crate::error::{Error, Result};
-use crate::exact::{ExactSums, NAMES, VALUES};
 use crate::film::{EstimateLayers, Film};
-use crate::pass_set::PassList;
-use crate::pass_sums::PassSums;
 use crate::settings::Settings;
 use crate::stats::RenderStats;
 use serde::{Deserialize, Serialize};

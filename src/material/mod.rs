@@ -1,0 +1,344 @@
+//! Materials and their BSDFs: Lambertian, glossy (Lambertian + normalised Phong lobe), perfect
+//! mirror and smooth dielectric, and the GGX rough ones; their evaluate, pdf and sample are in
+//! [`bsdf`].
+//!
+//! Directions are world-space unit vectors pointing away from the surface: `wo` toward the viewer
+//! (or where the photon came from), `wi` toward the next vertex. Opaque materials are two-sided:
+//! the frame is flipped to the side of `wo`. The dielectric uses the unflipped normal to know
+//! whether the ray enters or leaves.
+
+use crate::microfacet;
+pub use crate::optics::{fresnel_dielectric, reflect, refract};
+use crate::texture::Texture;
+use glam::{Vec2, Vec3};
+use std::sync::Arc;
+
+mod bsdf;
+
+/// What flows along the path: radiance (camera paths) or power (photons). Refraction scales
+/// radiance by (η_wo / η_wi)², never power.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Transport {
+    /// Camera paths carry radiance.
+    Radiance,
+    /// Photon paths carry power.
+    Power,
+}
+
+/// The scattering part of a material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+// Each variant's doc names and explains its fields.
+#[allow(missing_docs)]
+pub enum Bsdf {
+    /// Lambertian reflection with albedo `kd`.
+    Lambert { kd: Vec3 },
+    /// Lambertian `kd` plus a normalised modified-Phong lobe `ks·(n+2)/(2π)·cos^n α` around the mirror
+    /// direction (Lafortune & Willems 1994); kd + ks ≤ 1 per channel, so it never gains energy.
+    Glossy { kd: Vec3, ks: Vec3, exponent: f32 },
+    /// Perfect mirror with reflectance `ks`.
+    Mirror { ks: Vec3 },
+    /// Smooth clear dielectric with index of refraction `ior` (relative to the outside, the side
+    /// the geometric normal points to), exact Fresnel.
+    Glass { ior: f32 },
+    /// Rough conductor ([`crate::microfacet`]): GGX of width `alpha` (roughness²), Schlick's
+    /// Fresnel from the normal-incidence reflectance `ks`.
+    RoughConductor { ks: Vec3, alpha: f32 },
+    /// Rough (frosted) clear dielectric: GGX of width `alpha`, exact Fresnel, reflection and
+    /// refraction through the microfacets; `ior` as for [`Bsdf::Glass`].
+    RoughDielectric { ior: f32, alpha: f32 },
+    /// Rough plastic: a GGX dielectric coat (index `ior`, width `alpha`) over a Lambertian base
+    /// `kd` ([`microfacet::plastic_eval`]).
+    RoughPlastic { kd: Vec3, ior: f32, alpha: f32 },
+}
+
+/// The GGX α below which a rough conductor acts as a mirror for photons (roughness 0.3): its
+/// photons pass on as specular, so its caustics go into the caustic map, instead of being
+/// stored on it. Rough dielectrics always pass photons on (a photon stored on frosted glass
+/// could never light what lies behind it). The effects plan says which surfaces are which.
+pub const PHOTON_SPECULAR_ALPHA: f32 = 0.09;
+
+/// A named material: scattering plus emitted radiance from the front face.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name as in the MTL file or scene file.
+    pub name: String,
+    /// Scattering.
+    pub bsdf: Bsdf,
+    /// Emitted radiance from the front (counter-clockwise) face; zero for non-emitters.
+    pub emission: Vec3,
+    /// Image textures that replace the constant colours where the surface has them.
+    pub maps: Maps,
+}
+
+/// A material's image textures: each, when present, replaces its constant colour at every
+/// point by the texture's value at the point's texture coordinates.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Maps {
+    /// Diffuse albedo (MTL `map_Kd`): replaces `kd`.
+    pub kd: Option<Arc<Texture>>,
+    /// Specular reflectance (MTL `map_Ks`): replaces `ks` of glossy and mirror materials.
+    pub ks: Option<Arc<Texture>>,
+    /// Roughness (MTL `map_Pr`, a linear data map read from its red channel): replaces the rough
+    /// materials' roughness, within the material's photon class ([`Material::bsdf_at`]).
+    pub roughness: Option<Arc<Texture>>,
+    /// Emitted radiance (MTL `map_Ke`): multiplies the emission of an emitter.
+    pub ke: Option<Arc<Texture>>,
+    /// Metalness (MTL `map_Pm`, data, red channel): where it is at least ½ a rough material is a
+    /// rough conductor of the base colour, elsewhere a rough plastic of it ([`Material::bsdf_at`]).
+    pub metallic: Option<Arc<Texture>>,
+}
+
+impl Maps {
+    /// True when the material has no texture.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.kd.is_none()
+            && self.ks.is_none()
+            && self.roughness.is_none()
+            && self.ke.is_none()
+            && self.metallic.is_none()
+    }
+}
+
+impl Material {
+    /// A material without textures.
+    #[must_use]
+    pub fn new(name: impl Into<String>, bsdf: Bsdf, emission: Vec3) -> Material {
+        Material { name: name.into(), bsdf, emission, maps: Maps::default() }
+    }
+
+    /// The radiance emitted at texture coordinates `uv` from the front face: the constant
+    /// emission times the emission texture's value there (an 8-bit texture holds colours up to 1;
+    /// `Ke` scales them, as the MTL spec multiplies a map by its constant).
+    #[inline]
+    #[must_use]
+    pub fn emission_at(&self, uv: Vec2) -> Vec3 {
+        match &self.maps.ke {
+            Some(t) => self.emission * t.lookup(uv),
+            None => self.emission,
+        }
+    }
+
+    /// The scattering at texture coordinates `uv`: the constant BSDF with its textured colours
+    /// replaced. Albedos are kept within energy conservation as the MTL mapping keeps the
+    /// constants: a Lambertian or mirror colour at most 1, a glossy `kd + ks` at most 1 per
+    /// channel (both scaled down together). A roughness map sets α = roughness² but keeps a rough
+    /// conductor on its constant roughness's side of [`PHOTON_SPECULAR_ALPHA`]: whether photons
+    /// pass a material is decided per material, so both engines route it alike.
+    #[inline]
+    #[must_use]
+    pub fn bsdf_at(&self, uv: Vec2) -> Bsdf {
+        if self.maps.is_empty() {
+            return self.bsdf;
+        }
+        let kd_at = |kd: Vec3| self.maps.kd.as_ref().map_or(kd, |t| t.lookup(uv));
+        let ks_at = |ks: Vec3| self.maps.ks.as_ref().map_or(ks, |t| t.lookup(uv));
+        let alpha_at = |alpha: f32| {
+            self.maps.roughness.as_ref().map_or(alpha, |t| microfacet::alpha_of(t.lookup(uv).x.clamp(0.0, 1.0)))
+        };
+        if let Some(m) = &self.maps.metallic {
+            // The PBR extension's metallic workflow, per point: the base colour makes a metal's
+            // reflectance or a plastic's base. Metal parts store photons (α at least
+            // PHOTON_SPECULAR_ALPHA), as plastic does, so the material's photon class is one.
+            let (base, ior, alpha) = match self.bsdf {
+                Bsdf::RoughPlastic { kd, ior, alpha } => (kd_at(kd), ior, alpha_at(alpha)),
+                Bsdf::RoughConductor { ks, alpha } => (ks_at(ks), 1.5, alpha_at(alpha)),
+                other => return other,
+            };
+            let base = base.min(Vec3::ONE);
+            return if m.lookup(uv).x >= 0.5 {
+                Bsdf::RoughConductor { ks: base, alpha: alpha.max(PHOTON_SPECULAR_ALPHA) }
+            } else {
+                Bsdf::RoughPlastic { kd: base, ior, alpha }
+            };
+        }
+        match self.bsdf {
+            Bsdf::Lambert { kd } => Bsdf::Lambert { kd: kd_at(kd).min(Vec3::ONE) },
+            Bsdf::Glossy { kd, ks, exponent } => {
+                let (kd, ks) = (kd_at(kd), ks_at(ks));
+                let sum = (kd + ks).max_element();
+                let scale = if sum > 1.0 { 1.0 / sum } else { 1.0 };
+                Bsdf::Glossy { kd: kd * scale, ks: ks * scale, exponent }
+            }
+            Bsdf::Mirror { ks } => Bsdf::Mirror { ks: ks_at(ks).min(Vec3::ONE) },
+            Bsdf::RoughConductor { ks, alpha } => {
+                let a = alpha_at(alpha);
+                // The same photon class as the constant roughness.
+                let a = if alpha < PHOTON_SPECULAR_ALPHA {
+                    a.min(PHOTON_SPECULAR_ALPHA * (1.0 - f32::EPSILON))
+                } else {
+                    a.max(PHOTON_SPECULAR_ALPHA)
+                };
+                Bsdf::RoughConductor { ks: ks_at(ks).min(Vec3::ONE), alpha: a }
+            }
+            Bsdf::RoughPlastic { kd, ior, alpha } => {
+                Bsdf::RoughPlastic { kd: kd_at(kd).min(Vec3::ONE), ior, alpha: alpha_at(alpha) }
+            }
+            Bsdf::RoughDielectric { ior, alpha } => Bsdf::RoughDielectric { ior, alpha: alpha_at(alpha) },
+            b @ Bsdf::Glass { .. } => b,
+        }
+    }
+}
+
+/// A BSDF sample whose pdf came out zero (see [`Bsdf::sample_checked`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ZeroPdf;
+
+/// A sampled direction and its weight `f·|cos θi| / pdf` (for delta lobes, the lobe's weight).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// Sampled incident direction (unit).
+    pub wi: Vec3,
+    /// Throughput multiplier.
+    pub weight: Vec3,
+    /// True for mirror reflection and dielectric reflection/refraction.
+    pub delta: bool,
+}
+
+/// Geometry the BSDF needs at a point: geometric and shading normals (unit, unflipped).
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceFrame {
+    /// Geometric normal, as wound (front face).
+    pub ng: Vec3,
+    /// Shading normal (interpolated vertex normal, or `ng`).
+    pub ns: Vec3,
+}
+
+impl SurfaceFrame {
+    /// Normals flipped to the side of `wo`: (geometric, shading). The shading normal falls back to
+    /// the geometric one when they disagree about the side.
+    #[must_use]
+    pub fn oriented(&self, wo: Vec3) -> (Vec3, Vec3) {
+        let ng = if wo.dot(self.ng) < 0.0 { -self.ng } else { self.ng };
+        let ns = if self.ns.dot(ng) < 0.0 { -self.ns } else { self.ns };
+        let ns = if ns.dot(ng) > 0.0 && ns.is_finite() { ns } else { ng };
+        (ng, ns)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_roughness_map_sets_alpha_within_the_photon_class() {
+        let grey =
+            |v: f32| Some(Arc::new(Texture::new(std::path::Path::new("r.png"), 1, 1, vec![Vec3::splat(v)]).unwrap()));
+        let rough = |bsdf: Bsdf, v: f32| Material {
+            maps: Maps { roughness: grey(v), ..Maps::default() },
+            ..Material::new("m", bsdf, Vec3::ZERO)
+        };
+        let uv = Vec2::splat(0.5);
+        let Bsdf::RoughPlastic { alpha, .. } =
+            rough(Bsdf::RoughPlastic { kd: Vec3::ONE, ior: 1.5, alpha: 0.5 }, 0.6).bsdf_at(uv)
+        else {
+            panic!()
+        };
+        assert!((alpha - 0.36).abs() < 1e-6);
+        // A conductor whose photons are stored (α ≥ 0.09) stays there, and one whose photons pass stays below.
+        let stored = rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.25 }, 0.1).bsdf_at(uv);
+        assert_eq!(stored, Bsdf::RoughConductor { ks: Vec3::ONE, alpha: PHOTON_SPECULAR_ALPHA });
+        let passed = rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.01 }, 0.9).bsdf_at(uv);
+        assert!(passed.photon_specular(), "{passed:?}");
+        let Bsdf::RoughConductor { alpha, .. } =
+            rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.01 }, 0.2).bsdf_at(uv)
+        else {
+            panic!()
+        };
+        assert!((alpha - 0.04).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_metallic_map_picks_conductor_or_plastic_per_point() {
+        let two =
+            Some(Arc::new(Texture::new(std::path::Path::new("m.png"), 2, 1, vec![Vec3::ZERO, Vec3::ONE]).unwrap()));
+        let m = Material {
+            maps: Maps { metallic: two, ..Maps::default() },
+            ..Material::new("m", Bsdf::RoughPlastic { kd: Vec3::new(0.9, 0.5, 0.1), ior: 1.4, alpha: 0.04 }, Vec3::ZERO)
+        };
+        assert_eq!(
+            m.bsdf_at(Vec2::new(0.25, 0.5)),
+            Bsdf::RoughPlastic { kd: Vec3::new(0.9, 0.5, 0.1), ior: 1.4, alpha: 0.04 }
+        );
+        let metal = m.bsdf_at(Vec2::new(0.75, 0.5));
+        assert_eq!(metal, Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.5, 0.1), alpha: PHOTON_SPECULAR_ALPHA });
+        assert!(!metal.photon_specular(), "metal parts store photons, as the plastic does");
+    }
+
+    #[test]
+    fn fresnel_known_values() {
+        assert!((fresnel_dielectric(1.0, 1.5) - 0.04).abs() < 1e-6);
+        let c45 = std::f32::consts::FRAC_1_SQRT_2;
+        assert!((fresnel_dielectric(c45, 1.5) - 0.0502).abs() < 1e-4, "{}", fresnel_dielectric(c45, 1.5));
+        // Glass → air: critical angle asin(1/1.5) = 41.81°.
+        let crit = (1.0f32 / 1.5).asin();
+        assert_eq!(fresnel_dielectric((crit + 1e-3).cos(), 1.0 / 1.5), 1.0);
+        assert!(fresnel_dielectric((crit - 1e-3).cos(), 1.0 / 1.5) < 1.0);
+    }
+
+    #[test]
+    fn reflectance_plus_transmittance_is_one() {
+        // Energy through the boundary: T = 1 − R, and T computed from the Fresnel amplitudes agrees.
+        for i in 0..90 {
+            let th = (i as f32).to_radians();
+            let (ci, eta) = (th.cos(), 1.5f32);
+            let r = fresnel_dielectric(ci, eta);
+            let st2 = (1.0 - ci * ci) / (eta * eta);
+            let ct = (1.0 - st2).sqrt();
+            let ts = 2.0 * ci / (ci + eta * ct);
+            let tp = 2.0 * ci / (eta * ci + ct);
+            let t = eta * ct / ci * 0.5 * (ts * ts + tp * tp);
+            assert!((r + t - 1.0).abs() < 1e-4, "θ={i}: R={r} T={t}");
+        }
+    }
+
+    #[test]
+    fn total_internal_reflection_is_exact() {
+        let frame = SurfaceFrame { ng: Vec3::Z, ns: Vec3::Z };
+        // Inside the glass (wo below the surface), 60° from the normal: past 41.8°.
+        let wo = Vec3::new(60f32.to_radians().sin(), 0.0, -60f32.to_radians().cos());
+        for k in 0..100 {
+            let s =
+                Bsdf::Glass { ior: 1.5 }.sample(&frame, wo, [k as f32 / 100.0, 0.5, 0.5], Transport::Power).unwrap();
+            assert_eq!(s.weight, Vec3::ONE);
+            assert!(s.wi.z < 0.0, "must stay inside");
+        }
+    }
+
+    #[test]
+    fn lambert_sample_weight_is_kd_exactly() {
+        let kd = Vec3::new(0.7, 0.3, 0.05);
+        let frame = SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y };
+        for i in 0..64 {
+            let u = [(i % 8) as f32 / 8.0 + 0.03, (i / 8) as f32 / 8.0 + 0.05, 0.5];
+            let s = Bsdf::Lambert { kd }.sample(&frame, Vec3::Y, u, Transport::Radiance).unwrap();
+            assert_eq!(s.weight, kd);
+            assert!(s.wi.dot(Vec3::Y) > 0.0);
+        }
+    }
+
+    #[test]
+    fn glossy_never_reflects_more_than_it_receives() {
+        // Monte Carlo albedo (mean of sample weights) at several incidence angles, per channel ≤ 1.
+        let b = Bsdf::Glossy { kd: Vec3::splat(0.5), ks: Vec3::splat(0.5), exponent: 20.0 };
+        let frame = SurfaceFrame { ng: Vec3::Z, ns: Vec3::Z };
+        for deg in [0.0f32, 30.0, 60.0, 85.0] {
+            let wo = Vec3::new(deg.to_radians().sin(), 0.0, deg.to_radians().cos());
+            let n = 64;
+            let mut sum = Vec3::ZERO;
+            for i in 0..n * n {
+                let u = [
+                    ((i % n) as f32 + 0.5) / n as f32,
+                    ((i / n) as f32 + 0.5) / n as f32,
+                    ((i * 7919) % 1000) as f32 / 1000.0,
+                ];
+                if let Some(s) = b.sample(&frame, wo, u, Transport::Radiance) {
+                    sum += s.weight;
+                }
+            }
+            let albedo = sum / (n * n) as f32;
+            // Stratified estimate; 2 % slack for its error.
+            assert!(albedo.max_element() <= 1.02, "θ={deg}: albedo {albedo}");
+        }
+    }
+}

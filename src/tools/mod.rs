@@ -1,0 +1,10 @@
+//! The command line's measuring tools, clients of the engines: `compare` (how far an image is
+//! from a reference, per layer), `sweep` (a grid of settings rendered, timed and measured: what
+//! accuracy costs in time) and the plots `sweep` draws.
+//!
+//! Reads rendered films and a scene; writes CSV, JSON and SVG/PNG plots. Nothing here is used
+//! by a render.
+
+pub mod compare;
+pub mod plot;
+pub mod sweep;
