@@ -2,7 +2,7 @@
 # Error against time for every quality knob on the bundled glass-sphere Cornell box: renders a
 # reference with `--preset reference` (once; ~15 min on 2 cores), then one `photonwave sweep` per
 # knob, each starting from the default settings. Writes benches/error-vs-time/KNOB/{sweep.csv,
-# *.svg, *.png}; README.md and BENCHMARKS.md quote these files.
+# *.svg, *.png}; docs/src/compare-sweep.md and BENCHMARKS.md quote these files.
 #
 #   bash benches/error-vs-time.sh            # everything
 #   SIZE=64 bash benches/error-vs-time.sh    # a quicker, smaller run

@@ -223,7 +223,7 @@ irradiance = [0.2, 0.2, 0.2]
     comments = {
         "room": """# Back-to-back surfaces, written by scenes/generate.py: a closed room of zero-thickness walls
 # lit by a ceiling panel, alone. With a sun outside (room-sunlit.toml, room-on-ground.toml) the
-# inside renders the same: no light from outside can reach it (README, "Hard cases").""",
+# inside renders the same: no light from outside can reach it (docs/src/hard-cases.md).""",
         "room-sunlit": """# Back-to-back surfaces, written by scenes/generate.py: a closed room of zero-thickness walls
 # lit by a ceiling panel, 4 m above a 10 x 10 ground under a sun. No light from outside can
 # reach the inside: it renders the same with or without the sun (tests/rooms.rs).""",

@@ -1,4 +1,4 @@
-"""The README's error-layer picture: a progressive render's beauty image beside its `error`
+"""The output guide's error-layer picture (docs/src/output.md): a progressive render's beauty image beside its `error`
 layer (the 95 % bound, noise + |bias|, over the pixel's grey value, 0–10 %), and beside the
 actual error against a path-traced reference on the same scale.
 
