@@ -6,12 +6,14 @@
 use crate::error::{Error, Result};
 use crate::film::Film;
 use crate::job::Job;
+use crate::parallel::{metered, Meter};
 use crate::progress::{NoProgress, Progress};
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::Settings;
-use crate::stats::RenderStats;
+use crate::stats::{ParallelStats, RenderStats};
 use std::sync::Arc;
+use std::time::Instant;
 
 /// A rendering engine.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -111,14 +113,19 @@ pub fn render_planned(
 ) -> Result<(Film, RenderStats)> {
     check_planned(job, scene, engine, is_progressive(&job.settings, budget))?;
     let settings = &job.settings;
-    if !is_progressive(settings, budget) {
-        let (mut film, mut stats) = render_job(scene, rays, job, engine, progress);
-        crate::diagnostics::add_layers(scene, rays, job, &mut film, &mut stats);
-        return Ok((film, stats));
-    }
-    if engine == Engine::Path {
+    if engine == Engine::Path && is_progressive(settings, budget) {
         return Err(Error::setting("--engine", "progressive passes (--passes, --time) need a photon-mapping engine"));
     }
-    let run = |pass: &Job| Ok(render_job(scene, rays, pass, engine, &NoProgress));
-    crate::progressive::render_passes(scene, rays, job, &run, budget, progress)
+    let (meter, start) = (Arc::new(Meter::default()), Instant::now());
+    let (film, mut stats) = metered(&meter, || {
+        if !is_progressive(settings, budget) {
+            let (mut film, mut stats) = render_job(scene, rays, job, engine, progress);
+            crate::diagnostics::add_layers(scene, rays, job, &mut film, &mut stats);
+            return Ok((film, stats));
+        }
+        let run = |pass: &Job| Ok(render_job(scene, rays, pass, engine, &NoProgress));
+        crate::progressive::render_passes(scene, rays, job, &run, budget, progress)
+    })?;
+    stats.parallel = Some(ParallelStats::new(meter.reading(), job.threads, start.elapsed().as_secs_f64()));
+    Ok((film, stats))
 }

@@ -1,8 +1,15 @@
 //! Deterministic work sharing: items are split into fixed chunks; threads take chunks in any
 //! order, but results are returned in chunk order, so the output never depends on scheduling.
+//!
+//! A render can be metered ([`metered`]): every parallel region its thread starts adds its wall
+//! time, the workers' busy time (the chunks' own durations) and its capacity (threads × wall) to
+//! a [`Meter`], from which `--stats` reports the render's parallel utilisation and the time it
+//! spent outside parallel regions — what decides how it would scale on more cores.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::RefCell;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
+use std::time::Instant;
 
 use rayon_core::{ThreadPool, ThreadPoolBuilder};
 
@@ -45,9 +52,105 @@ fn run_workers(threads: usize, copies: usize, worker: &(dyn Fn() + Sync)) {
     }
 }
 
+/// Time accounts of the parallel regions started by the threads that run under it
+/// ([`metered`]), in nanoseconds. Workers add to it from any thread.
+#[derive(Debug, Default)]
+pub struct Meter {
+    /// The chunks' own durations, summed over every worker.
+    busy_ns: AtomicU64,
+    /// Wall time inside parallel regions (from a region's start to its last chunk's return).
+    region_ns: AtomicU64,
+    /// Σ threads × region wall time: what the workers could have done in the regions.
+    capacity_ns: AtomicU64,
+    /// Parallel regions (fork-joins, and one-worker regions alike).
+    regions: AtomicU64,
+}
+
+/// What a [`Meter`] has counted so far.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MeterReading {
+    /// Σ chunk durations over all workers (s).
+    pub busy_s: f64,
+    /// Wall time inside parallel regions (s).
+    pub in_regions_s: f64,
+    /// Σ threads × region wall time (s).
+    pub capacity_s: f64,
+    /// Parallel regions.
+    pub regions: u64,
+}
+
+impl Meter {
+    /// The counts so far.
+    #[must_use]
+    pub fn reading(&self) -> MeterReading {
+        let s = |a: &AtomicU64| a.load(Ordering::Relaxed) as f64 * 1e-9;
+        MeterReading {
+            busy_s: s(&self.busy_ns),
+            in_regions_s: s(&self.region_ns),
+            capacity_s: s(&self.capacity_ns),
+            regions: self.regions.load(Ordering::Relaxed),
+        }
+    }
+}
+
+thread_local! {
+    /// The meter of the render running on this thread, if it is metered.
+    static CURRENT: RefCell<Option<Arc<Meter>>> = const { RefCell::new(None) };
+}
+
+/// Runs `f` with `meter` counting the parallel regions this thread starts (the ones its workers
+/// start inside a chunk are part of that chunk's time). Renders of other threads in the same
+/// process (tests run several at once) count in their own meters.
+pub fn metered<R>(meter: &Arc<Meter>, f: impl FnOnce() -> R) -> R {
+    let previous = CURRENT.with(|c| c.replace(Some(Arc::clone(meter))));
+    let r = f();
+    CURRENT.with(|c| *c.borrow_mut() = previous);
+    r
+}
+
+/// The busy time (s) counted so far by this thread's render's meter; 0 when it is not metered.
+#[must_use]
+pub fn busy_seconds() -> f64 {
+    current_meter().map_or(0.0, |m| m.reading().busy_s)
+}
+
+/// The meter of this thread's render, if any.
+fn current_meter() -> Option<Arc<Meter>> {
+    CURRENT.with(|c| c.borrow().clone())
+}
+
 /// Runs `work(range)` over `0..n` in chunks of `chunk` on `threads` threads and
 /// returns the results in chunk order. `done(k)` is called after each chunk with its size.
+/// Under a [`metered`] render the region's wall, busy and capacity times are counted, the
+/// capacity at all `threads` even when there are fewer chunks (idle workers are the loss).
 pub fn map_chunks<T: Send>(
+    n: usize,
+    chunk: usize,
+    threads: usize,
+    work: impl Fn(std::ops::Range<usize>) -> T + Sync,
+    done: impl Fn(usize) + Sync,
+) -> Vec<T> {
+    let Some(meter) = current_meter() else {
+        return share_chunks(n, chunk, threads, work, done);
+    };
+    let start = Instant::now();
+    let timed = |range: std::ops::Range<usize>| {
+        let t = Instant::now();
+        let r = work(range);
+        let ns = u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        meter.busy_ns.fetch_add(ns, Ordering::Relaxed);
+        r
+    };
+    let out = share_chunks(n, chunk, threads, timed, done);
+    let wall = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+    meter.region_ns.fetch_add(wall, Ordering::Relaxed);
+    meter.capacity_ns.fetch_add(wall.saturating_mul(threads.max(1) as u64), Ordering::Relaxed);
+    meter.regions.fetch_add(1, Ordering::Relaxed);
+    out
+}
+
+/// [`map_chunks`] without the meter.
+fn share_chunks<T: Send>(
     n: usize,
     chunk: usize,
     threads: usize,

@@ -197,6 +197,10 @@ pub struct RenderStats {
     pub times: PhaseTimes,
     /// Per-system runs, lanes and time (wavefront engine).
     pub stages: Option<StageStats>,
+    /// How the render used its threads (absent in a merge and where the render was not
+    /// metered).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parallel: Option<ParallelStats>,
     /// Traversal kernel per ray queue, chosen by timing the candidates (wavefront engine, SIMD
     /// code path).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -311,6 +315,7 @@ impl RenderStats {
             self.numerics.photon_escaped,
             self.numerics.photons_filtered,
         ) + &self.progressive_summary()
+            + &self.parallel.map_or(String::new(), |p| p.summary() + "\n")
     }
 
     /// The progressive line: passes, radii, budget.
@@ -387,6 +392,10 @@ pub struct StageStat {
     pub items: u64,
     /// Wall time inside it.
     pub seconds: f64,
+    /// Its workers' busy time (the chunks' durations summed over threads; 0 where the render
+    /// was not metered): over `seconds` × threads, the stage's parallel utilisation.
+    #[serde(default)]
+    pub busy_seconds: f64,
 }
 
 /// Per-system counts and times.
@@ -401,17 +410,35 @@ impl std::ops::AddAssign<&StageStats> for StageStats {
             e.runs += s.runs;
             e.items += s.items;
             e.seconds += s.seconds;
+            e.busy_seconds += s.busy_seconds;
         }
+    }
+}
+
+/// When a system started: its wall clock and its render's busy time so far
+/// ([`crate::parallel::busy_seconds`]).
+#[derive(Clone, Copy, Debug)]
+pub struct StageClock {
+    start: std::time::Instant,
+    busy_s: f64,
+}
+
+impl StageClock {
+    /// Now.
+    #[must_use]
+    pub fn start() -> StageClock {
+        StageClock { start: std::time::Instant::now(), busy_s: crate::parallel::busy_seconds() }
     }
 }
 
 impl StageStats {
     /// Records one run of `system` over `items` lanes since `start`.
-    pub fn record(&mut self, system: &str, items: usize, start: std::time::Instant) {
+    pub fn record(&mut self, system: &str, items: usize, start: StageClock) {
         let e = self.0.entry(system.to_string()).or_default();
         e.runs += 1;
         e.items += items as u64;
-        e.seconds += start.elapsed().as_secs_f64();
+        e.seconds += start.start.elapsed().as_secs_f64();
+        e.busy_seconds += crate::parallel::busy_seconds() - start.busy_s;
     }
 }
 
@@ -455,4 +482,82 @@ pub struct ImageError {
     pub noise: f64,
     /// The size of each pixel's estimated bias (Hachisuka, Jarosz and Jensen 2010).
     pub bias: f64,
+}
+
+/// How a render used its threads: the parallel regions' busy time against what its threads
+/// could have done (from a [`crate::parallel::Meter`]).
+///
+/// Read as Amdahl's law: the render's work is `busy_s` on one thread plus `outside_regions_s`
+/// that no thread count shortens, so on n threads it takes at least
+/// `outside_regions_s + busy_s / n` ([`ParallelStats::amdahl_speedup`]) — a bound, which load
+/// imbalance, regions with fewer chunks than threads and memory bandwidth keep it from.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct ParallelStats {
+    /// Worker threads the render was given.
+    pub threads: usize,
+    /// Wall time of the metered render (s): its photon passes, maps and camera pass.
+    pub wall_s: f64,
+    /// The workers' busy time (s): every chunk's duration, summed over the threads.
+    pub busy_s: f64,
+    /// Wall time inside parallel regions (s).
+    pub in_regions_s: f64,
+    /// Wall time outside any parallel region (s): serial work, on one thread whatever the
+    /// thread count.
+    pub outside_regions_s: f64,
+    /// Parallel regions (each a fork and a join where the threads are more than one).
+    pub regions: u64,
+    /// `busy_s / (threads × wall_s)`, in [0, 1]: the share of the threads' time spent working.
+    pub utilisation: f64,
+    /// `busy_s / Σ threads × region wall`, in [0, 1]: the same inside the parallel regions only
+    /// (what barriers, idle workers and too few chunks cost).
+    pub region_utilisation: f64,
+}
+
+impl ParallelStats {
+    /// The stats of a render that took `wall_s` on `threads` threads, its meter read at the end.
+    #[must_use]
+    pub fn new(m: crate::parallel::MeterReading, threads: usize, wall_s: f64) -> ParallelStats {
+        let threads = threads.max(1);
+        let share = |num: f64, den: f64| if den > 0.0 { (num / den).clamp(0.0, 1.0) } else { 0.0 };
+        ParallelStats {
+            threads,
+            wall_s,
+            busy_s: m.busy_s,
+            in_regions_s: m.in_regions_s.min(wall_s),
+            outside_regions_s: (wall_s - m.in_regions_s).max(0.0),
+            regions: m.regions,
+            utilisation: share(m.busy_s, threads as f64 * wall_s),
+            region_utilisation: share(m.busy_s, m.capacity_s),
+        }
+    }
+
+    /// Amdahl's bound on the speed-up on `n` threads over one: (serial + work) / (serial +
+    /// work / n), the work being the busy time and the serial part the time outside regions.
+    #[must_use]
+    pub fn amdahl_speedup(&self, n: usize) -> f64 {
+        let one = self.outside_regions_s + self.busy_s;
+        let many = self.outside_regions_s + self.busy_s / n.max(1) as f64;
+        if many > 0.0 {
+            one / many
+        } else {
+            1.0
+        }
+    }
+
+    /// The summary's line: utilisation, where the time went, and the bound at 16 threads.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        format!(
+            "parallel: {} thread{} {:.0} % busy ({:.0} % inside parallel regions; {:.2} s of {:.2} s outside \
+             them, {} regions); Amdahl's bound: {:.1}x on 16 threads",
+            self.threads,
+            if self.threads == 1 { "" } else { "s" },
+            100.0 * self.utilisation,
+            100.0 * self.region_utilisation,
+            self.outside_regions_s,
+            self.wall_s,
+            self.regions,
+            self.amdahl_speedup(16)
+        )
+    }
 }

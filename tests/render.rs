@@ -96,3 +96,41 @@ fn a_caustic_appears_under_the_glass_sphere() {
     // A focused caustic: the brightest pixel carries ≥ 20× the mean caustic of a pixel.
     assert!(brightest > 20.0 * total_caustic / film.pixels.len() as f32);
 }
+
+#[test]
+fn more_threads_than_work_give_the_same_image_and_utilisation_is_a_share() {
+    // A 4×4 image: every stage holds fewer chunks than 16 threads. Both photon-mapping engines,
+    // one pass and three progressive passes, at 1, 2, 3, 7 and 16 threads.
+    use photonwave::engine::{render, Engine};
+    use photonwave::progress::NoProgress;
+    let loaded = load("cornell-spheres.toml");
+    let cam = loaded.camera.unwrap().prepare(4, 4).unwrap();
+    let scene = std::sync::Arc::new(loaded.scene);
+    for engine in [Engine::Wavefront, Engine::Reference] {
+        for passes in [1, 3] {
+            let s = Settings { width: 4, height: 4, spp: 2, photons: 4_000, caustic_photons: 2_000, passes, ..small() };
+            let run = |threads: u32| {
+                render(&scene, &cam, &Settings { threads, ..s.clone() }, engine, None, &NoProgress).unwrap()
+            };
+            let (first, first_stats) = run(1);
+            for threads in [1, 2, 3, 7, 16] {
+                let (film, stats) = run(threads);
+                let what = format!("{engine:?}, {passes} passes, {threads} threads");
+                assert!(film == first, "{what}: the image differs from one thread's");
+                let p = stats.parallel.unwrap_or_else(|| panic!("{what}: no parallel stats"));
+                assert_eq!(p.threads, threads as usize, "{what}");
+                for (name, v) in [("utilisation", p.utilisation), ("region_utilisation", p.region_utilisation)] {
+                    assert!((0.0..=1.0).contains(&v), "{what}: {name} {v}");
+                }
+                assert!(p.busy_s > 0.0 && p.outside_regions_s >= 0.0 && p.in_regions_s <= p.wall_s, "{what}: {p:?}");
+                // The work is cut into the same regions whatever the thread count.
+                assert_eq!(p.regions, first_stats.parallel.unwrap().regions, "{what}");
+                for (name, st) in stats.stages.iter().flat_map(|s| s.0.iter()) {
+                    let most = f64::from(threads) * st.seconds * 1.01 + 1e-4;
+                    assert!((0.0..=most).contains(&st.busy_seconds), "{what}: {name} busy {st:?}");
+                }
+                assert!(p.amdahl_speedup(16) >= 1.0 && p.amdahl_speedup(16) <= 16.0, "{what}: {p:?}");
+            }
+        }
+    }
+}

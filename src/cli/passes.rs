@@ -10,11 +10,12 @@ use photonwave::engine::{Budget, Engine};
 use photonwave::error::{Error, Result};
 use photonwave::film::Film;
 use photonwave::job::Job;
+use photonwave::parallel::{metered, Meter};
 use photonwave::progress::Progress;
 use photonwave::progressive::{self, Drive, Ended, Progressive};
 use photonwave::scene::camera::CameraRays;
 use photonwave::scene::Scene;
-use photonwave::stats::RenderStats;
+use photonwave::stats::{ParallelStats, RenderStats};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -218,13 +219,18 @@ pub fn render(s: &Setup, flags: &PassFlags, progress: &dyn Progress, say: Say) -
         Ok(photonwave::engine::render_job(s.scene, s.rays, pass, s.engine, &photonwave::progress::NoProgress))
     };
     let d = Drive { set, budget: s.budget, stop: &|| interrupt.stopping(), after_pass: &mut after_pass };
-    let ended = progressive::drive(&state, &run, d, progress)?;
+    // This run's use of its threads (a resumed render's earlier runs are not in it).
+    let (meter, metered_from) = (Arc::new(Meter::default()), Instant::now());
+    let parallel =
+        |threads: usize| Some(ParallelStats::new(meter.reading(), threads, metered_from.elapsed().as_secs_f64()));
+    let ended = metered(&meter, || progressive::drive(&state, &run, d, progress))?;
     let guard = state.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     interrupt.finish();
     if ended == Ended::Stopped {
         let sig = interrupt.signal().unwrap_or(signal_hook::consts::SIGTERM);
         let (film, mut stats) = (guard.image(), guard.stats_now());
         stats.times.total_s = t.elapsed().as_secs_f64();
+        stats.parallel = parallel(s.job.threads);
         partial::write(&stop_path, &identity, &guard.sums, spp, &film, &stats)?;
         say.info(format!(
             "stopped: {} passes written to {} (continue with --resume)\n",
@@ -239,8 +245,9 @@ pub fn render(s: &Setup, flags: &PassFlags, progress: &dyn Progress, say: Say) -
         write_partial(&guard)?;
     }
     let start = s.budget.map_or(s.t0, |b| b.start);
-    let (film, mut stats) = progressive::finish(&guard, s.scene, s.rays, s.budget, start, true);
+    let (film, mut stats) = metered(&meter, || progressive::finish(&guard, s.scene, s.rays, s.budget, start, true));
     stats.times.total_s = t.elapsed().as_secs_f64();
+    stats.parallel = parallel(s.job.threads);
     if let Some(path) = flags.checkpoint {
         partial::write(path, &identity, &guard.sums, spp, &film, &stats)?;
     }

@@ -119,7 +119,7 @@ pub fn merge(parts: impl IntoIterator<Item = Result<Partial>>) -> Result<Merged>
 /// from `kept[last]`, the file holding the last pass.
 fn merged_stats(kept: &[Part], last: usize, sums: &PassSums, film: &Film) -> RenderStats {
     let l = &kept[last];
-    let mut stats = RenderStats { progressive: None, ..l.stats.clone() };
+    let mut stats = RenderStats { progressive: None, parallel: None, ..l.stats.clone() };
     let mut progressive = l.stats.progressive.clone().unwrap_or_default();
     let (mut pass_seconds, mut elapsed) = (Vec::new(), 0.0f64);
     for (k, p) in kept.iter().enumerate() {

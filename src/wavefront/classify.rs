@@ -3,13 +3,12 @@
 //! their origin for the secondary gather. Reads hit columns; writes the lane lists and kinds.
 
 use super::queues::{Classified, HitColumns, PathKind};
-use super::{CameraWork, PhotonWork, Shared, StageStats};
+use super::{CameraWork, PhotonWork, Shared, StageClock, StageStats};
 use crate::material::Bsdf;
 use crate::scene::Scene;
 use crate::transport::gather::{lands_near, secondary_gather_distance};
 use crate::transport::photon::PathEnd;
 use bevy_ecs::prelude::*;
-use std::time::Instant;
 
 /// Fills `out` from `hits`, lanes in order. With `paths` (the camera pass), lanes at surfaces
 /// that photons pass on as specular (frosted glass, smooth rough metal) join the mirror lanes
@@ -35,7 +34,7 @@ pub fn classify(scene: &Scene, hits: &HitColumns, paths: bool, out: &mut Classif
 
 /// Classifies the photon queue's hits.
 pub fn classify_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let w = &mut *work;
     classify(&shared.scene, &w.queue.hits, false, &mut w.classified);
     if shared.scene.encloses_lights {
@@ -49,7 +48,7 @@ pub fn classify_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut s
 
 /// Classifies the path queue's hits.
 pub fn classify_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let w = &mut *work;
     classify(&shared.scene, &w.paths.hits, true, &mut w.classified);
     stats.record("classify_paths", w.paths.len(), t);
@@ -58,7 +57,7 @@ pub fn classify_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut sta
 /// Gather lanes at diffuse hits that landed near their origin become
 /// [`PathKind::NearGather`] (`transport::gather`'s secondary gather).
 pub fn mark_near_gathers(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let distance = secondary_gather_distance(&shared.scene, &shared.job);
     if distance <= 0.0 {
         return;

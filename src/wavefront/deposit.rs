@@ -3,7 +3,7 @@
 //! radiance. Reads the diffuse lane list and hits; writes deposits, survivors, or the wave's terms.
 
 use super::queues::PathKind;
-use super::{par_columns, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
+use super::{par_columns, CameraWork, PhotonWork, Shared, StageClock, StageStats, CHUNK};
 use crate::film::Term;
 use crate::photon_map::Photon;
 use crate::rng::Domain;
@@ -11,7 +11,6 @@ use crate::transport::photon::{deposit_photon, PhotonRay};
 use crate::transport::specular::emission_toward;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use std::time::Instant;
 
 /// One worker's deposits: its own range of stored photons and surviving lanes, appended in
 /// chunk order (no atomics, no shared writes).
@@ -25,7 +24,7 @@ pub struct DepositPart {
 
 /// Stores photons at diffuse hits; lanes whose path goes on become survivors.
 pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let scene = &*shared.scene;
     let w = &mut *work;
     let domain = w.domain.unwrap_or(Domain::GlobalPhoton);
@@ -68,7 +67,7 @@ pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
 /// radiance of emitters whose front face they hit, and of the environment and the sun when they
 /// leave the scene.
 pub fn deposit_emission(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let scene = &*shared.scene;
     let w = &mut *work;
     let mut n = 0;

@@ -2,7 +2,7 @@
 //! starting at lights) or the path queue (a wave of camera rays) and the wave's empty terms.
 
 use super::queues::{PathKind, PhotonLane, PhotonQueue, Segment};
-use super::{par_columns, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
+use super::{par_columns, CameraWork, PhotonWork, Shared, StageClock, StageStats, CHUNK};
 use crate::film::{Term, Terms};
 use crate::rng::Domain;
 use crate::transport::camera::camera_ray;
@@ -10,11 +10,10 @@ use crate::transport::photon::{start_photon, PathCounts, PathEnd, Start, BATCH};
 use crate::transport::streams;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use std::time::Instant;
 
 /// Starts `batches` × [`BATCH`] photon paths at the wave's first path index.
 pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let (scene, seed) = (&*shared.scene, shared.job.pass.seed);
     let domain = work.domain.unwrap_or(Domain::GlobalPhoton);
     let first = work.first_path;
@@ -60,7 +59,7 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
 /// Generates the wave's camera rays: sample `g` is sample `g % spp` of pixel `g / spp`, jittered
 /// (stratified when spp is a square) exactly as the reference engine does.
 pub fn emit_camera_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let w = &mut *work;
     w.paths.clear();
     w.next.clear();

@@ -5,7 +5,7 @@
 //! lane list, hits and maps; writes the wave's terms in lane order.
 
 use super::queues::PathKind;
-use super::{par_lanes, CameraWork, Maps, Shared, StageStats, GATHER_CHUNK};
+use super::{par_lanes, CameraWork, Maps, Shared, StageClock, StageStats, GATHER_CHUNK};
 use crate::code_path::MortonGrid;
 use crate::film::Term;
 use crate::material::Bsdf;
@@ -18,7 +18,6 @@ use crate::transport::estimate::{
 use crate::transport::Context;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use std::time::Instant;
 
 /// Runs `estimate(ctx, point, bsdf, wo, kind, pixel, scratch)` at the diffuse hit of every lane
 /// whose kind passes `wanted` (`pixel` is the lane's pixel for camera lanes, `None` for
@@ -161,7 +160,7 @@ pub fn gather_caustics(
     mut work: ResMut<CameraWork>,
     mut stats: ResMut<StageStats>,
 ) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let n = estimate_at_diffuse_hits(
         &shared,
         &maps,
@@ -183,7 +182,7 @@ pub fn gather_global(
     mut work: ResMut<CameraWork>,
     mut stats: ResMut<StageStats>,
 ) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let gather_on = shared.job.plan.final_gather.on;
     let n = estimate_at_diffuse_hits(
         &shared,

@@ -6,7 +6,7 @@
 
 use super::queues::PathKind;
 use super::queues::{HitColumns, RayColumns};
-use super::{par_lanes, par_pieces, CameraWork, PhotonWork, Shared, StageStats, CHUNK};
+use super::{par_lanes, par_pieces, CameraWork, PhotonWork, Shared, StageClock, StageStats, CHUNK};
 use crate::geometry::RayQuery;
 use crate::job::Job;
 use crate::rng::Domain;
@@ -15,7 +15,6 @@ use crate::scene::Scene;
 use crate::transport::camera::camera_ray;
 use crate::traversal_choice::{Queue, TRIAL_CHUNKS};
 use bevy_ecs::prelude::*;
-use std::time::Instant;
 
 /// Fills `hits` with the closest hits of `rays` (of `queue`), each chunk writing its own lanes
 /// in place (per-chunk columns appended afterwards cost `intersect_paths` ~6 % of its samples:
@@ -60,7 +59,7 @@ pub fn choose_camera_kernel(scene: &Scene, camera: &CameraRays, job: &Job) {
 
 /// Closest hits of the photon queue.
 pub fn intersect_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let domain = work.domain;
     let q = &mut work.queue;
     // A bounce's queue holds photons of one map and one bounce count.
@@ -82,7 +81,7 @@ pub fn intersect_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut 
 
 /// Closest hits of the path queue.
 pub fn intersect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let w = &mut *work;
     // The first bounce's queue holds the primary rays, and later ones none.
     let primary = w.paths.kind.first() == Some(&PathKind::Camera) && w.paths.depth.first() == Some(&0);
@@ -99,7 +98,7 @@ pub fn intersect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut st
 
 /// Any-hit tests of the shadow queue; unblocked rays add their contribution.
 pub fn trace_shadow_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let scene = &*shared.scene;
     let w = &mut *work;
     let q = &w.shadows;

@@ -41,7 +41,7 @@ use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::Settings;
 use crate::stats::{Numerics, RayCounts, RenderStats};
-pub use crate::stats::{StageStat, StageStats};
+pub use crate::stats::{StageClock, StageStat, StageStats};
 use crate::transport::PhotonMaps;
 use bevy_ecs::prelude::*;
 use photon_pass::photon_pass;

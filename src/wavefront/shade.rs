@@ -6,7 +6,7 @@
 //! the next queues, the shadow queue and the film.
 
 use super::queues::{PathKind, PathQueue, PhotonLane, PhotonQueue, Segment, ShadowLane, ShadowQueue};
-use super::{par_columns, par_lanes, CameraWork, Maps, PhotonWork, Shared, StageStats, CHUNK};
+use super::{par_columns, par_lanes, CameraWork, Maps, PhotonWork, Shared, StageClock, StageStats, CHUNK};
 use crate::film::{PixelMean, Term};
 use crate::rng::{Domain, Sampler};
 use crate::transport::direct::{direct_light_rays, ShadowRay};
@@ -15,7 +15,6 @@ use crate::transport::photon::{scatter_photon, PathEnd, PhotonRay, Scattered};
 use crate::transport::specular::continue_chain;
 use crate::transport::{streams, Context};
 use bevy_ecs::prelude::*;
-use std::time::Instant;
 
 /// Scatters the photon lanes `lanes` into `next`, counting per path what the bounce clamped,
 /// dropped or cut.
@@ -78,7 +77,7 @@ fn scatter_lanes(shared: &Shared, work: &mut PhotonWork, lanes: &[u32], next: &m
 
 /// Photons at mirrors and surviving diffuse photons scatter into the next queue.
 pub fn scatter_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let lanes: Vec<u32> = work.classified.mirror.iter().chain(&work.survivors).copied().collect();
     let mut next = std::mem::take(&mut work.next);
     scatter_lanes(&shared, &mut work, &lanes, &mut next);
@@ -88,7 +87,7 @@ pub fn scatter_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
 
 /// Photons at glass reflect or refract into the next queue (only in scenes with glass).
 pub fn refract_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let lanes = work.classified.glass.clone();
     let mut next = std::mem::take(&mut work.next);
     scatter_lanes(&shared, &mut work, &lanes, &mut next);
@@ -99,7 +98,7 @@ pub fn refract_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
 /// Diffuse lanes of camera, glossy and near-landed gather rays queue their shadow rays (direct
 /// light).
 pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
     let w = &*work;
     let scene = &*shared.scene;
@@ -163,7 +162,7 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
 /// Diffuse camera lanes spawn `gather_rays` cosine-weighted rays, each weighted beta·kd/N;
 /// near-landed gather lanes spawn their secondary gather's one ray, weighted beta·kd.
 pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let scene = &*shared.scene;
     let n = shared.job.settings.gather_rays;
     // Chunks append straight to the next queue (disjoint fields of the work resource).
@@ -234,7 +233,7 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
 
 /// Diffuse camera lanes on glossy materials spawn one ray from the glossy lobe.
 pub fn spawn_glossy_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let scene = &*shared.scene;
     let w = &*work;
     let mut segments = Vec::new();
@@ -323,7 +322,7 @@ fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32], cuts: &m
 
 /// Lanes at mirrors continue.
 pub fn reflect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let lanes = work.classified.mirror.clone();
     let mut cuts = 0;
     let mut segments = continue_specular(&shared, &work, &lanes, &mut cuts);
@@ -334,7 +333,7 @@ pub fn reflect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stat
 
 /// Lanes at glass reflect or refract (only in scenes with glass).
 pub fn refract_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let lanes = work.classified.glass.clone();
     let mut cuts = 0;
     let mut segments = continue_specular(&shared, &work, &lanes, &mut cuts);
@@ -345,7 +344,7 @@ pub fn refract_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stat
 
 /// Averages each pixel's samples (dropping non-finite ones, as the reference does) into the film.
 pub fn resolve_wave(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
-    let t = Instant::now();
+    let t = StageClock::start();
     let spp = shared.job.settings.spp as usize;
     let w = &mut *work;
     let first_pixel = (w.first_sample / spp as u64) as usize;
