@@ -143,60 +143,49 @@ fn inside_means(film: &photonwave::film::Film) -> (f64, f64) {
 /// Before issue 44, at equal budgets: indirect light +6.9 % (progressive, corrected) and
 /// −6.4 % (uncorrected), the first radius set by the sunlit ground's photons.
 fn renders_the_same_with_light_outside(name: &str) {
+    let (sunlit, dark) = with_twin(name);
+    let (sunlit_scene, dark_scene) = (Arc::new(sunlit.scene), Arc::new(dark.scene));
+    let share = dark_scene.total_power().element_sum() / sunlit_scene.total_power().element_sum();
+    assert!(share < 0.2, "{name}: the panel's share of the power is {share}");
+    let rays = sunlit.camera.unwrap().prepare(16, 16).unwrap();
+    let base =
+        Settings { width: 16, height: 16, spp: 1, photons: 3_000, gather_rays: 4, threads: 1, ..Default::default() };
+    // Photons stored per path emitted in the sunlit scene.
+    let per_path = {
+        let s = Settings { photons: 50_000, ..base.clone() };
+        let (_, global, _) = photonwave::reference::build_maps(&sunlit_scene, &s).unwrap();
+        global.stored as f64 / global.emitted as f64
+    };
+    for (mode, passes, corrected) in [("one pass", 1, true), ("3 passes", 3, true), ("3 passes, uncorrected", 3, false)]
     {
-        let (sunlit, dark) = with_twin(name);
-        let (sunlit_scene, dark_scene) = (Arc::new(sunlit.scene), Arc::new(dark.scene));
-        let share = dark_scene.total_power().element_sum() / sunlit_scene.total_power().element_sum();
-        assert!(share < 0.2, "{name}: the panel's share of the power is {share}");
-        let rays = sunlit.camera.unwrap().prepare(16, 16).unwrap();
-        let base = Settings {
-            width: 16,
-            height: 16,
-            spp: 1,
-            photons: 3_000,
-            gather_rays: 4,
-            threads: 1,
-            ..Default::default()
-        };
-        // Photons stored per path emitted in the sunlit scene.
-        let per_path = {
-            let s = Settings { photons: 50_000, ..base.clone() };
-            let (_, global, _) = photonwave::reference::build_maps(&sunlit_scene, &s).unwrap();
-            global.stored as f64 / global.emitted as f64
-        };
-        for (mode, passes, corrected) in
-            [("one pass", 1, true), ("3 passes", 3, true), ("3 passes, uncorrected", 3, false)]
-        {
-            let mut diffs: Vec<(f64, f64)> = Vec::new();
-            let mut level = (0.0, 0.0);
-            for seed in common::SEEDS {
-                let engine = if seed.is_multiple_of(2) { Engine::Reference } else { Engine::Wavefront };
-                let s = Settings { seed, passes, boundary_correction: corrected, ..base.clone() };
-                let image =
-                    |scene: &Arc<Scene>, s: &Settings| render(scene, &rays, s, engine, None, &NoProgress).unwrap();
-                let (film, stats) = image(&dark_scene, &s);
-                let paths = stats.global_map.emitted as f64 / f64::from(passes);
-                let more = Settings { photons: (paths / f64::from(share) * per_path).round() as u32, ..s.clone() };
-                let (a, b) = (inside_means(&image(&sunlit_scene, &more).0), inside_means(&film));
-                diffs.push((a.0 - b.0, a.1 - b.1));
-                level = (level.0 + b.0, level.1 + b.1);
-            }
-            let n = diffs.len() as f64;
-            level = (level.0 / n, level.1 / n);
-            for (layer, pick, mean_level) in [("direct", 0usize, level.0), ("indirect", 1, level.1)] {
-                let d: Vec<f64> = diffs.iter().map(|t| if pick == 0 { t.0 } else { t.1 }).collect();
-                let mean = d.iter().sum::<f64>() / n;
-                let se = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
-                println!(
-                    "{name}, {mode}, {layer}: sunlit − dark = {:+.2} % ± {:.2} % of {mean_level:.4}",
-                    100.0 * mean / mean_level,
-                    100.0 * se / mean_level
-                );
-                assert!(
-                    mean.abs() <= 5.0 * se + 0.01 * mean_level,
-                    "{name}, {mode}, {layer}: the inside changes by {mean} ± {se} of {mean_level} with the sun outside"
-                );
-            }
+        let mut diffs: Vec<(f64, f64)> = Vec::new();
+        let mut level = (0.0, 0.0);
+        for seed in common::SEEDS {
+            let engine = if seed.is_multiple_of(2) { Engine::Reference } else { Engine::Wavefront };
+            let s = Settings { seed, passes, boundary_correction: corrected, ..base.clone() };
+            let image = |scene: &Arc<Scene>, s: &Settings| render(scene, &rays, s, engine, None, &NoProgress).unwrap();
+            let (film, stats) = image(&dark_scene, &s);
+            let paths = stats.global_map.emitted as f64 / f64::from(passes);
+            let more = Settings { photons: (paths / f64::from(share) * per_path).round() as u32, ..s.clone() };
+            let (a, b) = (inside_means(&image(&sunlit_scene, &more).0), inside_means(&film));
+            diffs.push((a.0 - b.0, a.1 - b.1));
+            level = (level.0 + b.0, level.1 + b.1);
+        }
+        let n = diffs.len() as f64;
+        level = (level.0 / n, level.1 / n);
+        for (layer, pick, mean_level) in [("direct", 0usize, level.0), ("indirect", 1, level.1)] {
+            let d: Vec<f64> = diffs.iter().map(|t| if pick == 0 { t.0 } else { t.1 }).collect();
+            let mean = d.iter().sum::<f64>() / n;
+            let se = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+            println!(
+                "{name}, {mode}, {layer}: sunlit − dark = {:+.2} % ± {:.2} % of {mean_level:.4}",
+                100.0 * mean / mean_level,
+                100.0 * se / mean_level
+            );
+            assert!(
+                mean.abs() <= 5.0 * se + 0.01 * mean_level,
+                "{name}, {mode}, {layer}: the inside changes by {mean} ± {se} of {mean_level} with the sun outside"
+            );
         }
     }
 }

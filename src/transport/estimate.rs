@@ -227,14 +227,11 @@ pub fn complete_off_plane(
         let open = Lookup { filter: Filter { plane: 0.0, ..lookup.filter }, ..*lookup };
         return map.estimate_visible(set, &open, f, scratch, &keep);
     }
-    let seen: Vec<(f32, u32)> = map
-        .off_plane_photons(lookup)
-        .into_iter()
-        .filter(|&(_, i)| {
-            let p = map.photon(i as usize);
-            keep(p.position, p.normal)
-        })
-        .collect();
+    let mut seen = map.off_plane_photons(lookup);
+    seen.retain(|&(_, i)| {
+        let p = map.photon(i as usize);
+        keep(p.position, p.normal)
+    });
     let extra = map.estimate_photons(set, lookup, f, &seen);
     Estimate { radiance: e.radiance + extra.radiance / e.coverage, count: e.count + extra.count, off_plane: 0, ..e }
 }
