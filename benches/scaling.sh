@@ -74,12 +74,23 @@ for job in jobs:
     first, last = runs(job, threads[0]), runs(job, threads[-1])
     if not first[0].get("stages"):
         continue
-    print(f"stage (seconds at {threads[0]} and {threads[-1]} threads, speed-up, utilisation at {threads[-1]})")
+    # Stages that share their lanes among the threads (the photon pass's) have a wall time of
+    # their own: its speed-up and utilisation are printed. Stages run inside each worker's own
+    # tiles (the camera pass's) report the time summed over the workers: printed is that sum's
+    # growth from the fewest to the most threads (1.00 = no contention; above 1 = the workers
+    # slow each other down: memory bandwidth, shared caches, hyper-threads).
+    print(f"stage (seconds at {threads[0]} and {threads[-1]} threads, speed-up and utilisation at {threads[-1]}"
+          f" for shared stages; worker-seconds and their growth for per-worker stages)")
     stages = first[0]["stages"]
     for name in sorted(stages, key=lambda n: -stages[n]["seconds"]):
+        if not all(name in r["stages"] for r in first + last):
+            continue
         a = statistics.median(r["stages"][name]["seconds"] for r in first)
         b = statistics.median(r["stages"][name]["seconds"] for r in last)
         busy = statistics.median(r["stages"][name].get("busy_seconds", 0) for r in last)
-        util = busy / (threads[-1] * b) if b > 0 else 0
-        print(f"  {name:20s} {a:7.3f} {b:7.3f} {a / b if b else 0:6.2f}x {100 * util:5.0f} %")
+        if abs(busy - b) <= 1e-9 * max(b, 1) and threads[-1] > 1:
+            print(f"  {name:20s} {a:7.3f} {b:7.3f} per worker, grew {b / a if a else 0:5.2f}x")
+        else:
+            util = busy / (threads[-1] * b) if b > 0 else 0
+            print(f"  {name:20s} {a:7.3f} {b:7.3f} {a / b if b else 0:6.2f}x {100 * util:5.0f} %")
 PY

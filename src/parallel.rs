@@ -98,8 +98,8 @@ thread_local! {
     static CURRENT: RefCell<Option<Arc<Meter>>> = const { RefCell::new(None) };
 }
 
-/// Runs `f` with `meter` counting the parallel regions this thread starts (the ones its workers
-/// start inside a chunk are part of that chunk's time). Renders of other threads in the same
+/// Runs `f` with `meter` counting the parallel regions this thread starts (the ones started
+/// inside a chunk, on any thread, are part of that chunk's time). Renders of other threads in the same
 /// process (tests run several at once) count in their own meters.
 pub fn metered<R>(meter: &Arc<Meter>, f: impl FnOnce() -> R) -> R {
     let previous = CURRENT.with(|c| c.replace(Some(Arc::clone(meter))));
@@ -108,10 +108,11 @@ pub fn metered<R>(meter: &Arc<Meter>, f: impl FnOnce() -> R) -> R {
     r
 }
 
-/// The busy time (s) counted so far by this thread's render's meter; 0 when it is not metered.
+/// The busy time (s) counted so far by this thread's render's meter; `None` when it is not
+/// metered, or when this thread is inside a chunk of a metered region (where it is busy).
 #[must_use]
-pub fn busy_seconds() -> f64 {
-    current_meter().map_or(0.0, |m| m.reading().busy_s)
+pub fn busy_seconds() -> Option<f64> {
+    current_meter().map(|m| m.reading().busy_s)
 }
 
 /// The meter of this thread's render, if any.
@@ -136,7 +137,11 @@ pub fn map_chunks<T: Send>(
     let start = Instant::now();
     let timed = |range: std::ops::Range<usize>| {
         let t = Instant::now();
+        // Regions started inside a chunk are part of its busy time, whichever thread runs it
+        // (the pool's threads have no meter; the calling thread's is set aside meanwhile).
+        let outer = CURRENT.with(|c| c.replace(None));
         let r = work(range);
+        CURRENT.with(|c| *c.borrow_mut() = outer);
         let ns = u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX);
         meter.busy_ns.fetch_add(ns, Ordering::Relaxed);
         r

@@ -390,10 +390,12 @@ pub struct StageStat {
     pub runs: u64,
     /// Lanes it processed.
     pub items: u64,
-    /// Wall time inside it.
+    /// Wall time inside it, summed over the workers that ran it where it runs inside each
+    /// worker's own tiles (the camera pass's stages).
     pub seconds: f64,
-    /// Its workers' busy time (the chunks' durations summed over threads; 0 where the render
-    /// was not metered): over `seconds` × threads, the stage's parallel utilisation.
+    /// Its workers' busy time: for a stage that shares its lanes among the threads (the photon
+    /// pass's), the chunks' durations summed over threads, over `seconds` × threads its parallel
+    /// utilisation; for one run inside a worker's tile (the camera pass's), its `seconds`.
     #[serde(default)]
     pub busy_seconds: f64,
 }
@@ -420,7 +422,9 @@ impl std::ops::AddAssign<&StageStats> for StageStats {
 #[derive(Clone, Copy, Debug)]
 pub struct StageClock {
     start: std::time::Instant,
-    busy_s: f64,
+    /// The meter's busy time at the start; `None` on a thread without one (a worker's own
+    /// tile, or an unmetered render), where the stage's own wall time is its busy time.
+    busy_s: Option<f64>,
 }
 
 impl StageClock {
@@ -437,8 +441,12 @@ impl StageStats {
         let e = self.0.entry(system.to_string()).or_default();
         e.runs += 1;
         e.items += items as u64;
-        e.seconds += start.start.elapsed().as_secs_f64();
-        e.busy_seconds += crate::parallel::busy_seconds() - start.busy_s;
+        let seconds = start.start.elapsed().as_secs_f64();
+        e.seconds += seconds;
+        e.busy_seconds += match (start.busy_s, crate::parallel::busy_seconds()) {
+            (Some(before), Some(now)) => now - before,
+            _ => seconds,
+        };
     }
 }
 

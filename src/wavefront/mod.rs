@@ -3,24 +3,29 @@
 //!
 //! ```text
 //! photon pass (per wave):   emit ─► [ intersect ─► classify ─► deposit ─► shade ]* until no photon is left
-//! camera pass (per wave):   emit ─► [ intersect ─► classify ─► deposit ─► gather ─► shade ]* until no ray is left ─► resolve
+//! camera pass (per tile):   emit ─► [ intersect ─► classify ─► deposit ─► gather ─► shade ]* until no ray is left ─► resolve
 //! ```
 //!
 //! The bracketed loop is a sub-schedule run by an exclusive system until its queues are empty,
 //! as physics engines run substeps ([`schedule`]). The systems call the transport core
 //! ([`crate::transport`]) per lane with the same random streams as the oracle, so for the same
-//! seed the two agree per pixel up to the order of floating-point additions. Within a system,
-//! lanes are processed in fixed chunks on the persistent worker pool ([`crate::parallel`]) and
-//! results are reduced in lane order: the image is bit-identical at any thread count.
+//! seed the two agree per pixel up to the order of floating-point additions. The photon pass's
+//! waves are shared by all threads: within a system, lanes are processed in fixed chunks on the
+//! persistent worker pool ([`crate::parallel`]) and results are reduced in lane order. The
+//! camera pass runs per worker ([`camera_pass`]): each worker takes tiles of samples through the
+//! whole camera schedule on its own world. Either way the image is bit-identical at any thread
+//! count.
 //!
 //! Systems are gated on the [`Effects`](crate::effects::Effects) plan with run conditions: a
 //! scene without mirrors or glass never runs the caustic systems, one without glass never runs
 //! refraction.
 //!
 //! Files: [`schedule`] (the recipe), [`resources`] (what the systems share), [`queues`] (the SoA
-//! queues), [`photon_pass`] (waves of photon paths until the maps are full), and one file per
-//! stage.
+//! queues), [`photon_pass`] (waves of photon paths until the maps are full), [`camera_pass`]
+//! (tiles of samples, each through the camera schedule on one worker's own world), and one file
+//! per stage.
 
+pub mod camera_pass;
 pub mod classify;
 pub mod deposit;
 pub mod emit;
@@ -33,19 +38,19 @@ pub mod schedule;
 pub mod shade;
 
 use crate::error::Result;
-use crate::film::{Film, Terms};
+use crate::film::Film;
 use crate::job::Job;
 use crate::parallel::map_chunks;
 use crate::progress::{NoProgress, Progress};
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
 use crate::settings::Settings;
-use crate::stats::{Numerics, RayCounts, RenderStats};
+use crate::stats::RenderStats;
 pub use crate::stats::{StageClock, StageStat, StageStats};
 use crate::transport::PhotonMaps;
 use bevy_ecs::prelude::*;
+use camera_pass::camera_pass;
 use photon_pass::photon_pass;
-use queues::{Classified, PathQueue, ShadowQueue};
 pub use resources::{CameraWork, Maps, PhotonWork, Shared};
 pub use schedule::{schedules, CameraBounce, CameraPass, PhotonBounce, PhotonPass};
 use std::sync::Arc;
@@ -68,8 +73,6 @@ pub enum Stage {
     Shade,
 }
 
-/// Samples per camera wave (bounded memory: ~100 B of queue per lane in flight).
-pub const WAVE: usize = 32_768;
 /// Lanes per work chunk for cheap kernels (traversal, scattering).
 pub const CHUNK: usize = 1024;
 /// Lanes per work chunk for density estimates.
@@ -182,54 +185,26 @@ pub fn render_job(scene: Arc<Scene>, camera: &CameraRays, job: &Job, progress: &
     let mut stats =
         RenderStats { effects: Some(job.plan.clone()), ..RenderStats::new("wavefront", &scene, settings, job.threads) };
     let mut world = new_world(&scene, job);
-    let maps = photon_pass(&mut world, &scene, job, &mut stats, progress);
-    world.insert_resource(Maps(Arc::new(maps)));
+    let maps = Arc::new(photon_pass(&mut world, &scene, job, &mut stats, progress));
 
-    // Camera pass, wave by wave, with the camera rays' kernel chosen first.
+    // Camera pass, tile by tile on every worker, with the camera rays' kernel chosen first.
     let t = Instant::now();
     intersect::choose_camera_kernel(&scene, camera, job);
-    let pixels = settings.width as usize * settings.height as usize;
-    let total = pixels as u64 * settings.spp as u64;
-    world.insert_resource(CameraWork {
-        camera: *camera,
-        first_sample: 0,
-        count: 0,
-        paths: PathQueue::default(),
-        next: PathQueue::default(),
-        classified: Classified::default(),
-        shadows: ShadowQueue::default(),
-        terms: Vec::new(),
-        film: vec![Terms::default(); pixels],
-        rays: RayCounts::default(),
-        numerics: Numerics::default(),
-    });
-    progress.start("camera", pixels as u64);
-    // Waves hold whole pixels.
-    let wave = (WAVE / settings.spp as usize).max(1) as u64 * settings.spp as u64;
-    let mut first = 0u64;
-    while first < total {
-        let count = wave.min(total - first);
-        {
-            let mut w = world.resource_mut::<CameraWork>();
-            w.first_sample = first;
-            w.count = count as usize;
-        }
-        world.run_schedule(CameraPass);
-        progress.advance(count / settings.spp as u64);
-        first += count;
-    }
+    progress.start("camera", u64::from(settings.width) * u64::from(settings.height));
+    let out = camera_pass(&scene, camera, job, &maps, camera_pass::TILE, progress);
     progress.finish();
-    let mut w = world.resource_mut::<CameraWork>();
-    let film = Film::new(settings.width, settings.height, std::mem::take(&mut w.film));
-    stats.rays += w.rays;
-    stats.numerics += w.numerics;
+    let film = Film::new(settings.width, settings.height, out.film);
+    stats.rays += out.rays;
+    stats.numerics += out.numerics;
     stats.times.camera_s = t.elapsed().as_secs_f64();
     stats.phases.push(if job.plan.final_gather.on {
         "final gather (wavefront)".into()
     } else {
         "global map read at first hit (wavefront)".into()
     });
-    stats.stages = Some(world.resource::<StageStats>().clone());
+    let mut stages = world.resource::<StageStats>().clone();
+    stages += &out.stages;
+    stats.stages = Some(stages);
     stats.traversal = job.traversal.report();
     stats.times.total_s = start.elapsed().as_secs_f64();
     stats.mean_rgb = film.mean().to_array();

@@ -58,7 +58,8 @@ impl PhotonWork {
     }
 }
 
-/// Camera-pass state for one wave of samples.
+/// Camera-pass state of one worker: its tile of samples (a wave) and the counts of every tile
+/// it has rendered.
 #[derive(Resource)]
 pub struct CameraWork {
     /// Primary-ray generator.
@@ -77,10 +78,10 @@ pub struct CameraWork {
     pub shadows: ShadowQueue,
     /// Per-sample terms of the wave.
     pub terms: Vec<Terms>,
-    /// The image (per pixel), filled wave by wave.
+    /// The tile's pixels, resolved after its bounce loop.
     pub film: Vec<Terms>,
-    /// Rays traced.
+    /// Rays traced, over the worker's tiles.
     pub rays: RayCounts,
-    /// Samples dropped as non-finite, and pixel sums that overflowed.
+    /// Samples dropped as non-finite, and pixel sums that overflowed, over the worker's tiles.
     pub numerics: Numerics,
 }

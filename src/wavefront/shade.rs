@@ -2,7 +2,7 @@
 //! next photon queue. Camera-pass lanes at diffuse hits queue shadow rays (direct light) and
 //! spawn final-gather and glossy rays; gather lanes that landed near queue shadow rays and spawn
 //! their secondary gather's ray; lanes at mirrors and glass continue. After the bounce loop,
-//! `resolve_wave` turns the wave's samples into pixels. Reads classified lanes and hits; writes
+//! `resolve_wave` turns the tile's samples into pixels. Reads classified lanes and hits; writes
 //! the next queues, the shadow queue and the film.
 
 use super::queues::{PathKind, PathQueue, PhotonLane, PhotonQueue, Segment, ShadowLane, ShadowQueue};
@@ -342,18 +342,20 @@ pub fn refract_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stat
     stats.record("refract_paths", lanes.len(), t);
 }
 
-/// Averages each pixel's samples (dropping non-finite ones, as the reference does) into the film.
+/// Averages each pixel's samples (dropping non-finite ones, as the reference does) into the
+/// tile's pixels.
 pub fn resolve_wave(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = StageClock::start();
     let spp = shared.job.settings.spp as usize;
     let w = &mut *work;
-    let first_pixel = (w.first_sample / spp as u64) as usize;
-    for (k, samples) in w.terms.chunks(spp).enumerate() {
+    w.film.clear();
+    for samples in w.terms.chunks(spp) {
         let mut mean = PixelMean::default();
         for t in samples {
             mean.add(*t, 1.0 / spp as f32);
         }
-        w.film[first_pixel + k] = mean.finish(1.0 / spp as f32, &mut w.numerics);
+        let pixel = mean.finish(1.0 / spp as f32, &mut w.numerics);
+        w.film.push(pixel);
     }
     stats.record("resolve_wave", w.count, t);
 }
