@@ -44,7 +44,7 @@ fn photon_world(domain: Domain) -> World {
     let mut w = world(Settings::default());
     // Paths 100.. of a wave that starts there, each with its counts.
     let n = lanes().len();
-    let mut work = PhotonWork { domain: Some(domain), first_path: 100, ..Default::default() };
+    let mut work = PhotonWork { domain: Some(domain), first_path: 100, paths: 16_384, ..Default::default() };
     work.counts.resize(n, Default::default());
     for (i, (o, d)) in lanes().into_iter().enumerate() {
         work.queue.push(PhotonLane {
@@ -117,7 +117,12 @@ fn caustic_photons_are_kept_only_after_a_specular_bounce() {
 #[test]
 fn emit_photons_starts_a_batch_like_the_reference() {
     let mut w = world(Settings::default());
-    w.insert_resource(PhotonWork { domain: Some(Domain::GlobalPhoton), first_path: 5 * 16_384, ..Default::default() });
+    w.insert_resource(PhotonWork {
+        domain: Some(Domain::GlobalPhoton),
+        first_path: 5 * 16_384,
+        paths: 16_384,
+        ..Default::default()
+    });
     w.run_system_once(photonwave::wavefront::emit::emit_photons).unwrap();
     let shared = w.resource::<Shared>();
     let q = &w.resource::<PhotonWork>().queue;

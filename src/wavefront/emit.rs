@@ -6,18 +6,18 @@ use super::{par_columns, CameraWork, PhotonWork, Shared, StageClock, StageStats,
 use crate::film::{Term, Terms};
 use crate::rng::Domain;
 use crate::transport::camera::camera_ray;
-use crate::transport::photon::{start_photon, PathCounts, PathEnd, Start, BATCH};
+use crate::transport::photon::{start_photon, PathCounts, PathEnd, Start};
 use crate::transport::streams;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 
-/// Starts `batches` × [`BATCH`] photon paths at the wave's first path index.
+/// Starts the piece's photon paths at its first path index.
 pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
     let t = StageClock::start();
     let (scene, seed) = (&*shared.scene, shared.job.pass.seed);
     let domain = work.domain.unwrap_or(Domain::GlobalPhoton);
     let first = work.first_path;
-    let n = work.batches.max(1) * BATCH;
+    let n = work.paths;
     let w = &mut *work;
     w.queue.clear();
     w.counts.clear();

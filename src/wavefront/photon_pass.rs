@@ -1,34 +1,96 @@
 //! The wavefront photon pass: for each map the plan wants, waves of photon paths run through
 //! the photon schedule, and the transport core's [`Tally`] applied batch by batch, so the maps
 //! hold exactly the photons of the oracle's pass; then the maps are built.
+//!
+//! A wave's batches are cut into pieces of [`PIECE`] paths, and each worker traces the pieces it
+//! takes through the whole photon schedule on its own world, one thread per piece, as the
+//! camera pass does with its tiles (a wave shared by all threads met them at every stage of
+//! every bounce, and its deep bounces held too few photons to split: on 16 cores the global
+//! photons scaled 2.5×, issue 46). A piece's photons are keyed by (path, bounce) and the
+//! pieces hold consecutive paths, so their deposits concatenated in piece order are the
+//! reference engine's order, whoever traced which piece.
 
 use super::resources::PhotonWork;
 use super::schedule::PhotonPass;
+use super::{new_world, StageStats};
 use crate::job::Job;
+use crate::parallel::map_chunks;
 use crate::photon_map::Photon;
 use crate::progress::Progress;
 use crate::rng::Domain;
 use crate::scene::Scene;
 use crate::stats::RenderStats;
-use crate::transport::photon::{power_max_over_median, Tally, BATCH};
+use crate::transport::photon::{power_max_over_median, PathCounts, Tally, BATCH};
 use crate::transport::PhotonMaps;
 use bevy_ecs::prelude::*;
+use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Instant;
 
 /// At most this many batches per photon wave.
 pub const MAX_BATCHES_PER_WAVE: usize = 8;
+/// Photon paths per piece of work: a batch makes 8, so one batch keeps 8 workers busy, and
+/// a piece's first bounces still fill SIMD packets.
+pub const PIECE: usize = BATCH / 8;
+
+/// Traces paths `first..first + paths` of `domain`'s photons in pieces on `job.threads`
+/// workers (their worlds taken from and put back into `idle`), and returns their deposits in
+/// (path, bounce) order and their counts in path order.
+fn trace_wave(
+    scene: &Arc<Scene>,
+    job: &Job,
+    idle: &Mutex<Vec<World>>,
+    domain: Domain,
+    first: u64,
+    paths: usize,
+) -> (Vec<(u64, u32, Photon)>, Vec<PathCounts>) {
+    let worker_job = Job { threads: 1, ..job.clone() };
+    let pieces = map_chunks(
+        paths.div_ceil(PIECE),
+        1,
+        job.threads,
+        |k| {
+            let start = k.start * PIECE;
+            let taken = idle.lock().unwrap_or_else(PoisonError::into_inner).pop();
+            let mut world = taken.unwrap_or_else(|| new_world(scene, &worker_job));
+            {
+                // The queues keep their allocations from piece to piece (emit clears them).
+                let mut w = world.resource_mut::<PhotonWork>();
+                w.domain = Some(domain);
+                w.first_path = first + start as u64;
+                w.paths = PIECE.min(paths - start);
+                w.deposits.clear();
+            }
+            world.run_schedule(PhotonPass);
+            let mut w = world.resource_mut::<PhotonWork>();
+            let mut deposits = std::mem::take(&mut w.deposits);
+            deposits.sort_by_key(|(path, bounce, _)| (*path, *bounce));
+            let counts = std::mem::take(&mut w.counts);
+            idle.lock().unwrap_or_else(PoisonError::into_inner).push(world);
+            (deposits, counts)
+        },
+        |_| {},
+    );
+    let mut deposits = Vec::with_capacity(pieces.iter().map(|p| p.0.len()).sum());
+    let mut counts = Vec::with_capacity(paths);
+    for (mut d, mut c) in pieces {
+        deposits.append(&mut d);
+        counts.append(&mut c);
+    }
+    (deposits, counts)
+}
 
 /// The photon pass of both maps the plan wants, run through the photon schedule of `world`,
 /// and the maps built from it; counts and times go into `stats`.
 pub fn photon_pass(
     world: &mut World,
-    scene: &Scene,
+    scene: &Arc<Scene>,
     job: &Job,
     stats: &mut RenderStats,
     progress: &dyn Progress,
 ) -> PhotonMaps {
     let (plan, settings) = (&job.plan, &job.settings);
     let mut maps_photons: [Vec<Photon>; 2] = [Vec::new(), Vec::new()];
+    let idle: Mutex<Vec<World>> = Mutex::new(Vec::new());
     for (k, (domain, on, target)) in [
         (Domain::GlobalPhoton, plan.global_map.on, settings.photons),
         (Domain::CausticPhoton, plan.caustic_map.on, settings.caustic_photons),
@@ -44,10 +106,9 @@ pub fn photon_pass(
         progress.start(name, u64::from(target));
         let mut tally = Tally::new(target);
         let mut reported = 0u64;
-        *world.resource_mut::<PhotonWork>() = PhotonWork { domain: Some(domain), ..Default::default() };
-        // A wave holds several batches — large queues keep both cores busy in the deep bounces —
-        // sized from the photons per batch seen so far. The tally is then fed batch by batch, so
-        // the photons are the oracle's; paths traced past the stopping batch are discarded.
+        // A wave holds several batches — enough pieces to keep every worker busy — sized from
+        // the photons per batch seen so far. The tally is then fed batch by batch, so the
+        // photons are the oracle's; paths traced past the stopping batch are discarded.
         let mut per_batch = 0.0f64;
         while tally.wants_more() {
             let wanted = if per_batch > 0.0 {
@@ -56,17 +117,9 @@ pub fn photon_pass(
                 1
             };
             let batches = wanted.clamp(1, MAX_BATCHES_PER_WAVE).min(tally.batches_left());
-            {
-                let mut w = world.resource_mut::<PhotonWork>();
-                w.first_path = tally.emitted();
-                w.batches = batches;
-            }
-            world.run_schedule(PhotonPass);
-            let mut w = world.resource_mut::<PhotonWork>();
-            let mut deposits = std::mem::take(&mut w.deposits);
-            deposits.sort_by_key(|(path, bounce, _)| (*path, *bounce));
+            let (deposits, counts) = trace_wave(scene, job, &idle, domain, tally.emitted(), batches * BATCH);
             let mut rest = deposits.as_slice();
-            for counts in w.counts.chunks(BATCH) {
+            for counts in counts.chunks(BATCH) {
                 if !tally.wants_more() {
                     break;
                 }
@@ -98,6 +151,11 @@ pub fn photon_pass(
         maps_photons[k] = photons;
     }
     stats.record_plan(plan);
+    // The workers' stage counts and times join the render's.
+    let mut stages = world.resource_mut::<StageStats>();
+    for w in idle.into_inner().unwrap_or_else(PoisonError::into_inner) {
+        *stages += w.resource::<StageStats>();
+    }
 
     let t = Instant::now();
     let [global, caustic] = maps_photons;

@@ -27,15 +27,15 @@ pub struct Shared {
 #[derive(Resource, Default)]
 pub struct Maps(pub Arc<PhotonMaps>);
 
-/// Photon-pass state.
+/// Photon-pass state of one worker: its piece of a wave.
 #[derive(Resource, Default)]
 pub struct PhotonWork {
     /// Which map this pass fills.
     pub domain: Option<Domain>,
     /// Path index of the wave's first photon.
     pub first_path: u64,
-    /// Batches ([`BATCH`](crate::transport::photon::BATCH) paths each) in this wave.
-    pub batches: usize,
+    /// Paths in this piece of a wave.
+    pub paths: usize,
     /// Photons to trace this bounce.
     pub queue: PhotonQueue,
     /// Photons for the next bounce.
