@@ -237,8 +237,11 @@ pub fn complete_off_plane(
 }
 
 /// Whether a photon (position, normal) near the flat point `q` (normal `n`) belongs in its
-/// estimate: one in the point's plane (to `plane` of its distance, [`Filter::plane`]) always;
-/// one off it only if the segment between them, both lifted off their surfaces, meets nothing.
+/// estimate: one in the point's plane (to `plane` of its distance, [`Filter::plane`]) or in
+/// front of it always, as the filter keeps them; one behind it only if the segment between them,
+/// both lifted off their surfaces, meets nothing. (Tracing the photons in front too — a corner's
+/// other wall — cost the modern hall's gather a third of its time and kept fewer of them than
+/// the filter does wherever no photon was behind.)
 /// The lift is ¾ of the photon's height above the plane (at least 10⁻³ of its distance): enough
 /// to clear a convex crease or a curved neighbour between them (a chord dips below a sphere by a
 /// quarter of that height), not enough to lift a photon under a floor above it.
@@ -246,7 +249,7 @@ pub fn off_plane_visibility(scene: &Scene, q: Vec3, n: Vec3, plane: f32) -> impl
     move |p, m| {
         let d = p - q;
         let (h, d2) = (d.dot(n), d.length_squared());
-        if h * h <= plane * plane * d2 {
+        if h >= 0.0 || h * h <= plane * plane * d2 {
             return true;
         }
         let lift = (0.75 * h.abs()).max(1e-3 * d2.sqrt());
