@@ -28,11 +28,24 @@ use crate::transport::PhotonMaps;
 use bevy_ecs::prelude::*;
 use std::sync::{Arc, Mutex, PoisonError};
 
-/// Samples per tile (rounded down to whole pixels, at least one pixel). Small enough that
-/// a 320² image at 16 spp makes 400 tiles (the last tiles even out the workers' loads on 16
-/// threads), large enough that a stage's queues fill SIMD packets and amortise its fixed cost;
-/// a worker's queues then hold ~`TILE` × (1 + gather rays) lanes of ~100 B.
+/// Samples per tile at most (rounded down to whole pixels, at least one pixel): large enough
+/// that a stage's queues fill SIMD packets and amortise its fixed cost, small enough that a
+/// 320² image at 16 spp makes 400 tiles; a worker's queues then hold ~`TILE` × (1 + gather
+/// rays) lanes of ~100 B.
 pub const TILE: usize = 4096;
+/// Samples per tile at least, where smaller images cut finer ([`tile_for`]).
+pub const MIN_TILE: usize = 512;
+/// Tiles per worker wanted, so that the last tiles even out the workers' loads.
+const TILES_PER_WORKER: usize = 8;
+
+/// The tile size for `samples` samples on `threads` workers: [`TILE`], or less where that would
+/// leave fewer than [`TILES_PER_WORKER`] tiles per worker (a progressive pass of one sample per
+/// pixel at 320² makes 25 tiles of 4 096: on 16 workers the second round would keep 9 busy), but
+/// not below [`MIN_TILE`]. Only the speed depends on it, never the image.
+#[must_use]
+pub fn tile_for(samples: usize, threads: usize) -> usize {
+    TILE.min(samples.div_ceil(threads.max(1) * TILES_PER_WORKER)).max(MIN_TILE)
+}
 
 /// What the camera pass returns: the film's pixels (row-major) and the workers' counts.
 pub struct CameraPassOut {
@@ -67,7 +80,7 @@ fn worker_world(scene: &Arc<Scene>, job: &Job, maps: &Arc<PhotonMaps>, camera: &
 }
 
 /// Renders every sample of `job`'s image through the camera schedule, in tiles of `tile`
-/// samples (whole pixels, at least one; the render uses [`TILE`]) on `job.threads` workers, each
+/// samples (whole pixels, at least one; the render uses [`tile_for`]) on `job.threads` workers, each
 /// with its own world (built on first use, kept for its next tiles). The image is the same for
 /// any `tile` and thread count.
 #[must_use]
@@ -125,4 +138,22 @@ pub fn camera_pass(
         out.stages += world.resource::<StageStats>();
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{tile_for, MIN_TILE, TILE, TILES_PER_WORKER};
+
+    #[test]
+    fn tiles_are_cut_finer_only_where_workers_would_wait() {
+        // 320² at 16 spp on 2 threads: full tiles (400 of them).
+        assert_eq!(tile_for(320 * 320 * 16, 2), TILE);
+        // One sample per pixel at 320² on 16 threads: at least 8 tiles per worker.
+        let t = tile_for(320 * 320, 16);
+        assert!((320 * 320usize).div_ceil(t) >= 16 * TILES_PER_WORKER && t >= MIN_TILE, "{t}");
+        // A tiny image is one tile of at least MIN_TILE samples, whatever the thread count.
+        for threads in [0, 1, 2, 16, 1000] {
+            assert_eq!(tile_for(32, threads), MIN_TILE);
+        }
+    }
 }

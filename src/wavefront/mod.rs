@@ -191,7 +191,9 @@ pub fn render_job(scene: Arc<Scene>, camera: &CameraRays, job: &Job, progress: &
     let t = Instant::now();
     intersect::choose_camera_kernel(&scene, camera, job);
     progress.start("camera", u64::from(settings.width) * u64::from(settings.height));
-    let out = camera_pass(&scene, camera, job, &maps, camera_pass::TILE, progress);
+    let samples = settings.width as usize * settings.height as usize * settings.spp as usize;
+    let tile = camera_pass::tile_for(samples, job.threads);
+    let out = camera_pass(&scene, camera, job, &maps, tile, progress);
     progress.finish();
     let film = Film::new(settings.width, settings.height, out.film);
     stats.rays += out.rays;

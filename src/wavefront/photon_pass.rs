@@ -2,7 +2,7 @@
 //! the photon schedule, and the transport core's [`Tally`] applied batch by batch, so the maps
 //! hold exactly the photons of the oracle's pass; then the maps are built.
 //!
-//! A wave's batches are cut into pieces of [`PIECE`] paths, and each worker traces the pieces it
+//! A wave's batches are cut into pieces of up to [`PIECE`] paths, and each worker traces the pieces it
 //! takes through the whole photon schedule on its own world, one thread per piece, as the
 //! camera pass does with its tiles (a wave shared by all threads met them at every stage of
 //! every bounce, and its deep bounces held too few photons to split: on 16 cores the global
@@ -28,9 +28,22 @@ use std::time::Instant;
 
 /// At most this many batches per photon wave.
 pub const MAX_BATCHES_PER_WAVE: usize = 8;
-/// Photon paths per piece of work: a batch makes 8, so one batch keeps 8 workers busy, and
-/// a piece's first bounces still fill SIMD packets.
+/// Photon paths per piece of work at most: a batch makes 8, and a piece's first bounces still
+/// fill SIMD packets.
 pub const PIECE: usize = BATCH / 8;
+/// Photon paths per piece at least, where a small wave on many workers cuts finer.
+pub const MIN_PIECE: usize = 256;
+/// Pieces per worker wanted in a wave, so that the last pieces even out the workers' loads.
+const PIECES_PER_WORKER: usize = 4;
+
+/// The piece size for a wave of `paths` paths on `threads` workers: [`PIECE`], or less where
+/// that would leave fewer than [`PIECES_PER_WORKER`] pieces per worker (a progressive pass's one
+/// batch is 8 pieces of 2 048: half of 16 workers would wait), but not below [`MIN_PIECE`].
+/// Only the speed depends on it, never the photons.
+#[must_use]
+pub fn piece_for(paths: usize, threads: usize) -> usize {
+    PIECE.min(paths.div_ceil(threads.max(1) * PIECES_PER_WORKER)).max(MIN_PIECE)
+}
 
 /// Traces paths `first..first + paths` of `domain`'s photons in pieces on `job.threads`
 /// workers (their worlds taken from and put back into `idle`), and returns their deposits in
@@ -44,12 +57,13 @@ fn trace_wave(
     paths: usize,
 ) -> (Vec<(u64, u32, Photon)>, Vec<PathCounts>) {
     let worker_job = Job { threads: 1, ..job.clone() };
+    let piece = piece_for(paths, job.threads);
     let pieces = map_chunks(
-        paths.div_ceil(PIECE),
+        paths.div_ceil(piece),
         1,
         job.threads,
         |k| {
-            let start = k.start * PIECE;
+            let start = k.start * piece;
             let taken = idle.lock().unwrap_or_else(PoisonError::into_inner).pop();
             let mut world = taken.unwrap_or_else(|| new_world(scene, &worker_job));
             {
@@ -57,7 +71,7 @@ fn trace_wave(
                 let mut w = world.resource_mut::<PhotonWork>();
                 w.domain = Some(domain);
                 w.first_path = first + start as u64;
-                w.paths = PIECE.min(paths - start);
+                w.paths = piece.min(paths - start);
                 w.deposits.clear();
             }
             world.run_schedule(PhotonPass);
@@ -163,4 +177,25 @@ pub fn photon_pass(
     stats.irradiance_points = maps.irradiance.len() as u64;
     stats.times.map_build_s = t.elapsed().as_secs_f64();
     maps
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{piece_for, BATCH, MIN_PIECE, PIECE, PIECES_PER_WORKER};
+
+    #[test]
+    fn pieces_are_cut_finer_only_where_workers_would_wait() {
+        // One batch on 1 or 2 threads: 8 pieces of 2 048.
+        assert_eq!(piece_for(BATCH, 1), PIECE);
+        assert_eq!(piece_for(BATCH, 2), PIECE);
+        // One batch on 16 threads: 4 pieces per worker.
+        assert_eq!(BATCH.div_ceil(piece_for(BATCH, 16)), 16 * PIECES_PER_WORKER);
+        // Never below MIN_PIECE, never above PIECE.
+        for threads in [0, 1, 3, 64, 1000] {
+            for paths in [1, BATCH, 8 * BATCH] {
+                let p = piece_for(paths, threads);
+                assert!((MIN_PIECE..=PIECE).contains(&p), "{paths} paths, {threads} threads: {p}");
+            }
+        }
+    }
 }
