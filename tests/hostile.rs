@@ -215,6 +215,32 @@ fn materials_are_kept_apart_per_file() {
     assert_eq!(loaded.inputs.len(), 5, "scene, two OBJ and two MTL files: {:?}", loaded.inputs);
 }
 
+/// Warnings name their file: skipped degenerate triangles the mesh they were in (one warning per
+/// mesh), energy-conserving material fixes the MTL file and line of the material.
+#[test]
+fn warnings_name_their_file() {
+    let d = scratch_dir("warnings-name-files");
+    write(
+        &d,
+        "m.mtl",
+        "newmtl white\nKd 0.5 0.5 0.5\nnewmtl hot\nKd 1.5 0.2 0.2\nnewmtl shiny\nKd 0.7 0.7 0.7\nKs 0.6 0.6 0.6\n",
+    );
+    // Two faces each; in a.obj one of them has zero area, in b.obj both are fine.
+    write(&d, "a.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nusemtl hot\nf 1 2 3\nf 1 2 4\n");
+    write(&d, "b.obj", "mtllib m.mtl\nv 0 0 1\nv 1 0 1\nv 0 1 1\nusemtl shiny\nf 1 2 3\n");
+    let toml = write(
+        &d,
+        "s.toml",
+        "[[mesh]]\nfile = \"a.obj\"\n[[mesh]]\nfile = \"b.obj\"\n[[light]]\ntype = \"point\"\nposition = [0.2, 0.2, 2]\nintensity = [1, 1, 1]\n",
+    );
+    let w = load_scene(&toml).unwrap().scene.warnings;
+    let skipped: Vec<_> = w.iter().filter(|w| w.contains("degenerate")).collect();
+    assert_eq!(skipped.len(), 1, "{w:?}");
+    assert!(skipped[0].contains("a.obj") && skipped[0].contains(": 1 degenerate"), "{w:?}");
+    assert!(w.iter().any(|w| w.contains("m.mtl:3: material `hot`: Kd > 1")), "{w:?}");
+    assert!(w.iter().any(|w| w.contains("m.mtl:5: material `shiny`: Kd + Ks")), "{w:?}");
+}
+
 /// Texture statements not simulated (`map_d`, `bump`) and transparency are read and said to be ignored, once per material;
 /// `Ns -5`, `illum 99` and a file that is not UTF-8 are errors with their line.
 #[test]

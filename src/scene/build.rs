@@ -34,6 +34,8 @@ impl Scene {
         let mut uv: Vec<[Vec2; 3]> = vec![];
         let mut untextured_uses: Vec<String> = vec![];
         let mut dropped = 0usize;
+        // Triangles skipped per mesh, named in the warning.
+        let mut dropped_in: Vec<(&str, usize)> = vec![];
         let zero_normals = meshes.iter().map(|m| m.zero_normals).sum();
         // Emissive area per material, to refuse lights whose every triangle is degenerate.
         let mut emitter_area = vec![0.0f64; materials.len()];
@@ -61,6 +63,10 @@ impl Scene {
                 // underflows): such a triangle could never be hit, nor lit if it emitted.
                 if !(area > 0.0) || is_degenerate(v[0], v[1], v[2]) {
                     dropped += 1;
+                    match dropped_in.last_mut() {
+                        Some((source, n)) if *source == m.source.as_str() => *n += 1,
+                        _ => dropped_in.push((&m.source, 1)),
+                    }
                     continue;
                 }
                 if emissive {
@@ -101,8 +107,8 @@ impl Scene {
                 )));
             }
         }
-        if dropped > 0 {
-            warnings.push(format!("{dropped} degenerate (zero-area) triangles were skipped"));
+        for (source, n) in &dropped_in {
+            warnings.push(format!("{source}: {n} degenerate (zero-area) triangles were skipped"));
         }
         if p0.is_empty() {
             let directional = extra_lights.iter().any(Light::is_distant);

@@ -285,9 +285,10 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
     Ok(out)
 }
 
-/// Maps one MTL material onto photonwave's materials; warnings go to `warnings`.
+/// Maps one MTL material (read from `file`) onto photonwave's materials; warnings, each naming
+/// the file and the material's `newmtl` line, go to `warnings`.
 #[must_use]
-pub fn material_from_mtl(m: &MtlMaterial, warnings: &mut Vec<String>) -> Material {
+pub fn material_from_mtl(m: &MtlMaterial, file: &Path, warnings: &mut Vec<String>) -> Material {
     let kd = m.kd.unwrap_or(Vec3::splat(0.8));
     // A `map_Ks` gives a specular colour even without `Ks`; its texels replace `ks` (and are kept
     // within kd + ks ≤ 1 where they are read, `Material::bsdf_at`).
@@ -310,7 +311,12 @@ pub fn material_from_mtl(m: &MtlMaterial, warnings: &mut Vec<String>) -> Materia
         (2, _) if ks.max_element() > 0.0 => {
             let sum = (kd + ks).max_element();
             let scale = if sum > 1.0 && !ks_map && m.map("map_Kd").is_none() {
-                warnings.push(format!("material `{}`: Kd + Ks = {sum:.3} > 1, scaled down to conserve energy", m.name));
+                warnings.push(format!(
+                    "{}:{}: material `{}`: Kd + Ks = {sum:.3} > 1, scaled down to conserve energy",
+                    file.display(),
+                    m.line,
+                    m.name
+                ));
                 1.0 / sum
             } else {
                 1.0
@@ -319,7 +325,12 @@ pub fn material_from_mtl(m: &MtlMaterial, warnings: &mut Vec<String>) -> Materia
         }
         _ => {
             if kd.max_element() > 1.0 {
-                warnings.push(format!("material `{}`: Kd > 1 clamped to 1 to conserve energy", m.name));
+                warnings.push(format!(
+                    "{}:{}: material `{}`: Kd > 1 clamped to 1 to conserve energy",
+                    file.display(),
+                    m.line,
+                    m.name
+                ));
             }
             Bsdf::Lambert { kd: kd.min(Vec3::ONE) }
         }
@@ -371,7 +382,7 @@ mod tests {
         let (m, w) = parse(text);
         let m = m.unwrap();
         let mut w2 = Vec::new();
-        let b: Vec<Bsdf> = m.iter().map(|x| material_from_mtl(x, &mut w2).bsdf).collect();
+        let b: Vec<Bsdf> = m.iter().map(|x| material_from_mtl(x, Path::new("t.mtl"), &mut w2).bsdf).collect();
         assert_eq!(b[0], Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.6, 0.3), alpha: alpha_of(0.4) });
         assert!(m[0].map("map_Pr").is_some(), "map_Pr before Pr is kept");
         assert_eq!(b[1], Bsdf::RoughDielectric { ior: 1.4, alpha: alpha_of(0.5) });

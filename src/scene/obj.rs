@@ -216,7 +216,7 @@ pub fn load_obj(
     .map_err(|e| Error::parse(path, 0, format!("OBJ: {e}")))?;
     let mut ids = Vec::with_capacity(mtl.len());
     for (file, m) in &mtl {
-        let mut material = material_from_mtl(m, warnings);
+        let mut material = material_from_mtl(m, file, warnings);
         material.maps = table.load_maps(file, m, inputs)?;
         // A PBR metal's colour is its `Kd`: so is its texture's.
         if m.pm.is_some_and(|p| p >= 0.5) && material.maps.ks.is_none() {
