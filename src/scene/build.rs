@@ -33,8 +33,7 @@ impl Scene {
         let textured = materials.iter().any(|m| !m.maps.is_empty());
         let mut uv: Vec<[Vec2; 3]> = vec![];
         let mut untextured_uses: Vec<String> = vec![];
-        let mut dropped = 0usize;
-        // Triangles skipped per mesh, named in the warning.
+        // Degenerate triangles skipped, per mesh (named in the warning).
         let mut dropped_in: Vec<(&str, usize)> = vec![];
         let zero_normals = meshes.iter().map(|m| m.zero_normals).sum();
         // Emissive area per material, to refuse lights whose every triangle is degenerate.
@@ -62,7 +61,6 @@ impl Scene {
                 // Also what the intersection test takes as degenerate (its f32 cross product
                 // underflows): such a triangle could never be hit, nor lit if it emitted.
                 if !(area > 0.0) || is_degenerate(v[0], v[1], v[2]) {
-                    dropped += 1;
                     match dropped_in.last_mut() {
                         Some((source, n)) if *source == m.source.as_str() => *n += 1,
                         _ => dropped_in.push((&m.source, 1)),
@@ -107,6 +105,7 @@ impl Scene {
                 )));
             }
         }
+        let dropped: usize = dropped_in.iter().map(|(_, n)| n).sum();
         for (source, n) in &dropped_in {
             warnings.push(format!("{source}: {n} degenerate (zero-area) triangles were skipped"));
         }

@@ -16,7 +16,7 @@
 use super::queues::{Classified, PathQueue, ShadowQueue};
 use super::resources::{CameraWork, Maps};
 use super::schedule::CameraPass;
-use super::{new_world, StageStats};
+use super::{new_world, IdleWorlds, StageStats};
 use crate::film::Terms;
 use crate::job::Job;
 use crate::parallel::map_chunks;
@@ -26,7 +26,7 @@ use crate::scene::Scene;
 use crate::stats::{Numerics, RayCounts};
 use crate::transport::PhotonMaps;
 use bevy_ecs::prelude::*;
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::Arc;
 
 /// Samples per tile at most (rounded down to whole pixels, at least one pixel): large enough
 /// that a stage's queues fill SIMD packets and amortise its fixed cost, small enough that a
@@ -104,7 +104,7 @@ pub fn camera_pass(
     let tile_pixels = (tile / spp).max(1);
     // Inside a tile everything runs on its worker's thread.
     let worker_job = Job { threads: 1, ..job.clone() };
-    let idle: Mutex<Vec<World>> = Mutex::new(Vec::new());
+    let idle = IdleWorlds::default();
     let tiles = map_chunks(
         pixels.div_ceil(tile_pixels),
         1,
@@ -112,36 +112,38 @@ pub fn camera_pass(
         |k| {
             let first = k.start * tile_pixels;
             let count = tile_pixels.min(pixels - first);
-            let taken = idle.lock().unwrap_or_else(PoisonError::into_inner).pop();
-            let mut world = taken.unwrap_or_else(|| worker_world(scene, &worker_job, maps, camera));
-            {
-                let mut w = world.resource_mut::<CameraWork>();
-                w.first_sample = (first * spp) as u64;
-                w.count = count * spp;
-            }
-            world.run_schedule(CameraPass);
-            let film = std::mem::take(&mut world.resource_mut::<CameraWork>().film);
-            idle.lock().unwrap_or_else(PoisonError::into_inner).push(world);
+            let film = idle.with(
+                || worker_world(scene, &worker_job, maps, camera),
+                |world| {
+                    {
+                        let mut w = world.resource_mut::<CameraWork>();
+                        w.first_sample = (first * spp) as u64;
+                        w.count = count * spp;
+                    }
+                    world.run_schedule(CameraPass);
+                    std::mem::take(&mut world.resource_mut::<CameraWork>().film)
+                },
+            );
             progress.advance(count as u64);
             film
         },
         |_| {},
     );
+    let (worlds, stages) = idle.finish();
     let mut out = CameraPassOut {
         film: Vec::with_capacity(pixels),
         rays: RayCounts::default(),
         numerics: Numerics::default(),
-        stages: StageStats::default(),
+        stages,
     };
     for mut t in tiles {
         out.film.append(&mut t);
     }
-    // Integer counts and times: the sums do not depend on which worker ran which tile.
-    for world in idle.into_inner().unwrap_or_else(PoisonError::into_inner) {
+    // Integer counts: the sums do not depend on which worker ran which tile.
+    for world in &worlds {
         let w = world.resource::<CameraWork>();
         out.rays += w.rays;
         out.numerics += w.numerics;
-        out.stages += world.resource::<StageStats>();
     }
     out
 }

@@ -143,6 +143,36 @@ pub fn par_lanes<T: Send>(
     map_chunks(n, chunk, threads, f, |_| {}).into_iter().flatten()
 }
 
+/// The worlds of a pass's workers: a tile or piece takes an idle one (or builds one) and puts it
+/// back after, so a worker's queues keep their allocations from one to the next. At most one
+/// world per worker is ever built.
+#[derive(Default)]
+pub struct IdleWorlds(std::sync::Mutex<Vec<World>>);
+
+impl IdleWorlds {
+    /// Runs `f` on an idle world, or on a new one from `make`, and keeps the world for the next.
+    pub fn with<R>(&self, make: impl FnOnce() -> World, f: impl FnOnce(&mut World) -> R) -> R {
+        let lock = || self.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let taken = lock().pop();
+        let mut world = taken.unwrap_or_else(make);
+        let r = f(&mut world);
+        lock().push(world);
+        r
+    }
+
+    /// The worlds, and their stage counts and times summed (sums of counts and times: they do
+    /// not depend on which worker took which tile).
+    #[must_use]
+    pub fn finish(self) -> (Vec<World>, StageStats) {
+        let worlds = self.0.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let mut stages = StageStats::default();
+        for w in &worlds {
+            stages += w.resource::<StageStats>();
+        }
+        (worlds, stages)
+    }
+}
+
 /// A world holding the shared resources and the schedules of both passes.
 fn new_world(scene: &Arc<Scene>, job: &Job) -> World {
     let mut world = World::new();
@@ -161,8 +191,7 @@ fn new_world(scene: &Arc<Scene>, job: &Job) -> World {
 pub fn build_maps(scene: Arc<Scene>, settings: &Settings) -> Result<(PhotonMaps, RenderStats)> {
     let job = Job::photon_mapping(&scene, settings)?;
     let mut stats = RenderStats::new("wavefront", &scene, settings, job.threads);
-    let mut world = new_world(&scene, &job);
-    let maps = photon_pass(&mut world, &scene, &job, &mut stats, &NoProgress);
+    let maps = photon_pass(&scene, &job, &mut stats, &mut StageStats::default(), &NoProgress);
     Ok((maps, stats))
 }
 
@@ -184,8 +213,8 @@ pub fn render_job(scene: Arc<Scene>, camera: &CameraRays, job: &Job, progress: &
     let start = Instant::now();
     let mut stats =
         RenderStats { effects: Some(job.plan.clone()), ..RenderStats::new("wavefront", &scene, settings, job.threads) };
-    let mut world = new_world(&scene, job);
-    let maps = Arc::new(photon_pass(&mut world, &scene, job, &mut stats, progress));
+    let mut stages = StageStats::default();
+    let maps = Arc::new(photon_pass(&scene, job, &mut stats, &mut stages, progress));
 
     // Camera pass, tile by tile on every worker, with the camera rays' kernel chosen first.
     let t = Instant::now();
@@ -204,7 +233,6 @@ pub fn render_job(scene: Arc<Scene>, camera: &CameraRays, job: &Job, progress: &
     } else {
         "global map read at first hit (wavefront)".into()
     });
-    let mut stages = world.resource::<StageStats>().clone();
     stages += &out.stages;
     stats.stages = Some(stages);
     stats.traversal = job.traversal.report();

@@ -12,7 +12,7 @@
 
 use super::resources::PhotonWork;
 use super::schedule::PhotonPass;
-use super::{new_world, StageStats};
+use super::{new_world, IdleWorlds, StageStats};
 use crate::job::Job;
 use crate::parallel::map_chunks;
 use crate::photon_map::Photon;
@@ -22,8 +22,7 @@ use crate::scene::Scene;
 use crate::stats::RenderStats;
 use crate::transport::photon::{power_max_over_median, PathCounts, Tally, BATCH};
 use crate::transport::PhotonMaps;
-use bevy_ecs::prelude::*;
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// At most this many batches per photon wave.
@@ -51,7 +50,7 @@ pub fn piece_for(paths: usize, threads: usize) -> usize {
 fn trace_wave(
     scene: &Arc<Scene>,
     job: &Job,
-    idle: &Mutex<Vec<World>>,
+    idle: &IdleWorlds,
     domain: Domain,
     first: u64,
     paths: usize,
@@ -64,23 +63,24 @@ fn trace_wave(
         job.threads,
         |k| {
             let start = k.start * piece;
-            let taken = idle.lock().unwrap_or_else(PoisonError::into_inner).pop();
-            let mut world = taken.unwrap_or_else(|| new_world(scene, &worker_job));
-            {
-                // The queues keep their allocations from piece to piece (emit clears them).
-                let mut w = world.resource_mut::<PhotonWork>();
-                w.domain = Some(domain);
-                w.first_path = first + start as u64;
-                w.paths = piece.min(paths - start);
-                w.deposits.clear();
-            }
-            world.run_schedule(PhotonPass);
-            let mut w = world.resource_mut::<PhotonWork>();
-            let mut deposits = std::mem::take(&mut w.deposits);
-            deposits.sort_by_key(|(path, bounce, _)| (*path, *bounce));
-            let counts = std::mem::take(&mut w.counts);
-            idle.lock().unwrap_or_else(PoisonError::into_inner).push(world);
-            (deposits, counts)
+            idle.with(
+                || new_world(scene, &worker_job),
+                |world| {
+                    {
+                        // The queues keep their allocations from piece to piece (emit clears them).
+                        let mut w = world.resource_mut::<PhotonWork>();
+                        w.domain = Some(domain);
+                        w.first_path = first + start as u64;
+                        w.paths = piece.min(paths - start);
+                        w.deposits.clear();
+                    }
+                    world.run_schedule(PhotonPass);
+                    let mut w = world.resource_mut::<PhotonWork>();
+                    let mut deposits = std::mem::take(&mut w.deposits);
+                    deposits.sort_by_key(|(path, bounce, _)| (*path, *bounce));
+                    (deposits, std::mem::take(&mut w.counts))
+                },
+            )
         },
         |_| {},
     );
@@ -93,18 +93,19 @@ fn trace_wave(
     (deposits, counts)
 }
 
-/// The photon pass of both maps the plan wants, run through the photon schedule of `world`,
-/// and the maps built from it; counts and times go into `stats`.
+/// The photon pass of both maps the plan wants, run through the photon schedule on the workers'
+/// worlds, and the maps built from it; counts and times go into `stats`, and the stages' into
+/// `stages`.
 pub fn photon_pass(
-    world: &mut World,
     scene: &Arc<Scene>,
     job: &Job,
     stats: &mut RenderStats,
+    stages: &mut StageStats,
     progress: &dyn Progress,
 ) -> PhotonMaps {
     let (plan, settings) = (&job.plan, &job.settings);
     let mut maps_photons: [Vec<Photon>; 2] = [Vec::new(), Vec::new()];
-    let idle: Mutex<Vec<World>> = Mutex::new(Vec::new());
+    let idle = IdleWorlds::default();
     for (k, (domain, on, target)) in [
         (Domain::GlobalPhoton, plan.global_map.on, settings.photons),
         (Domain::CausticPhoton, plan.caustic_map.on, settings.caustic_photons),
@@ -166,10 +167,7 @@ pub fn photon_pass(
     }
     stats.record_plan(plan);
     // The workers' stage counts and times join the render's.
-    let mut stages = world.resource_mut::<StageStats>();
-    for w in idle.into_inner().unwrap_or_else(PoisonError::into_inner) {
-        *stages += w.resource::<StageStats>();
-    }
+    *stages += &idle.finish().1;
 
     let t = Instant::now();
     let [global, caustic] = maps_photons;
