@@ -27,6 +27,44 @@ pub fn scene_files_input(dir: &Path, data: &[u8]) -> Result<(), String> {
     scene_files(dir, toml, obj, mtl)
 }
 
+/// The cargo-fuzz target `mesh_files`'s input: the first byte picks the format (0: PLY, 1: glTF,
+/// 2: GLB, by its value mod 3), the rest is the file, checked by [`mesh_file`] in `dir`.
+pub fn mesh_files_input(dir: &Path, data: &[u8]) -> Result<(), String> {
+    let (kind, body) = data.split_first().unwrap_or((&0, &[]));
+    mesh_file(dir, ["m.ply", "m.gltf", "m.glb"][usize::from(*kind) % 3], body)
+}
+
+/// Writes `bytes` as `dir/name` (a PLY, glTF or GLB file) and loads it alone, lit by a headlight
+/// (so that a model without lights still renders). An error must be a short, non-empty message;
+/// a model that loads must render a 4×4 image on both engines, finite or an error.
+pub fn mesh_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), String> {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).map_err(|e| format!("cannot write the input: {e}"))?;
+    let headlight = |_: (Vec3, Vec3), _: Option<crate::scene::Camera>| {
+        vec![crate::scene::Light::Point { position: Vec3::new(0.0, 0.0, 10.0), intensity: Vec3::ONE }]
+    };
+    let loaded = match crate::scene::file::load_scene_lit(&path, &headlight) {
+        Err(e) => {
+            let msg = e.to_string();
+            return if msg.is_empty() || msg.len() > 2000 { Err(format!("unhelpful error: {msg:?}")) } else { Ok(()) };
+        }
+        Ok(loaded) => loaded,
+    };
+    let s = Settings {
+        threads: 1,
+        width: 4,
+        height: 4,
+        spp: 1,
+        photons: 300,
+        caustic_photons: 300,
+        gather_rays: 2,
+        ..loaded.settings
+    };
+    let camera = loaded.camera.unwrap_or_else(|| crate::scene::file::fitted_camera(&loaded.scene, 40.0, 1.0));
+    let Ok(rays) = camera.prepare(s.width, s.height) else { return Ok(()) };
+    renders_finite(loaded.scene, &rays, &s).map_err(|e| format!("{name}, {e}"))
+}
+
 /// The cargo-fuzz target `edge_rays`'s input: 18 floats — the edge's ends `a`, `b`, the wings
 /// `c1`, `c2`, the ray origin (3 each), where on the edge the ray aims (in [0, 1]), a scale for
 /// every point, and whether the direction is normalised (> 0) — checked by [`edge_ray`].
@@ -68,9 +106,18 @@ pub fn scene_files(dir: &Path, toml: &[u8], obj: &[u8], mtl: &[u8]) -> Result<()
         return Ok(());
     }
     let Ok(rays) = camera.prepare(s.width, s.height) else { return Ok(()) };
-    let scene = Arc::new(loaded.scene);
+    renders_finite(loaded.scene, &rays, &s)
+}
+
+/// Renders `scene` on both engines: each gives a finite image or an error.
+fn renders_finite(
+    scene: crate::scene::Scene,
+    rays: &crate::scene::camera::CameraRays,
+    s: &Settings,
+) -> Result<(), String> {
+    let scene = Arc::new(scene);
     for engine in [Engine::Wavefront, Engine::Reference] {
-        if let Ok((film, _)) = render(&scene, &rays, &s, engine, None, &NoProgress) {
+        if let Ok((film, _)) = render(&scene, rays, s, engine, None, &NoProgress) {
             if let Some(i) = film.pixels.iter().position(|t| !t.is_finite()) {
                 return Err(format!("{engine:?}: pixel {i} is {:?}", film.pixels[i]));
             }

@@ -149,6 +149,40 @@ fn mutated_scene_files_load_or_fail_cleanly() {
         .unwrap();
 }
 
+/// 300 mutated models: the ASCII PLY quad and the bundled glTF Cornell box, edited 1–5 times as
+/// text (see [`Edit`]), and the binary PLY and GLB boxes with 1–8 bytes overwritten: each loads,
+/// or fails with a short message, and a model that loads renders to a finite image or an error.
+#[test]
+fn mutated_models_load_or_fail_cleanly() {
+    let dir = scratch_dir("fuzz-models");
+    let ascii = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+property float nx\nproperty float ny\nproperty float nz\nelement face 1\nproperty list uchar int vertex_indices\n\
+end_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n";
+    let scenes = common::bundled("interchange");
+    let gltf = std::fs::read_to_string(scenes.join("cornell-box.gltf")).unwrap();
+    let (ply, glb) =
+        (std::fs::read(scenes.join("white.ply")).unwrap(), std::fs::read(scenes.join("cornell-box.glb")).unwrap());
+    let bytes = prop::collection::vec((any::<usize>(), any::<u8>()), 1..9);
+    runner(300, 13)
+        .run(&(0u8..4, edits(0, 1), bytes), |(kind, edits, bytes)| {
+            let overwrite = |mut data: Vec<u8>| {
+                let n = data.len();
+                bytes.iter().for_each(|&(at, b)| data[at % n] = b);
+                data
+            };
+            let (name, data) = match kind {
+                0 => ("m.ply", apply(ascii, &edits).into_bytes()),
+                1 => ("m.gltf", apply(&gltf, &edits).into_bytes()),
+                2 => ("m.ply", overwrite(ply.clone())),
+                _ => ("m.glb", overwrite(glb.clone())),
+            };
+            let result = fuzzing::mesh_file(&dir, name, &data);
+            prop_assert!(result.is_ok(), "{result:?}\n--- {name}\n{}", String::from_utf8_lossy(&data));
+            Ok(())
+        })
+        .unwrap();
+}
+
 /// 3 000 triangle pairs sharing an edge, at scales 10⁻⁴, 1 and 10⁵, and rays toward a point of
 /// the edge (its middle half) from inside their wedge, from as far as the edge is long or 10³ and
 /// 10⁶ times that (where a triangle is tiny beside its distance and f32 alone cannot prove t > 0),
@@ -192,7 +226,7 @@ fn inputs_the_fuzzers_found_stay_fixed() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions");
     let dir = scratch_dir("fuzz-regressions");
     let mut count = 0;
-    for target in ["edge_rays", "scene_files"] {
+    for target in ["edge_rays", "scene_files", "mesh_files"] {
         let Ok(entries) = std::fs::read_dir(root.join(target)) else { continue };
         for entry in entries {
             let path = entry.unwrap().path();
@@ -201,6 +235,8 @@ fn inputs_the_fuzzers_found_stay_fixed() {
                 let floats: Vec<f32> =
                     data.chunks_exact(4).take(18).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
                 fuzzing::edge_rays_input(floats.try_into().expect("an edge_rays input has 72 bytes"))
+            } else if target == "mesh_files" {
+                fuzzing::mesh_files_input(&dir, &data)
             } else {
                 fuzzing::scene_files_input(&dir, &data)
             };

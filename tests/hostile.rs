@@ -277,7 +277,7 @@ fn messages_say_what_is_actually_wrong() {
     write(&d, "a.obj", OBJ);
     let scaled = write(&d, "scaled.toml", "[[mesh]]\nfile = \"a.obj\"\nscale = 1e30\n");
     let e = load_scene(&scaled).err().unwrap().to_string();
-    assert!(e.contains("a.obj:3:") && e.contains("after scale and translate"), "{e}");
+    assert!(e.contains("a.obj:3:") && e.contains("after the mesh's transform"), "{e}");
     let sun =
         write(&d, "sun.toml", "[[light]]\ntype = \"directional\"\ndirection = [0, -1, 0]\nirradiance = [1, 1, 1]\n");
     let e = load_scene(&sun).err().unwrap().to_string();

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 /// Flags of `bench`.
 #[derive(clap::Args)]
 pub struct BenchArgs {
-    /// Scenes (.toml or .obj), or `generated:sphere` for the built-in displaced sphere
+    /// Scenes (.toml, .obj, .ply, .gltf or .glb), or `generated:sphere` for the built-in displaced sphere
     /// (~1 M triangles). Default: the bundled Cornell boxes and the generated sphere.
     pub scenes: Vec<String>,
     /// Print one JSON object instead of tables.

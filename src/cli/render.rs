@@ -19,7 +19,7 @@ use std::time::Instant;
 /// Flags of `render`.
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// Scene file (.toml) or mesh (.obj with its .mtl).
+    /// Scene file (.toml) or model (.obj with its .mtl, .ply, .gltf or .glb).
     pub scene: PathBuf,
     /// Output EXR (beauty as the default layer, one layer per term).
     #[arg(short, long, default_value = "out.exr")]
@@ -157,6 +157,9 @@ pub struct RenderArgs {
     /// progressive run to measure other renders against).
     #[arg(long)]
     pub preset: Option<Preset>,
+    /// A camera of the scene's glTF model by name, instead of the first (or the scene file's).
+    #[arg(long)]
+    pub camera: Option<String>,
     /// Add a light to the scene, placed from the camera (repeatable): `headlight` (a point light
     /// at the eye) or `sun` (a directional light from above and behind the camera). For meshes
     /// that bring no light, such as a bare OBJ from a model library.
@@ -236,7 +239,21 @@ pub fn run(args: RenderArgs) -> Result<()> {
     // Validated and planned once, for the whole render.
     let job = Job::new(&scene, &settings)?;
     let settings = &job.settings;
-    let camera = view(&args, loaded.camera, scene.mesh_bounds(), settings.width as f32 / settings.height as f32);
+    let file_camera = match &args.camera {
+        None => loaded.camera,
+        Some(name) => Some(loaded.cameras.iter().find(|c| &c.0 == name).map(|c| c.1).ok_or_else(|| {
+            let names: Vec<&str> = loaded.cameras.iter().map(|c| c.0.as_str()).collect();
+            photonwave::error::Error::setting(
+                "--camera",
+                if names.is_empty() {
+                    format!("`{name}`: the scene's models name no cameras")
+                } else {
+                    format!("`{name}` is not a camera of the scene (its cameras: {})", names.join(", "))
+                },
+            )
+        })?),
+    };
+    let camera = view(&args, file_camera, scene.mesh_bounds(), settings.width as f32 / settings.height as f32);
     let rays = camera.prepare(settings.width, settings.height)?;
     let load_s = t0.elapsed().as_secs_f64();
 

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 /// Flags of `sweep`.
 #[derive(clap::Args)]
 pub struct SweepArgs {
-    /// Scene file (.toml) or mesh (.obj with its .mtl).
+    /// Scene file (.toml) or model (.obj with its .mtl, .ply, .gltf or .glb).
     pub scene: PathBuf,
     /// The reference image (.exr), e.g. from `render --preset reference`; the sweep renders at
     /// its size.

@@ -166,8 +166,9 @@ impl Scene {
         lights.extend(extra_lights);
         if lights.is_empty() {
             return Err(Error::scene(
-                "the scene has no light: give a material a non-zero `Ke` in the MTL file, add a [[light]] to the scene \
-                 file, or light it from the command line with `--light headlight` or `--light sun`",
+                "the scene has no light: give a material emission (`Ke` in an MTL file, `emissiveFactor` in a glTF \
+                 file, `emission` in a [materials] table), add a [[light]] to the scene file, or light it from the \
+                 command line with `--light headlight` or `--light sun`",
             ));
         }
         let mut scene = Scene {

@@ -40,13 +40,14 @@
 
 use super::camera::Camera;
 use super::environment::Environment;
+use super::file_materials::{colour, finite3, MaterialEntry};
+use super::file_meshes::{Brought, MeshEntry};
 use super::image::load_texture;
 use super::light::Light;
-use super::obj::{load_obj, MaterialTable};
+use super::obj::MaterialTable;
 use super::{bounds_of, MeshInput, Scene};
 use crate::error::{Error, Result};
 use crate::files::{read_text, MAX_SCENE_FILE};
-use crate::material::{Bsdf, Material};
 use crate::settings::Settings;
 use crate::texture::Encoding;
 use glam::Vec3;
@@ -86,16 +87,6 @@ struct EnvironmentEntry {
 
 fn sun_angle() -> f32 {
     0.27
-}
-
-#[derive(Deserialize, Debug)]
-#[serde(deny_unknown_fields)]
-struct MeshEntry {
-    file: PathBuf,
-    #[serde(default = "one")]
-    scale: f32,
-    #[serde(default)]
-    translate: [f32; 3],
 }
 
 fn one() -> f32 {
@@ -144,122 +135,19 @@ enum LightEntry {
     },
 }
 
-#[derive(Deserialize, Debug)]
-#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
-enum MaterialEntry {
-    Lambert {
-        kd: [f32; 3],
-        #[serde(default)]
-        emission: Option<[f32; 3]>,
-    },
-    Glossy {
-        kd: [f32; 3],
-        ks: [f32; 3],
-        exponent: f32,
-        #[serde(default)]
-        emission: Option<[f32; 3]>,
-    },
-    Mirror {
-        #[serde(default = "ones")]
-        ks: [f32; 3],
-        #[serde(default)]
-        emission: Option<[f32; 3]>,
-    },
-    #[serde(rename = "rough_conductor")]
-    RoughConductor {
-        #[serde(default = "ones")]
-        ks: [f32; 3],
-        roughness: f32,
-        #[serde(default)]
-        emission: Option<[f32; 3]>,
-    },
-    #[serde(rename = "rough_plastic")]
-    RoughPlastic {
-        kd: [f32; 3],
-        #[serde(default = "ior_default")]
-        ior: f32,
-        roughness: f32,
-        #[serde(default)]
-        emission: Option<[f32; 3]>,
-    },
-    #[serde(rename = "rough_dielectric")]
-    RoughDielectric {
-        #[serde(default = "ior_default")]
-        ior: f32,
-        #[serde(default = "one")]
-        outside_ior: f32,
-        roughness: f32,
-        #[serde(default)]
-        emission: Option<[f32; 3]>,
-    },
-    Glass {
-        #[serde(default = "ior_default")]
-        ior: f32,
-        /// Index of the medium on the side the face's normal points to (1, air, by default):
-        /// one face with `ior` and `outside_ior` is the boundary between two dielectrics.
-        #[serde(default = "one")]
-        outside_ior: f32,
-        #[serde(default)]
-        emission: Option<[f32; 3]>,
-    },
-}
-
-fn ones() -> [f32; 3] {
-    [1.0; 3]
-}
-fn ior_default() -> f32 {
-    1.5
-}
-
 /// A loaded scene with what its file said about the camera and settings.
 pub struct LoadedScene {
     /// The assembled scene.
     pub scene: Scene,
-    /// Camera from the file, if it had one.
+    /// Camera from the file, if it had one: the TOML `[camera]`, else the first a glTF file
+    /// brings.
     pub camera: Option<Camera>,
+    /// The named cameras mesh files bring (glTF), for `--camera NAME`.
+    pub cameras: Vec<(String, Camera)>,
     /// Settings from the file's `[render]` table (defaults otherwise).
     pub settings: Settings,
     /// Every file read: the scene file, its OBJ and MTL files (outputs must not overwrite them).
     pub inputs: Vec<PathBuf>,
-}
-
-fn finite3(field: &str, v: [f32; 3]) -> Result<Vec3> {
-    let v = Vec3::from_array(v);
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(Error::setting(field, "must be finite"))
-    }
-}
-
-fn colour(field: &str, v: [f32; 3]) -> Result<Vec3> {
-    let v = finite3(field, v)?;
-    if v.min_element() < 0.0 {
-        Err(Error::setting(field, "must not be negative"))
-    } else {
-        Ok(v)
-    }
-}
-
-/// GGX α of a `roughness` in (0, 1] (α = roughness²; 0 is the smooth `mirror` or `glass`).
-fn roughness_alpha(field: &str, roughness: f32) -> Result<f32> {
-    if roughness > 0.0 && roughness <= 1.0 {
-        Ok(crate::microfacet::alpha_of(roughness))
-    } else {
-        Err(Error::setting(
-            field,
-            format!("must be in (0, 1], found {roughness} (a smooth surface is `mirror` or `glass`)"),
-        ))
-    }
-}
-
-fn albedo(field: &str, v: [f32; 3]) -> Result<Vec3> {
-    let v = colour(field, v)?;
-    if v.max_element() > 1.0 {
-        Err(Error::setting(field, "must not exceed 1 (it would create energy)"))
-    } else {
-        Ok(v)
-    }
 }
 
 impl LightEntry {
@@ -352,59 +240,11 @@ impl EnvironmentEntry {
     }
 }
 
-impl MaterialEntry {
-    fn to_material(&self, name: &str) -> Result<Material> {
-        let f = |field: &str| format!("materials.{name}.{field}");
-        let (bsdf, emission) = match *self {
-            MaterialEntry::Lambert { kd, emission } => (Bsdf::Lambert { kd: albedo(&f("kd"), kd)? }, emission),
-            MaterialEntry::Glossy { kd, ks, exponent, emission } => {
-                let (kd, ks) = (albedo(&f("kd"), kd)?, albedo(&f("ks"), ks)?);
-                if (kd + ks).max_element() > 1.0 {
-                    return Err(Error::setting(f("ks"), "kd + ks must not exceed 1 in any channel"));
-                }
-                if !(exponent >= 0.0 && exponent.is_finite()) {
-                    return Err(Error::setting(f("exponent"), "must be a finite number ≥ 0"));
-                }
-                (Bsdf::Glossy { kd, ks, exponent }, emission)
-            }
-            MaterialEntry::Mirror { ks, emission } => (Bsdf::Mirror { ks: albedo(&f("ks"), ks)? }, emission),
-            MaterialEntry::RoughConductor { ks, roughness, emission } => {
-                let alpha = roughness_alpha(&f("roughness"), roughness)?;
-                (Bsdf::RoughConductor { ks: albedo(&f("ks"), ks)?, alpha }, emission)
-            }
-            MaterialEntry::RoughPlastic { kd, ior, roughness, emission } => {
-                let alpha = roughness_alpha(&f("roughness"), roughness)?;
-                if !(ior > 0.0 && ior.is_finite()) {
-                    return Err(Error::setting(f("ior"), "must be a positive number"));
-                }
-                (Bsdf::RoughPlastic { kd: albedo(&f("kd"), kd)?, ior, alpha }, emission)
-            }
-            MaterialEntry::RoughDielectric { ior, outside_ior, roughness, emission } => {
-                let alpha = roughness_alpha(&f("roughness"), roughness)?;
-                if !(ior > 0.0 && ior.is_finite() && outside_ior > 0.0 && outside_ior.is_finite()) {
-                    return Err(Error::setting(f("ior"), "`ior` and `outside_ior` must be positive numbers"));
-                }
-                (Bsdf::RoughDielectric { ior: ior / outside_ior, alpha }, emission)
-            }
-            MaterialEntry::Glass { ior, outside_ior, emission } => {
-                if !(ior > 0.0 && ior.is_finite()) {
-                    return Err(Error::setting(f("ior"), "must be a positive number"));
-                }
-                if !(outside_ior > 0.0 && outside_ior.is_finite()) {
-                    return Err(Error::setting(f("outside_ior"), "must be a positive number"));
-                }
-                (Bsdf::Glass { ior: ior / outside_ior }, emission)
-            }
-        };
-        let emission = match emission {
-            Some(e) => colour(&f("emission"), e)?,
-            None => Vec3::ZERO,
-        };
-        Ok(Material::new(name, bsdf, emission))
-    }
-}
+/// The extensions of mesh files that load as scenes by themselves.
+const MESH_FORMATS: [&str; 4] = ["obj", "ply", "gltf", "glb"];
 
-/// Loads a scene: a `.toml` scene file, or a bare `.obj` (with its MTL files).
+/// Loads a scene: a `.toml` scene file, or a bare mesh file (OBJ with its MTL files, PLY, glTF
+/// or GLB).
 pub fn load_scene(path: &Path) -> Result<LoadedScene> {
     load_scene_lit(path, &|_, _| Vec::new())
 }
@@ -416,13 +256,21 @@ pub type AddedLights<'a> = &'a dyn Fn((Vec3, Vec3), Option<Camera>) -> Vec<Light
 /// Loads a scene as [`load_scene`] does, with the lights `added` gives it besides its own.
 pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
     let bounds = |meshes: &[MeshInput]| bounds_of(meshes.iter().flat_map(|m| m.positions.iter()));
-    let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-    if is_obj {
-        let (mut table, mut warnings, mut inputs) = (MaterialTable::default(), Vec::new(), Vec::new());
-        let meshes = vec![load_obj(path, (1.0, Vec3::ZERO), &mut table, &mut warnings, &mut inputs)?];
-        let lights = added(bounds(&meshes), None);
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    if MESH_FORMATS.contains(&ext.as_str()) {
+        // A bare mesh file: its own camera and lights if it brings them, `added` besides.
+        let (mut table, mut warnings, mut inputs, mut brought) =
+            (MaterialTable::default(), Vec::new(), Vec::new(), Brought::default());
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let name = PathBuf::from(path.file_name().unwrap_or_default());
+        let meshes =
+            vec![MeshEntry::of_file(name).load(0, dir, None, &mut table, &mut warnings, &mut inputs, &mut brought)?];
+        let camera = brought.cameras.first().map(|c| c.1);
+        let mut lights = brought.lights;
+        lights.extend(added(bounds(&meshes), camera));
         let scene = Scene::build(meshes, table.materials, lights, warnings)?;
-        return Ok(LoadedScene { scene, camera: None, settings: Settings::default(), inputs });
+        let (settings, cameras) = (Settings::default(), brought.cameras);
+        return Ok(LoadedScene { scene, camera, cameras, settings, inputs });
     }
     let text = read_text(path, "a scene file", MAX_SCENE_FILE)?;
     let mut inputs = vec![path.to_path_buf()];
@@ -437,12 +285,28 @@ pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
     let mut table = MaterialTable::default();
     let mut warnings = Vec::new();
     let mut meshes: Vec<MeshInput> = Vec::new();
+    let mut brought = Brought::default();
+    // Materials `[[mesh]]` entries name, each added to the table once.
+    let mut named: BTreeMap<&str, u32> = BTreeMap::new();
     for (i, m) in file.mesh.iter().enumerate() {
-        if !(m.scale.is_finite() && m.scale > 0.0) {
-            return Err(Error::setting(format!("mesh[{i}].scale"), "must be a positive number"));
-        }
-        let translate = finite3(&format!("mesh[{i}].translate"), m.translate)?;
-        meshes.push(load_obj(&dir.join(&m.file), (m.scale, translate), &mut table, &mut warnings, &mut inputs)?);
+        let material = match m.material.as_deref() {
+            None => None,
+            Some(name) => Some(match named.get(name) {
+                Some(&id) => id,
+                None => {
+                    let entry = file.materials.get(name).ok_or_else(|| {
+                        Error::setting(
+                            format!("mesh[{i}].material"),
+                            format!("names `{name}`, but there is no [materials.{name}]"),
+                        )
+                    })?;
+                    let id = table.insert(path, entry.to_material(name)?, &mut Vec::new());
+                    named.insert(name, id);
+                    id
+                }
+            }),
+        };
+        meshes.push(m.load(i, dir, material, &mut table, &mut warnings, &mut inputs, &mut brought)?);
     }
     for (name, entry) in &file.materials {
         if table.replace_named(name, &entry.to_material(name)?) == 0 {
@@ -450,12 +314,16 @@ pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
         }
     }
     let mut lights = file.light.iter().enumerate().map(|(i, l)| l.to_light(i)).collect::<Result<Vec<_>>>()?;
-    let camera = file.camera.map(|c| Camera {
-        eye: Vec3::from_array(c.eye),
-        target: Vec3::from_array(c.target),
-        up: Vec3::from_array(c.up),
-        fov_deg: c.fov,
-    });
+    lights.extend(brought.lights);
+    let camera = file
+        .camera
+        .map(|c| Camera {
+            eye: Vec3::from_array(c.eye),
+            target: Vec3::from_array(c.target),
+            up: Vec3::from_array(c.up),
+            fov_deg: c.fov,
+        })
+        .or_else(|| brought.cameras.first().map(|c| c.1));
     if !meshes.is_empty() {
         lights.extend(added(bounds(&meshes), camera));
     }
@@ -463,7 +331,7 @@ pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
     settings.validate()?;
     let environment = file.environment.as_ref().map(|e| e.to_environment(dir, &mut inputs)).transpose()?;
     let scene = Scene::build_lit(meshes, table.materials, lights, environment, warnings)?;
-    Ok(LoadedScene { scene, camera, settings, inputs })
+    Ok(LoadedScene { scene, camera, cameras: brought.cameras, settings, inputs })
 }
 
 /// A camera that frames the bounding sphere of the scene's triangles from +z, looking down −z, for an image of

@@ -76,5 +76,11 @@ pub fn displaced_sphere(rings: u32, segments: u32) -> Result<LoadedScene> {
     ];
     let scene = Scene::build(vec![sphere, room], materials, vec![], vec![])?;
     let camera = Camera { eye: Vec3::new(0.5, 0.5, 0.02), target: centre, up: Vec3::Y, fov_deg: 60.0 };
-    Ok(LoadedScene { scene, camera: Some(camera), settings: Settings::default(), inputs: Vec::new() })
+    Ok(LoadedScene {
+        scene,
+        camera: Some(camera),
+        cameras: Vec::new(),
+        settings: Settings::default(),
+        inputs: Vec::new(),
+    })
 }

@@ -65,16 +65,31 @@ pub fn load_texture(path: &Path, encoding: Encoding, what: &str) -> Result<Textu
         }
         Format::Png | Format::Jpeg => {
             let data = read_input(path, what, MAX_IMAGE_FILE)?;
-            let decoded = std::panic::catch_unwind(|| match format {
-                Format::Png => decode_png(&data),
-                _ => decode_jpeg(&data),
-            })
-            .unwrap_or_else(|_| Err("the decoder failed on it".into()));
-            let (w, h, channels, max, values) =
-                decoded.map_err(|e| Error::parse(path, 0, format!("{what}: damaged or unreadable image: {e}")))?;
-            (w, h, to_rgb(&values, channels, max, encoding))
+            return texture_from_bytes(path, &data, encoding, what);
         }
     };
+    finish(path, width, height, texels, what)
+}
+
+/// Decodes a PNG or JPEG image held in memory (a glTF file's embedded image); `origin` names it
+/// in messages and in the texture.
+pub fn texture_from_bytes(origin: &Path, data: &[u8], encoding: Encoding, what: &str) -> Result<Texture> {
+    let format = sniff(data).filter(|f| *f != Format::Exr).ok_or_else(|| {
+        Error::parse(origin, 0, format!("{what}: not a PNG or JPEG image (its first bytes are neither's)"))
+    })?;
+    let decoded = std::panic::catch_unwind(|| match format {
+        Format::Png => decode_png(data),
+        _ => decode_jpeg(data),
+    })
+    .unwrap_or_else(|_| Err("the decoder failed on it".into()));
+    let (w, h, channels, max, values) =
+        decoded.map_err(|e| Error::parse(origin, 0, format!("{what}: damaged or unreadable image: {e}")))?;
+    finish(origin, w, h, to_rgb(&values, channels, max, encoding), what)
+}
+
+/// The texture of `width × height` `texels`, refused when empty, too large or holding a value that
+/// is not finite or is negative.
+fn finish(path: &Path, width: u32, height: u32, texels: Vec<Vec3>, what: &str) -> Result<Texture> {
     if width == 0 || height == 0 {
         return Err(Error::parse(path, 0, format!("{what}: the image has no texels ({width}×{height})")));
     }

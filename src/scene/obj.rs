@@ -8,6 +8,7 @@
 
 use super::image::load_texture;
 use super::mtl::{material_from_mtl, parse_mtl, MtlMaterial};
+use super::transform::Transform;
 use super::validate::{check_obj, MtlLib};
 use super::MeshInput;
 use crate::error::{Error, Result};
@@ -148,15 +149,15 @@ fn named_by(e: Error, obj: &Path, line: usize) -> Error {
 }
 
 /// The error for the first `v` statement of `text` that lies outside ±[`MAX_COORDINATE`] once
-/// scaled and translated (tobj reorders vertices, so the file is read again for its line).
-fn out_of_range(path: &Path, text: &str, (scale, translate): (f32, Vec3)) -> Error {
+/// transformed (tobj reorders vertices, so the file is read again for its line).
+fn out_of_range(path: &Path, text: &str, transform: &Transform) -> Error {
     let first = text.lines().enumerate().find_map(|(i, line)| {
         let mut words = line.split_whitespace();
         if words.next() != Some("v") {
             return None;
         }
         let xyz: Vec<f32> = words.take(3).filter_map(|w| w.parse().ok()).collect();
-        let p = Vec3::from_slice(&xyz) * scale + translate;
+        let p = transform.point(Vec3::from_slice(&xyz));
         (!in_range(p)).then_some((i + 1, p))
     });
     let (line, p) = first.unwrap_or((0, Vec3::splat(f32::INFINITY)));
@@ -164,7 +165,7 @@ fn out_of_range(path: &Path, text: &str, (scale, translate): (f32, Vec3)) -> Err
         path,
         line,
         format!(
-            "the vertex lies at {p} (after scale and translate), outside ±{MAX_COORDINATE:e}, the range in \
+            "the vertex lies at {p} (after the mesh's transform), outside ±{MAX_COORDINATE:e}, the range in \
              which photonwave's f32 geometry stays watertight; scale the scene down (`scale` in the scene \
              file; docs/src/bad-input.md, \"Limits\")"
         ),
@@ -176,11 +177,10 @@ fn out_of_range(path: &Path, text: &str, (scale, translate): (f32, Vec3)) -> Err
 const ALL_MATERIALS: &str = "\u{1}photonwave-materials";
 
 /// Loads an OBJ file (and the MTL files it names) into a mesh; materials go into `table`.
-/// `transform` scales then translates every position.
-/// Every file read is added to `inputs`.
+/// `transform` places it ([`Transform::apply`]). Every file read is added to `inputs`.
 pub fn load_obj(
     path: &Path,
-    transform: (f32, Vec3),
+    transform: &Transform,
     table: &mut MaterialTable,
     warnings: &mut Vec<String>,
     inputs: &mut Vec<PathBuf>,
@@ -232,7 +232,6 @@ pub fn load_obj(
         ids.push(table.insert(file, material, warnings));
     }
 
-    let (scale, translate) = transform;
     let mut mesh = MeshInput { source: path.display().to_string(), ..Default::default() };
     let mut any_normals = false;
     let mut any_texcoords = false;
@@ -252,7 +251,7 @@ pub fn load_obj(
             }
         }));
         for (k, p) in m.positions.chunks_exact(3).enumerate() {
-            mesh.positions.push(Vec3::new(p[0], p[1], p[2]) * scale + translate);
+            mesh.positions.push(Vec3::new(p[0], p[1], p[2]));
             mesh.normals.push(if has_normals {
                 let n = Vec3::new(m.normals[3 * k], m.normals[3 * k + 1], m.normals[3 * k + 2]);
                 if n.try_normalize().is_none() {
@@ -283,6 +282,7 @@ pub fn load_obj(
     if !any_texcoords {
         mesh.texcoords.clear();
     }
+    transform.apply(&mut mesh);
     if mesh.positions.iter().any(|p| !in_range(*p)) {
         return Err(out_of_range(path, &text, transform));
     }

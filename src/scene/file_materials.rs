@@ -1,0 +1,214 @@
+//! The TOML scene file's `[materials.NAME]` tables: each becomes a [`Material`] replacing the
+//! MTL material of that name, or one a `[[mesh]]` names with `material = "NAME"`.
+//!
+//! A `conductor` given by its complex index η + ik (or a named metal, [`METALS`]) is rendered
+//! as a mirror (roughness 0) or a GGX rough conductor whose Schlick Fresnel starts from the
+//! exact normal-incidence reflectance ((η − 1)² + k²) / ((η + 1)² + k²): the colour is exact
+//! head-on, the rise toward grazing angles Schlick's (within a few per cent for metals).
+
+use crate::error::{Error, Result};
+use crate::material::{Bsdf, Material};
+use crate::optics::{conductor_f0, named_metal_f0, METALS};
+use glam::Vec3;
+use serde::Deserialize;
+
+#[derive(Deserialize, Debug)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+pub(super) enum MaterialEntry {
+    Lambert {
+        kd: [f32; 3],
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+    Glossy {
+        kd: [f32; 3],
+        ks: [f32; 3],
+        exponent: f32,
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+    Mirror {
+        #[serde(default = "ones")]
+        ks: [f32; 3],
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+    #[serde(rename = "rough_conductor")]
+    RoughConductor {
+        #[serde(default = "ones")]
+        ks: [f32; 3],
+        roughness: f32,
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+    #[serde(rename = "rough_plastic")]
+    RoughPlastic {
+        kd: [f32; 3],
+        #[serde(default = "ior_default")]
+        ior: f32,
+        roughness: f32,
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+    #[serde(rename = "rough_dielectric")]
+    RoughDielectric {
+        #[serde(default = "ior_default")]
+        ior: f32,
+        #[serde(default = "one")]
+        outside_ior: f32,
+        roughness: f32,
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+    /// A metal given by its complex index (`eta`, `k`) or by name (`metal`), smooth (a mirror)
+    /// or rough.
+    Conductor {
+        #[serde(default)]
+        eta: Option<[f32; 3]>,
+        #[serde(default)]
+        k: Option<[f32; 3]>,
+        #[serde(default)]
+        metal: Option<String>,
+        #[serde(default)]
+        roughness: f32,
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+    Glass {
+        #[serde(default = "ior_default")]
+        ior: f32,
+        /// Index of the medium on the side the face's normal points to (1, air, by default):
+        /// one face with `ior` and `outside_ior` is the boundary between two dielectrics.
+        #[serde(default = "one")]
+        outside_ior: f32,
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
+}
+
+fn ones() -> [f32; 3] {
+    [1.0; 3]
+}
+fn ior_default() -> f32 {
+    1.5
+}
+
+pub(super) fn finite3(field: &str, v: [f32; 3]) -> Result<Vec3> {
+    let v = Vec3::from_array(v);
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(Error::setting(field, "must be finite"))
+    }
+}
+
+pub(super) fn colour(field: &str, v: [f32; 3]) -> Result<Vec3> {
+    let v = finite3(field, v)?;
+    if v.min_element() < 0.0 {
+        Err(Error::setting(field, "must not be negative"))
+    } else {
+        Ok(v)
+    }
+}
+
+/// GGX α of a `roughness` in (0, 1] (α = roughness²; 0 is the smooth `mirror` or `glass`).
+fn roughness_alpha(field: &str, roughness: f32) -> Result<f32> {
+    if roughness > 0.0 && roughness <= 1.0 {
+        Ok(crate::microfacet::alpha_of(roughness))
+    } else {
+        Err(Error::setting(
+            field,
+            format!("must be in (0, 1], found {roughness} (a smooth surface is `mirror` or `glass`)"),
+        ))
+    }
+}
+
+fn albedo(field: &str, v: [f32; 3]) -> Result<Vec3> {
+    let v = colour(field, v)?;
+    if v.max_element() > 1.0 {
+        Err(Error::setting(field, "must not exceed 1 (it would create energy)"))
+    } else {
+        Ok(v)
+    }
+}
+
+impl MaterialEntry {
+    /// The material this entry describes, called `name`.
+    pub(super) fn to_material(&self, name: &str) -> Result<Material> {
+        let f = |field: &str| format!("materials.{name}.{field}");
+        let (bsdf, emission) = match *self {
+            MaterialEntry::Lambert { kd, emission } => (Bsdf::Lambert { kd: albedo(&f("kd"), kd)? }, emission),
+            MaterialEntry::Glossy { kd, ks, exponent, emission } => {
+                let (kd, ks) = (albedo(&f("kd"), kd)?, albedo(&f("ks"), ks)?);
+                if (kd + ks).max_element() > 1.0 {
+                    return Err(Error::setting(f("ks"), "kd + ks must not exceed 1 in any channel"));
+                }
+                if !(exponent >= 0.0 && exponent.is_finite()) {
+                    return Err(Error::setting(f("exponent"), "must be a finite number ≥ 0"));
+                }
+                (Bsdf::Glossy { kd, ks, exponent }, emission)
+            }
+            MaterialEntry::Mirror { ks, emission } => (Bsdf::Mirror { ks: albedo(&f("ks"), ks)? }, emission),
+            MaterialEntry::RoughConductor { ks, roughness, emission } => {
+                let alpha = roughness_alpha(&f("roughness"), roughness)?;
+                (Bsdf::RoughConductor { ks: albedo(&f("ks"), ks)?, alpha }, emission)
+            }
+            MaterialEntry::RoughPlastic { kd, ior, roughness, emission } => {
+                let alpha = roughness_alpha(&f("roughness"), roughness)?;
+                if !(ior > 0.0 && ior.is_finite()) {
+                    return Err(Error::setting(f("ior"), "must be a positive number"));
+                }
+                (Bsdf::RoughPlastic { kd: albedo(&f("kd"), kd)?, ior, alpha }, emission)
+            }
+            MaterialEntry::RoughDielectric { ior, outside_ior, roughness, emission } => {
+                let alpha = roughness_alpha(&f("roughness"), roughness)?;
+                if !(ior > 0.0 && ior.is_finite() && outside_ior > 0.0 && outside_ior.is_finite()) {
+                    return Err(Error::setting(f("ior"), "`ior` and `outside_ior` must be positive numbers"));
+                }
+                (Bsdf::RoughDielectric { ior: ior / outside_ior, alpha }, emission)
+            }
+            MaterialEntry::Conductor { eta, k, ref metal, roughness, emission } => {
+                let ks = match (eta, k, metal) {
+                    (None, None, Some(name)) => named_metal_f0(name).ok_or_else(|| {
+                        let known: Vec<&str> = METALS.iter().map(|m| m.0).collect();
+                        Error::setting(
+                            f("metal"),
+                            format!("unknown metal `{name}` (known: {}, none)", known.join(", ")),
+                        )
+                    })?,
+                    (Some(eta), Some(k), None) => {
+                        let (eta, k) = (colour(&f("eta"), eta)?, colour(&f("k"), k)?);
+                        if eta.min_element() <= 0.0 {
+                            return Err(Error::setting(f("eta"), "must be positive"));
+                        }
+                        conductor_f0(eta, k)
+                    }
+                    _ => return Err(Error::setting(f("type"), "a conductor takes `eta` and `k`, or `metal`")),
+                };
+                if roughness == 0.0 {
+                    (Bsdf::Mirror { ks }, emission)
+                } else {
+                    (Bsdf::RoughConductor { ks, alpha: roughness_alpha(&f("roughness"), roughness)? }, emission)
+                }
+            }
+            MaterialEntry::Glass { ior, outside_ior, emission } => {
+                if !(ior > 0.0 && ior.is_finite()) {
+                    return Err(Error::setting(f("ior"), "must be a positive number"));
+                }
+                if !(outside_ior > 0.0 && outside_ior.is_finite()) {
+                    return Err(Error::setting(f("outside_ior"), "must be a positive number"));
+                }
+                (Bsdf::Glass { ior: ior / outside_ior }, emission)
+            }
+        };
+        let emission = match emission {
+            Some(e) => colour(&f("emission"), e)?,
+            None => Vec3::ZERO,
+        };
+        Ok(Material::new(name, bsdf, emission))
+    }
+}
+
+fn one() -> f32 {
+    1.0
+}

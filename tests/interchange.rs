@@ -1,0 +1,362 @@
+//! Scenes from other tools: glTF 2.0 models, PLY meshes, and what the TOML scene file says of
+//! meshes (transforms, built-in shapes, a material per mesh, conductors by η and k). The same
+//! Cornell box as OBJ/MTL, glTF and PLY renders the same image; every feature loads with the
+//! right transforms, cameras, lights and materials; bad files are errors naming file and element.
+
+mod common;
+
+use common::{bundled, scratch_dir};
+use glam::{Vec2, Vec3};
+use photonwave::engine::{render, Engine};
+use photonwave::material::Bsdf;
+use photonwave::progress::NoProgress;
+use photonwave::scene::file::{load_scene, LoadedScene};
+use photonwave::scene::Light;
+use photonwave::settings::Settings;
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+fn beauty(loaded: LoadedScene) -> Vec<Vec3> {
+    let s = Settings {
+        width: 24,
+        height: 24,
+        spp: 2,
+        photons: 4000,
+        caustic_photons: 1000,
+        gather_rays: 4,
+        threads: 2,
+        ..Settings::default()
+    };
+    let rays = loaded.camera.unwrap().prepare(s.width, s.height).unwrap();
+    render(&Arc::new(loaded.scene), &rays, &s, Engine::Wavefront, None, &NoProgress).unwrap().0.beauty()
+}
+
+/// The Cornell box as OBJ/MTL, as glTF (with its own camera) and as PLY meshes with TOML
+/// materials: the readers give the same triangles in the same order, so the images are the same
+/// bit for bit — stronger than "within noise", which would hide a reader that dropped a face.
+#[test]
+fn the_cornell_box_renders_the_same_from_obj_gltf_and_ply() {
+    let obj = beauty(load_scene(&bundled("cornell-box.toml")).unwrap());
+    let gltf = load_scene(&bundled("interchange/cornell-box.gltf")).unwrap();
+    assert_eq!(gltf.cameras.len(), 1);
+    assert!((gltf.camera.unwrap().fov_deg - 39.3).abs() < 1e-4);
+    assert!(gltf.scene.warnings.is_empty(), "{:?}", gltf.scene.warnings);
+    assert_eq!(beauty(gltf), obj, "glTF");
+    assert_eq!(beauty(load_scene(&bundled("interchange/cornell-box-ply.toml")).unwrap()), obj, "PLY");
+}
+
+/// A glTF document of one triangle per node in `nodes` (each naming mesh 0), with `extra` merged
+/// in at the top level; the buffer is a data URI.
+fn gltf_doc(nodes: Value, material: Value, extra: Value) -> Value {
+    let mut blob = Vec::new();
+    for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+        p.iter().for_each(|x| blob.extend(x.to_le_bytes()));
+    }
+    for uv in [[0.0f32, 0.0], [1.0, 0.0], [0.0, 1.0]] {
+        uv.iter().for_each(|x| blob.extend(x.to_le_bytes()));
+    }
+    use base64::Engine as _;
+    let uri =
+        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&blob));
+    let mut doc = json!({
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0]}],
+        "nodes": nodes,
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 0}]}],
+        "materials": [material],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}
+        ],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
+        "buffers": [{"byteLength": 60, "uri": uri}]
+    });
+    if let (Value::Object(d), Value::Object(e)) = (&mut doc, extra) {
+        d.extend(e);
+    }
+    doc
+}
+
+/// Loads `doc` as a glTF file named by a scene file that adds a point light (so that models
+/// without lights render).
+fn load_doc(dir: &Path, doc: &Value) -> photonwave::error::Result<LoadedScene> {
+    write(dir, "m.gltf", doc.to_string());
+    let toml =
+        "[[mesh]]\nfile = \"m.gltf\"\n[[light]]\ntype = \"point\"\nposition = [0, 0, 4]\nintensity = [1, 1, 1]\n";
+    load_scene(&write(dir, "s.toml", toml))
+}
+
+/// Node transforms compose parent × child (translation, rotation, scale, matrix); the camera
+/// sits on its node looking down −z; punctual lights are placed and converted from photometric
+/// units (1/683 W per lm).
+#[test]
+fn gltf_hierarchy_cameras_and_lights() {
+    let d = scratch_dir("gltf-hierarchy");
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    let nodes = json!([
+        {"translation": [10, 0, 0], "children": [1, 2, 3, 4, 5]},
+        // Turned 90° about +z, scaled 2: (1, 0, 0) → (0, 2, 0).
+        {"mesh": 0, "rotation": [0, 0, s, s], "scale": [2, 2, 2]},
+        {"camera": 0, "name": "front", "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,5,1]},
+        {"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [0, 3, 0]},
+        {"extensions": {"KHR_lights_punctual": {"light": 1}}, "rotation": [-0.5, 0, 0, 0.8660254]},
+        {"extensions": {"KHR_lights_punctual": {"light": 2}}}
+    ]);
+    let extra = json!({
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "intensity": 683, "color": [1, 0.5, 0]},
+            {"type": "directional", "intensity": 1366},
+            {"type": "spot", "intensity": 68.3, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.4}}
+        ]}}
+    });
+    let loaded = load_doc(&d, &gltf_doc(nodes, json!({"pbrMetallicRoughness": {"metallicFactor": 0}}), extra)).unwrap();
+    let (lo, hi) = loaded.scene.mesh_bounds();
+    assert!((lo - Vec3::new(8.0, 0.0, 0.0)).abs().max_element() < 1e-5, "{lo}");
+    assert!((hi - Vec3::new(10.0, 2.0, 0.0)).abs().max_element() < 1e-5, "{hi}");
+    let (name, cam) = &loaded.cameras[0];
+    assert_eq!(name, "front");
+    assert_eq!(cam.eye, Vec3::new(10.0, 0.0, 5.0));
+    assert!((cam.target - cam.eye - Vec3::NEG_Z).length() < 1e-6);
+    assert!((cam.fov_deg - 0.5f32.to_degrees()).abs() < 1e-4);
+    // The scene file's point light first, then the model's.
+    let lights: Vec<&Light> = loaded.scene.lights.iter().filter(|l| !matches!(l, Light::Area { .. })).skip(1).collect();
+    assert_eq!(lights.len(), 3, "{lights:?}");
+    assert!(matches!(lights[0], Light::Point { position, intensity }
+        if (*position - Vec3::new(10.0, 3.0, 0.0)).length() < 1e-6 && (*intensity - Vec3::new(1.0, 0.5, 0.0)).length() < 1e-6));
+    // −60° about x turns −z toward −y: (0, −sin 60°, −cos 60°).
+    assert!(matches!(lights[1], Light::Directional { direction, irradiance }
+        if (*direction - Vec3::new(0.0, -0.8660254, -0.5)).length() < 1e-5 && (*irradiance - Vec3::splat(2.0)).length() < 1e-5));
+    assert!(matches!(lights[2], Light::Spot { cos_inner, cos_outer, intensity, .. }
+        if (*cos_inner - 0.2f32.cos()).abs() < 1e-6 && (*cos_outer - 0.4f32.cos()).abs() < 1e-6 && (intensity.x - 0.1).abs() < 1e-6));
+}
+
+/// The metallic–roughness mapping (docs/src/formats.md): each kind of material lands on the BSDF
+/// the mapping names, emission is factor × strength, and a texture transform moves the texture
+/// coordinates.
+#[test]
+fn gltf_materials_map_onto_the_bsdfs_they_name() {
+    let d = scratch_dir("gltf-materials");
+    let node = json!([{"mesh": 0}]);
+    let extra = json!({"extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_emissive_strength"]});
+    let cases = [
+        (
+            json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.4, 0.3, 1], "metallicFactor": 0, "roughnessFactor": 1}}),
+            Bsdf::Lambert { kd: Vec3::new(0.5, 0.4, 0.3) },
+        ),
+        (
+            json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.4, 0.3, 1], "metallicFactor": 0, "roughnessFactor": 0.5}}),
+            Bsdf::RoughPlastic { kd: Vec3::new(0.5, 0.4, 0.3), ior: 1.5, alpha: 0.25 },
+        ),
+        (
+            json!({"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.7, 0.3, 1], "metallicFactor": 1, "roughnessFactor": 0}}),
+            Bsdf::Mirror { ks: Vec3::new(0.9, 0.7, 0.3) },
+        ),
+        (
+            json!({"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.7, 0.3, 1], "metallicFactor": 1, "roughnessFactor": 0.4}}),
+            Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.7, 0.3), alpha: 0.16000001 },
+        ),
+        (
+            json!({"pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
+                "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_ior": {"ior": 1.33}}}),
+            Bsdf::Glass { ior: 1.33 },
+        ),
+    ];
+    for (material, want) in cases {
+        let loaded = load_doc(&d, &gltf_doc(node.clone(), material.clone(), extra.clone())).unwrap();
+        assert_eq!(loaded.scene.materials[loaded.scene.material[0] as usize].bsdf, want, "{material}");
+    }
+    let glowing = json!({"emissiveFactor": [1, 0.5, 0.25], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 8}}});
+    let loaded = load_doc(&d, &gltf_doc(node.clone(), glowing, extra.clone())).unwrap();
+    assert_eq!(loaded.scene.materials[loaded.scene.material[0] as usize].emission, Vec3::new(8.0, 4.0, 2.0));
+    assert!(loaded.scene.lights.iter().any(|l| matches!(l, Light::Area { .. })));
+    // A 2×2 base-colour texture, embedded as a PNG data URI, offset by ½ in u: the
+    // coordinates move (and v is flipped: glTF's runs down the image).
+    let mut png_bytes = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut png_bytes, 2, 2);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.write_header().unwrap().write_image_data(&[255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255]).unwrap();
+    }
+    use base64::Engine as _;
+    let image = format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(&png_bytes));
+    let textured = json!({"pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 1, "baseColorTexture": {
+        "index": 0, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0], "scale": [2, 1]}}}}});
+    let extra =
+        json!({"extensionsUsed": ["KHR_texture_transform"], "textures": [{"source": 0}], "images": [{"uri": image}]});
+    let loaded = load_doc(&d, &gltf_doc(node, textured, extra)).unwrap();
+    let m = &loaded.scene.materials[loaded.scene.material[0] as usize];
+    assert!(m.maps.kd.is_some());
+    // Corner (1, 0) in glTF coordinates: scaled to (2, 0), offset to (2.5, 0), v flipped to 1.
+    let uvs: Vec<Vec2> = loaded.scene.uv[0].to_vec();
+    assert!(uvs.iter().any(|uv| (*uv - Vec2::new(2.5, 1.0)).length() < 1e-6), "{uvs:?}");
+}
+
+/// What is read but not rendered is warned of by name; an unknown required extension, a missing
+/// buffer, a bad accessor index, a stride shorter than an element, an index past the vertices and
+/// a cut GLB are errors naming the file and the element.
+#[test]
+fn gltf_bad_files_are_errors_naming_the_element() {
+    let d = scratch_dir("gltf-bad");
+    let node = json!([{"mesh": 0}]);
+    let lambert = json!({"pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 1}});
+    let images = json!({"extensionsUsed": ["KHR_materials_clearcoat"], "textures": [{"source": 0}],
+                        "images": [{"uri": "data:image/png;base64,"}]});
+    // Normal textures are not read, so an empty image there is only warned of; as a base colour
+    // it is an error naming the image.
+    let masked =
+        json!({"alphaMode": "MASK", "normalTexture": {"index": 0}, "pbrMetallicRoughness": {"metallicFactor": 0}});
+    let loaded = load_doc(&d, &gltf_doc(node.clone(), masked, images.clone())).unwrap();
+    let w = loaded.scene.warnings.join("\n");
+    assert!(
+        w.contains("KHR_materials_clearcoat") && w.contains("alphaMode Mask") && w.contains("normal texture"),
+        "{w}"
+    );
+    let coloured = json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}});
+    let e = load_doc(&d, &gltf_doc(node.clone(), coloured, images)).err().unwrap().to_string();
+    assert!(e.contains("m.gltf") && e.contains("image 0"), "{e}");
+
+    let mut doc =
+        gltf_doc(node.clone(), lambert.clone(), json!({"extensionsRequired": ["KHR_draco_mesh_compression"]}));
+    let e = load_doc(&d, &doc).err().unwrap().to_string();
+    assert!(e.contains("m.gltf") && e.contains("KHR_draco_mesh_compression"), "{e}");
+
+    doc = gltf_doc(node.clone(), lambert.clone(), json!({}));
+    doc["buffers"][0]["uri"] = json!("missing.bin");
+    let e = load_doc(&d, &doc).err().unwrap().to_string();
+    assert!(e.contains("m.gltf") && e.contains("buffer 0") && e.contains("missing.bin"), "{e}");
+
+    doc = gltf_doc(node.clone(), lambert.clone(), json!({}));
+    doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(7);
+    let e = load_doc(&d, &doc).err().unwrap().to_string();
+    assert!(e.contains("m.gltf") && e.contains("POSITION"), "{e}");
+
+    doc = gltf_doc(node.clone(), lambert.clone(), json!({}));
+    doc["bufferViews"][0]["byteStride"] = json!(8);
+    let e = load_doc(&d, &doc).err().unwrap().to_string();
+    assert!(e.contains("accessor 0") && e.contains("stride 8"), "{e}");
+
+    doc = gltf_doc(node.clone(), lambert.clone(), json!({}));
+    doc["accessors"][0]["count"] = json!(4);
+    let e = load_doc(&d, &doc).err().unwrap().to_string();
+    assert!(e.contains("accessor 0") && e.contains("past the end"), "{e}");
+
+    let e = load_scene(&write(&d, "cut.glb", b"glTF\x02\0\0\0\xff\0\0\0")).err().unwrap().to_string();
+    assert!(e.contains("cut.glb") && e.contains("GLB"), "{e}");
+}
+
+/// PLY: ASCII with normals, texture coordinates and a quad (fanned); big-endian binary; errors
+/// with the header line, the element and index, or the ASCII line.
+#[test]
+fn ply_meshes_in_every_encoding() {
+    let d = scratch_dir("ply");
+    let header = |format: &str, extra: &str| {
+        format!("ply\nformat {format} 1.0\ncomment a quad\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n{extra}element face 1\nproperty list uchar int vertex_indices\nend_header\n")
+    };
+    let ascii = header(
+        "ascii",
+        "property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n",
+    ) + "0 0 0 0 0 1 0 0\n1 0 0 0 0 1 1 0\n1 1 0 0 0 1 1 1\n0 1 0 0 0 1 0 1\n4 0 1 2 3\n";
+    let toml = "[[mesh]]\nfile = \"q.ply\"\nmaterial = \"grey\"\n[materials.grey]\ntype = \"lambert\"\nkd = [0.5, 0.5, 0.5]\n[[light]]\ntype = \"point\"\nposition = [0, 0, 1]\nintensity = [1, 1, 1]\n";
+    write(&d, "q.ply", &ascii);
+    let s = write(&d, "s.toml", toml);
+    let loaded = load_scene(&s).unwrap();
+    assert_eq!(loaded.scene.p0.len(), 2);
+    assert!(loaded.scene.uv.is_empty() || loaded.scene.uv.len() == 2);
+    assert!(loaded.scene.warnings.is_empty(), "{:?}", loaded.scene.warnings);
+    let mut big = header("binary_big_endian", "").into_bytes();
+    for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]] {
+        p.iter().for_each(|x| big.extend(x.to_be_bytes()));
+    }
+    big.push(4);
+    [0i32, 1, 2, 3].iter().for_each(|i| big.extend(i.to_be_bytes()));
+    write(&d, "q.ply", &big);
+    let (lo, hi) = load_scene(&s).unwrap().scene.mesh_bounds();
+    assert_eq!((lo, hi), (Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0)));
+    for (bad, want) in [
+        (ascii.replace("property float u\n", "property float128 u\n"), "q.ply:11:"),
+        (ascii.replace("4 0 1 2 3", "4 0 1 2 9"), "vertex index 9"),
+        (ascii.replace("0 1 0 0 0 1 0 1\n4 0 1 2 3\n", "0 1 0 0 0 1 0 1\n4 0 1"), "ends early"),
+        (ascii.replace("1 1 0 0 0 1 1 1", "1 nan 0 0 0 1 1 1"), "not finite"),
+        (ascii.replace("1 1 0 0 0 1 1 1", "1 x 0 0 0 1 1 1"), "q.ply:18:"),
+        (ascii.replace("end_header\n", ""), "end_header"),
+    ] {
+        write(&d, "q.ply", &bad);
+        let e = load_scene(&s).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains("q.ply") && e.contains(want), "{want}: {e}");
+    }
+}
+
+/// `[[mesh]]` transforms: scale, rotate and translate equal the matrix they make; a shape takes a
+/// material; a conductor is given by η and k or by name; mistakes are errors naming the field.
+#[test]
+fn toml_transforms_shapes_and_conductors() {
+    let d = scratch_dir("toml-meshes");
+    let load = |body: &str| {
+        load_scene(&write(
+            &d,
+            "s.toml",
+            format!("{body}\n[[light]]\ntype = \"point\"\nposition = [0, 5, 0]\nintensity = [1, 1, 1]\n"),
+        ))
+    };
+    let gold = "[materials.gold]\ntype = \"conductor\"\nmetal = \"Au\"\nroughness = 0.3\n";
+    let a = load(&format!("[[mesh]]\nshape = \"cube\"\nmaterial = \"gold\"\nscale = [1, 2, 3]\nrotate = [0, 0, 1, 90]\ntranslate = [5, 0, 0]\n{gold}")).unwrap();
+    let b = load(&format!("[[mesh]]\nshape = \"cube\"\nmaterial = \"gold\"\nmatrix = [0, -2, 0, 5,  1, 0, 0, 0,  0, 0, 3, 0,  0, 0, 0, 1]\n{gold}")).unwrap();
+    let (lo, hi) = a.scene.mesh_bounds();
+    assert!(
+        (lo - Vec3::new(3.0, -1.0, -3.0)).abs().max_element() < 1e-5
+            && (hi - Vec3::new(7.0, 1.0, 3.0)).abs().max_element() < 1e-5,
+        "{lo} {hi}"
+    );
+    // The same triangles (the BVH may order them differently by a rounding).
+    let corners = |s: &photonwave::scene::Scene| {
+        let mut v: Vec<[i64; 9]> = (0..s.p0.len())
+            .map(|i| {
+                let c = [s.p0[i], s.p1[i], s.p2[i]].map(|p| (p * 1e4).round().as_i64vec3().to_array());
+                std::array::from_fn(|k| c[k / 3][k % 3])
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(corners(&a.scene), corners(&b.scene));
+    let m = &a.scene.materials[a.scene.material[0] as usize];
+    assert!(
+        matches!(m.bsdf, Bsdf::RoughConductor { ks, alpha } if ks.x > 0.9 && ks.z < 0.5 && (alpha - 0.09).abs() < 1e-6),
+        "{m:?}"
+    );
+    let c = load("[[mesh]]\nshape = \"sphere\"\nmaterial = \"m\"\n[materials.m]\ntype = \"conductor\"\neta = [1.5, 1.5, 1.5]\nk = [0, 0, 0]\n").unwrap();
+    assert!(
+        matches!(c.scene.materials[c.scene.material[0] as usize].bsdf, Bsdf::Mirror { ks } if (ks.x - 0.04).abs() < 1e-6)
+    );
+    // A mirroring matrix keeps the front face in front: the rectangle still faces where its
+    // normal is sent.
+    let r = load("[[mesh]]\nshape = \"rectangle\"\nmaterial = \"m\"\nmatrix = [1, 0, 0, 0,  0, 1, 0, 0,  0, 0, -1, 0,  0, 0, 0, 1]\n[materials.m]\ntype = \"lambert\"\nkd = [0.5, 0.5, 0.5]\n").unwrap();
+    assert!(r.scene.ng.iter().all(|n| (*n - Vec3::NEG_Z).length() < 1e-6), "{:?}", r.scene.ng);
+    let grey = load("[[mesh]]\nshape = \"disk\"\n").unwrap();
+    assert!(grey.scene.warnings.iter().any(|w| w.contains("mesh[0] (a disk) names no `material`")));
+    for (body, want) in [
+        ("[[mesh]]\nshape = \"torus\"\n", "unknown shape `torus`"),
+        ("[[mesh]]\nshape = \"cube\"\nmatrix = [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]\nscale = 2\n", "mesh[0].matrix"),
+        ("[[mesh]]\nshape = \"cube\"\nscale = [1, 0, 1]\n", "mesh[0].scale"),
+        ("[[mesh]]\nshape = \"cube\"\nmaterial = \"nope\"\n", "no [materials.nope]"),
+        (
+            "[[mesh]]\nshape = \"cube\"\nmaterial = \"m\"\n[materials.m]\ntype = \"conductor\"\nmetal = \"Xx\"\n",
+            "unknown metal `Xx`",
+        ),
+        ("[[mesh]]\nfile = \"a.stl\"\n", "mesh[0].file"),
+        ("[[mesh]]\nshape = \"cube\"\nfile = \"a.obj\"\n", "not both"),
+    ] {
+        let e = load(body).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains(want), "{want}: {e}");
+    }
+}
