@@ -28,13 +28,14 @@ pub fn scene_files_input(dir: &Path, data: &[u8]) -> Result<(), String> {
 }
 
 /// The cargo-fuzz target `mesh_files`'s input: the first byte picks the format (0: PLY, 1: glTF,
-/// 2: GLB, by its value mod 3), the rest is the file, checked by [`mesh_file`] in `dir`.
+/// 2: GLB, 3: Mitsuba XML, by its value mod 4), the rest is the file, checked by [`mesh_file`]
+/// in `dir`.
 pub fn mesh_files_input(dir: &Path, data: &[u8]) -> Result<(), String> {
     let (kind, body) = data.split_first().unwrap_or((&0, &[]));
-    mesh_file(dir, ["m.ply", "m.gltf", "m.glb"][usize::from(*kind) % 3], body)
+    mesh_file(dir, ["m.ply", "m.gltf", "m.glb", "m.xml"][usize::from(*kind) % 4], body)
 }
 
-/// Writes `bytes` as `dir/name` (a PLY, glTF or GLB file) and loads it alone, lit by a headlight
+/// Writes `bytes` as `dir/name` (a PLY, glTF, GLB or Mitsuba file) and loads it alone, lit by a headlight
 /// (so that a model without lights still renders). An error must be a short, non-empty message;
 /// a model that loads must render a 4×4 image on both engines, finite or an error.
 pub fn mesh_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), String> {

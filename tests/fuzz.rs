@@ -149,8 +149,9 @@ fn mutated_scene_files_load_or_fail_cleanly() {
         .unwrap();
 }
 
-/// 300 mutated models: the ASCII PLY quad and the bundled glTF Cornell box, edited 1–5 times as
-/// text (see [`Edit`]), and the binary PLY and GLB boxes with 1–8 bytes overwritten: each loads,
+/// 400 mutated models: the ASCII PLY quad, the bundled glTF Cornell box and a Mitsuba scene of
+/// built-in shapes, edited 1–5 times as text (see [`Edit`]), and the binary PLY and GLB boxes
+/// with 1–8 bytes overwritten: each loads,
 /// or fails with a short message, and a model that loads renders to a finite image or an error.
 #[test]
 fn mutated_models_load_or_fail_cleanly() {
@@ -163,8 +164,16 @@ end_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n";
     let (ply, glb) =
         (std::fs::read(scenes.join("white.ply")).unwrap(), std::fs::read(scenes.join("cornell-box.glb")).unwrap());
     let bytes = prop::collection::vec((any::<usize>(), any::<u8>()), 1..9);
-    runner(300, 13)
-        .run(&(0u8..4, edits(0, 1), bytes), |(kind, edits, bytes)| {
+    let xml = "<scene version=\"2.0.0\">\n<default name=\"a\" value=\"0.3\"/>\n<sensor type=\"perspective\">\n\
+<float name=\"fov\" value=\"45\"/>\n<transform name=\"to_world\"><lookat origin=\"0, 0, 4\" target=\"0, 0, 0\" up=\"0, 1, 0\"/>\n\
+</transform>\n<film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/></film>\n</sensor>\n\
+<bsdf type=\"roughconductor\" id=\"m\"><float name=\"alpha\" value=\"$a\"/></bsdf>\n\
+<shape type=\"sphere\"><float name=\"radius\" value=\"0.5\"/><ref id=\"m\"/></shape>\n\
+<shape type=\"rectangle\"><transform name=\"to_world\"><rotate x=\"1\" angle=\"90\"/><scale value=\"3\"/>\n\
+<translate y=\"2\"/></transform><bsdf type=\"dielectric\"/><emitter type=\"area\"><rgb name=\"radiance\" value=\"2\"/></emitter></shape>\n\
+<emitter type=\"spot\"><float name=\"cutoff_angle\" value=\"40\"/></emitter>\n</scene>\n";
+    runner(400, 13)
+        .run(&(0u8..5, edits(0, 1), bytes), |(kind, edits, bytes)| {
             let overwrite = |mut data: Vec<u8>| {
                 let n = data.len();
                 bytes.iter().for_each(|&(at, b)| data[at % n] = b);
@@ -174,7 +183,8 @@ end_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n";
                 0 => ("m.ply", apply(ascii, &edits).into_bytes()),
                 1 => ("m.gltf", apply(&gltf, &edits).into_bytes()),
                 2 => ("m.ply", overwrite(ply.clone())),
-                _ => ("m.glb", overwrite(glb.clone())),
+                3 => ("m.glb", overwrite(glb.clone())),
+                _ => ("m.xml", apply(xml, &edits).into_bytes()),
             };
             let result = fuzzing::mesh_file(&dir, name, &data);
             prop_assert!(result.is_ok(), "{result:?}\n--- {name}\n{}", String::from_utf8_lossy(&data));

@@ -360,3 +360,100 @@ fn toml_transforms_shapes_and_conductors() {
         assert!(e.contains(want), "{want}: {e}");
     }
 }
+
+/// The Mitsuba 0.6 Cornell box over the PLY meshes: the same image as the OBJ box, and its
+/// integrator and sampler are warned of with their lines.
+#[test]
+fn the_mitsuba_cornell_box_renders_the_same() {
+    let obj = beauty(load_scene(&bundled("cornell-box.toml")).unwrap());
+    let xml = load_scene(&bundled("interchange/cornell-box.xml")).unwrap();
+    assert_eq!((xml.settings.width, xml.settings.height), (320, 320));
+    let w = xml.scene.warnings.join("\n");
+    assert!(w.contains("cornell-box.xml:5: integrator `path`") && w.contains("cornell-box.xml:12: the sampler"), "{w}");
+    assert_eq!(beauty(xml), obj, "Mitsuba");
+}
+
+/// A Mitsuba 3 scene (snake_case names) of built-in shapes with transforms, `$param` defaults,
+/// named metals and indices, and every emitter kind read; what is not read is warned of with its
+/// line, and mistakes are errors naming file and line.
+#[test]
+fn mitsuba_shapes_materials_emitters_and_errors() {
+    let d = scratch_dir("mitsuba");
+    let scene = |body: &str| {
+        format!("<scene version=\"3.0.0\">\n<default name=\"r\" value=\"0.25\"/>\n<sensor type=\"perspective\">\n\
+<float name=\"fov\" value=\"60\"/>\n<transform name=\"to_world\"><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform>\n\
+<film type=\"hdrfilm\"><integer name=\"width\" value=\"40\"/><integer name=\"height\" value=\"20\"/></film>\n</sensor>\n{body}</scene>\n")
+    };
+    let body = "<bsdf type=\"roughconductor\" id=\"gold\"><string name=\"material\" value=\"Au\"/><float name=\"alpha\" value=\"$r\"/>\
+<string name=\"distribution\" value=\"ggx\"/></bsdf>\n\
+<shape type=\"sphere\"><point name=\"center\" x=\"1\" y=\"2\" z=\"3\"/><float name=\"radius\" value=\"0.5\"/><ref id=\"gold\"/></shape>\n\
+<shape type=\"rectangle\"><transform name=\"to_world\"><scale x=\"2\" y=\"3\"/><rotate x=\"1\" angle=\"-90\"/><translate y=\"-1\"/></transform>\
+<bsdf type=\"twosided\"><bsdf type=\"roughplastic\"><rgb name=\"diffuse_reflectance\" value=\"0.2, 0.3, 0.4\"/><boolean name=\"nonlinear\" value=\"true\"/></bsdf></bsdf></shape>\n\
+<shape type=\"cube\"><bsdf type=\"dielectric\"><string name=\"int_ior\" value=\"water\"/></bsdf>\
+<emitter type=\"area\"><rgb name=\"radiance\" value=\"1, 2, 3\"/></emitter></shape>\n\
+<shape type=\"disk\"><bsdf type=\"hanrahan_krueger\"/></shape>\n\
+<emitter type=\"point\"><point name=\"position\" value=\"0, 4, 0\"/><rgb name=\"intensity\" value=\"5\"/></emitter>\n\
+<emitter type=\"spot\"><transform name=\"to_world\"><lookat origin=\"0, 4, 0\" target=\"0, 0, 0\" up=\"0, 0, 1\"/></transform>\
+<float name=\"cutoff_angle\" value=\"30\"/></emitter>\n\
+<emitter type=\"directional\"><vector name=\"direction\" value=\"0, -1, 0\"/><rgb name=\"irradiance\" value=\"2\"/></emitter>\n\
+<emitter type=\"constant\"><rgb name=\"radiance\" value=\"0.1\"/></emitter>\n\
+<medium type=\"homogeneous\"/>\n";
+    let loaded = load_scene(&write(&d, "s.xml", scene(body))).unwrap();
+    assert_eq!((loaded.settings.width, loaded.settings.height), (40, 20));
+    // fov_axis x: a 60° horizontal field of a 2:1 image is 2·atan(tan 30° / 2) vertically.
+    let cam = loaded.camera.unwrap();
+    assert!((cam.fov_deg - 2.0 * (30f32.to_radians().tan() / 2.0).atan().to_degrees()).abs() < 1e-4);
+    assert_eq!(cam.eye, Vec3::new(0.0, 0.0, 5.0));
+    let s = &loaded.scene;
+    let kinds: Vec<String> = s.materials.iter().map(|m| format!("{:?}", m.bsdf)).collect();
+    assert!(
+        s.materials
+            .iter()
+            .any(|m| matches!(m.bsdf, Bsdf::RoughConductor { ks, alpha } if ks.x > 0.9 && ks.z < 0.5 && alpha == 0.25)),
+        "{kinds:?}"
+    );
+    assert!(
+        s.materials
+            .iter()
+            .any(|m| m.bsdf == Bsdf::RoughPlastic { kd: Vec3::new(0.2, 0.3, 0.4), ior: 1.49 / 1.000277, alpha: 0.1 }),
+        "{kinds:?}"
+    );
+    assert!(
+        s.materials
+            .iter()
+            .any(|m| m.bsdf == Bsdf::Glass { ior: 1.333 / 1.000277 } && m.emission == Vec3::new(1.0, 2.0, 3.0)),
+        "{kinds:?}"
+    );
+    // The sphere: centre (1, 2, 3), radius 0.5. The rectangle: 4 × 6, turned flat at y = −1
+    // (x in [−2, 2], z in [−3, 3]).
+    let (lo, hi) = s.mesh_bounds();
+    assert!((hi - Vec3::new(2.0, 2.5, 3.5)).abs().max_element() < 1e-4, "{hi}");
+    assert!((lo - Vec3::new(-2.0, -1.0, -3.0)).abs().max_element() < 1e-4, "{lo}");
+    let delta: Vec<&Light> =
+        s.lights.iter().filter(|l| !matches!(l, Light::Area { .. } | Light::Environment)).collect();
+    assert!(
+        matches!(delta[0], Light::Point { position, intensity } if *position == Vec3::new(0.0, 4.0, 0.0) && *intensity == Vec3::splat(5.0))
+    );
+    assert!(
+        matches!(delta[1], Light::Spot { direction, cos_outer, .. } if (*direction + Vec3::Y).length() < 1e-6 && (*cos_outer - 30f32.to_radians().cos()).abs() < 1e-6)
+    );
+    assert!(matches!(delta[2], Light::Directional { irradiance, .. } if *irradiance == Vec3::splat(2.0)));
+    assert!(s.environment.is_some());
+    let w = s.warnings.join("\n");
+    assert!(w.contains("s.xml:10: `nonlinear` of <bsdf type=\"roughplastic\"> is not read"), "{w}");
+    assert!(
+        w.contains("s.xml:12: bsdf `hanrahan_krueger` is not read") && w.contains("s.xml:17: <medium> is not read"),
+        "{w}"
+    );
+    for (body, want) in [
+        ("<shape type=\"cube\"><bsdf type=\"conductor\"><string name=\"material\" value=\"Unobtainium\"/></bsdf></shape>\n", "s.xml:8: metal `Unobtainium`"),
+        ("<shape type=\"cube\"><ref id=\"nothing\"/></shape>\n", "names no element"),
+        ("<shape type=\"cube\"><bsdf type=\"diffuse\"><float name=\"reflectance\" value=\"$nope\"/></bsdf></shape>\n", "`$nope` has no value"),
+        ("<shape type=\"ply\"><string name=\"filename\" value=\"missing.ply\"/></shape>\n", "missing.ply"),
+        ("<shape type=\"cube\"><transform name=\"to_world\"><scale value=\"0\"/></transform></shape>\n", "s.xml:8"),
+        ("<shape type=\"cube\">\n", "XML"),
+    ] {
+        let e = load_scene(&write(&d, "s.xml", scene(body))).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains(want), "{want}: {e}");
+    }
+}

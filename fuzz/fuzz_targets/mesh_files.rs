@@ -1,4 +1,4 @@
-//! A PLY, glTF or GLB file (the first byte picks which), loaded alone and rendered small
+//! A PLY, glTF, GLB or Mitsuba file (the first byte picks which), loaded alone and rendered small
 //! (decoded by `photonwave::fuzzing::mesh_files_input`).
 #![no_main]
 

@@ -167,7 +167,7 @@ impl Scene {
         if lights.is_empty() {
             return Err(Error::scene(
                 "the scene has no light: give a material emission (`Ke` in an MTL file, `emissiveFactor` in a glTF \
-                 file, `emission` in a [materials] table), add a [[light]] to the scene file, or light it from the \
+                 file, `emission` in a [materials] table, an area `emitter` in a Mitsuba file), add a [[light]] to the scene file, or light it from the \
                  command line with `--light headlight` or `--light sun`",
             ));
         }

@@ -44,6 +44,7 @@ use super::file_materials::{colour, finite3, MaterialEntry};
 use super::file_meshes::{Brought, MeshEntry};
 use super::image::load_texture;
 use super::light::Light;
+use super::mitsuba::load_mitsuba;
 use super::obj::MaterialTable;
 use super::{bounds_of, MeshInput, Scene};
 use crate::error::{Error, Result};
@@ -243,8 +244,8 @@ impl EnvironmentEntry {
 /// The extensions of mesh files that load as scenes by themselves.
 const MESH_FORMATS: [&str; 4] = ["obj", "ply", "gltf", "glb"];
 
-/// Loads a scene: a `.toml` scene file, or a bare mesh file (OBJ with its MTL files, PLY, glTF
-/// or GLB).
+/// Loads a scene: a `.toml` scene file, a Mitsuba scene file (`.xml`), or a bare mesh file (OBJ
+/// with its MTL files, PLY, glTF or GLB).
 pub fn load_scene(path: &Path) -> Result<LoadedScene> {
     load_scene_lit(path, &|_, _| Vec::new())
 }
@@ -257,6 +258,18 @@ pub type AddedLights<'a> = &'a dyn Fn((Vec3, Vec3), Option<Camera>) -> Vec<Light
 pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
     let bounds = |meshes: &[MeshInput]| bounds_of(meshes.iter().flat_map(|m| m.positions.iter()));
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    if ext == "xml" {
+        let (mut table, mut warnings, mut inputs) = (MaterialTable::default(), Vec::new(), Vec::new());
+        let m = load_mitsuba(path, &mut table, &mut warnings, &mut inputs)?;
+        let mut lights = m.lights;
+        lights.extend(added(bounds(&m.meshes), m.camera));
+        let scene = Scene::build_lit(m.meshes, table.materials, lights, m.environment, warnings)?;
+        let mut settings = Settings::default();
+        if let Some((width, height)) = m.size {
+            (settings.width, settings.height) = (width, height);
+        }
+        return Ok(LoadedScene { scene, camera: m.camera, cameras: Vec::new(), settings, inputs });
+    }
     if MESH_FORMATS.contains(&ext.as_str()) {
         // A bare mesh file: its own camera and lights if it brings them, `added` besides.
         let (mut table, mut warnings, mut inputs, mut brought) =

@@ -10,7 +10,7 @@ use super::camera::Camera;
 use super::file_materials::finite3;
 use super::gltf::load_gltf;
 use super::light::Light;
-use super::obj::{load_obj, MaterialTable};
+use super::obj::{load_obj, MaterialTable, ObjMaterials};
 use super::ply::load_ply;
 use super::shapes::shape;
 use super::transform::Transform;
@@ -156,7 +156,10 @@ impl MeshEntry {
                 let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
                 match ext.as_str() {
                     // A file without an extension is read as OBJ, as before other formats.
-                    "obj" | "" => load_obj(&path, &transform, table, warnings, inputs)?,
+                    "obj" | "" => {
+                        let from = material.map_or(ObjMaterials::Mtl, ObjMaterials::All);
+                        load_obj(&path, &transform, from, table, warnings, inputs)?
+                    }
                     "ply" => {
                         let what = format!("{}, a PLY file, which has no materials", file.display());
                         let m = fallback(&what, table, warnings);

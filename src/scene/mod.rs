@@ -12,6 +12,7 @@ pub mod generated;
 mod gltf;
 pub mod image;
 pub mod light;
+pub mod mitsuba;
 pub mod mtl;
 pub mod obj;
 pub mod open_edges;

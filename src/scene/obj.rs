@@ -176,11 +176,23 @@ fn out_of_range(path: &Path, text: &str, transform: &Transform) -> Error {
 /// MTL files, already read and checked).
 const ALL_MATERIALS: &str = "\u{1}photonwave-materials";
 
-/// Loads an OBJ file (and the MTL files it names) into a mesh; materials go into `table`.
-/// `transform` places it ([`Transform::apply`]). Every file read is added to `inputs`.
+/// Where an OBJ mesh's materials come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ObjMaterials {
+    /// From the MTL files its `mtllib` statements name, by `usemtl`.
+    Mtl,
+    /// Every face is this material of the table (a scene file's `material = "NAME"`, a Mitsuba
+    /// shape's BSDF): the MTL files are not read.
+    All(u32),
+}
+
+/// Loads an OBJ file (and the MTL files it names, unless `materials` says otherwise) into a
+/// mesh; materials go into `table`. `transform` places it ([`Transform::apply`]). Every file
+/// read is added to `inputs`.
 pub fn load_obj(
     path: &Path,
     transform: &Transform,
+    materials: ObjMaterials,
     table: &mut MaterialTable,
     warnings: &mut Vec<String>,
     inputs: &mut Vec<PathBuf>,
@@ -189,8 +201,9 @@ pub fn load_obj(
     inputs.push(path.to_path_buf());
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut mtl: Vec<(PathBuf, MtlMaterial)> = Vec::new();
-    for lib in check_obj(path, &text)? {
-        for file in mtllib_files(dir, &lib) {
+    let libs = check_obj(path, &text)?;
+    for lib in libs.iter().filter(|_| materials == ObjMaterials::Mtl) {
+        for file in mtllib_files(dir, lib) {
             let mtl_path = dir.join(file);
             let mtl_text = read_text(&mtl_path, "a material file (MTL)", MAX_MATERIAL_FILE)
                 .map_err(|e| named_by(e, path, lib.line))?;
@@ -264,8 +277,9 @@ pub fn load_obj(
                 Vec3::ZERO
             });
         }
-        let material = match m.material_id {
-            Some(i) if i < ids.len() => ids[i],
+        let material = match (materials, m.material_id) {
+            (ObjMaterials::All(id), _) => id,
+            (_, Some(i)) if i < ids.len() => ids[i],
             _ => {
                 missing_material = true;
                 table.default_material()

@@ -1,0 +1,272 @@
+//! Mitsuba BSDFs and textures onto photonwave's materials.
+//!
+//! | Mitsuba | photonwave |
+//! |---|---|
+//! | `diffuse` | Lambertian (`reflectance`, a colour or a texture) |
+//! | `twosided` | its inner BSDF (photonwave's opaque materials are two-sided already) |
+//! | `dielectric` | smooth glass of index `int_ior` / `ext_ior` (numbers or Mitsuba's names) |
+//! | `thindielectric` | smooth glass, warned of (a thin sheet does not bend light; glass does) |
+//! | `roughdielectric` | GGX rough dielectric of width `alpha` |
+//! | `conductor`, `roughconductor` | mirror or GGX rough conductor, reflectance from `eta`, `k` or the named `material` ([`crate::optics::METALS`]), times `specular_reflectance` |
+//! | `plastic`, `roughplastic` | rough plastic over `diffuse_reflectance` (a smooth coat as α = 0.01, warned of) |
+//! | `phong` | normalised Phong (`diffuse_reflectance`, `specular_reflectance`, `exponent`) |
+//! | `bumpmap`, `normalmap`, `mask`, `coating`, `roughcoating`, `blendbsdf`, `mixturebsdf` | the (first) inner BSDF, warned of by name |
+//! | anything else | grey Lambertian (0.5), warned of with its line |
+//!
+//! Beckmann and Phong microfacet distributions are rendered as GGX of the same α, anisotropic
+//! `alpha_u`/`alpha_v` as their mean; each is warned of. Textures: `bitmap` (`filename`, sRGB for
+//! colours) and `checkerboard` (`color0`, `color1`, drawn into a 256² image), with `uvscale`,
+//! `uoffset`, `voffset` (0.5) or a `to_uv` scale and translation (3.x), applied to the shape's
+//! texture coordinates.
+
+use super::Ctx;
+use crate::error::Result;
+use crate::material::{Bsdf, Maps, Material};
+use crate::microfacet::MIN_ALPHA;
+use crate::optics::{conductor_f0, named_metal_f0};
+use crate::texture::{Encoding, Texture};
+use glam::{Vec2, Vec3};
+use roxmltree::Node;
+use std::sync::Arc;
+
+/// A texture coordinate scale and offset: uv·scale + offset.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvMap {
+    pub scale: Vec2,
+    pub offset: Vec2,
+}
+
+/// GGX α of a smooth `plastic` coat (photonwave has no smooth coated diffuse).
+const SMOOTH_COAT_ALPHA: f32 = 0.01;
+
+/// Mitsuba's named indices of refraction.
+const IORS: [(&str, f32); 22] = [
+    ("vacuum", 1.0),
+    ("helium", 1.00004),
+    ("hydrogen", 1.00013),
+    ("air", 1.000277),
+    ("carbon dioxide", 1.00045),
+    ("water", 1.333),
+    ("acetone", 1.36),
+    ("ethanol", 1.361),
+    ("carbon tetrachloride", 1.461),
+    ("glycerol", 1.4729),
+    ("benzene", 1.501),
+    ("silicone oil", 1.52045),
+    ("bromine", 1.661),
+    ("water ice", 1.31),
+    ("fused quartz", 1.458),
+    ("pyrex", 1.470),
+    ("acrylic glass", 1.49),
+    ("polypropylene", 1.49),
+    ("bk7", 1.5046),
+    ("sodium chloride", 1.544),
+    ("amber", 1.55),
+    ("diamond", 2.419),
+];
+
+/// A colour property, or a texture in its place, of a BSDF.
+pub(super) struct Coloured {
+    pub value: Vec3,
+    pub map: Option<Arc<Texture>>,
+    pub uv: Option<UvMap>,
+}
+
+impl Ctx<'_> {
+    /// An index of refraction property: a number or one of Mitsuba's names.
+    fn ior(&self, node: Node, name: &str, default: f32) -> Result<f32> {
+        let Some(p) = self.r.prop(node, name) else { return Ok(default) };
+        let v = self.r.attr(p, "value")?.unwrap_or_default();
+        if let Ok(x) = v.trim().parse::<f32>() {
+            return if x.is_finite() && x > 0.0 {
+                Ok(x)
+            } else {
+                Err(self.r.error(p, format!("`{name}` must be positive")))
+            };
+        }
+        IORS.iter().find(|(n, _)| n.eq_ignore_ascii_case(v.trim())).map(|(_, x)| *x).ok_or_else(|| {
+            self.r.error(
+                p,
+                format!(
+                    "`{v}` is not an index of refraction Mitsuba names (e.g. {})",
+                    IORS.map(|x| x.0)[..6].join(", ")
+                ),
+            )
+        })
+    }
+
+    /// A colour property of `node` (a colour element, a nested texture or a `ref` to one), or
+    /// `default`.
+    pub(super) fn coloured(&mut self, node: Node, name: &str, default: Vec3, encoding: Encoding) -> Result<Coloured> {
+        let plain = |value| Coloured { value, map: None, uv: None };
+        let Some(p) = self.r.prop(node, name) else { return Ok(plain(default)) };
+        let p = match p.tag_name().name() {
+            "ref" => self.referenced(p)?,
+            _ => p,
+        };
+        if p.tag_name().name() != "texture" {
+            return Ok(plain(self.r.colour_of(p)?));
+        }
+        let uv = self.uv_map(p)?;
+        let kind = p.attribute("type").unwrap_or("");
+        let map = match kind {
+            "bitmap" => {
+                let file =
+                    self.r.string(p, "filename")?.ok_or_else(|| self.r.error(p, "a bitmap needs a `filename`"))?;
+                self.image(p, &file, encoding)?
+            }
+            "checkerboard" => {
+                let (c0, c1) = (self.r.prop(p, "color0"), self.r.prop(p, "color1"));
+                let c0 = c0.map_or(Ok(Vec3::splat(0.4)), |c| self.r.colour_of(c))?;
+                let c1 = c1.map_or(Ok(Vec3::splat(0.2)), |c| self.r.colour_of(c))?;
+                const N: u32 = 256;
+                let texels = (0..N * N).map(|k| if ((k % N) < N / 2) == ((k / N) < N / 2) { c0 } else { c1 }).collect();
+                Arc::new(Texture::new(self.r.path, N, N, texels).expect("a 256² checkerboard"))
+            }
+            other => {
+                self.warn(p, format!("texture `{other}` is not read: its mean colour 0.5 is used"));
+                return Ok(plain(Vec3::splat(0.5)));
+            }
+        };
+        Ok(Coloured { value: Vec3::ONE, map: Some(map), uv })
+    }
+
+    /// A texture's coordinate scale and offset, `None` for the identity.
+    fn uv_map(&self, t: Node) -> Result<Option<UvMap>> {
+        let us = self.r.float(t, "uscale", 1.0)? * self.r.float(t, "uvscale", 1.0)?;
+        let vs = self.r.float(t, "vscale", 1.0)? * self.r.float(t, "uvscale", 1.0)?;
+        let offset = Vec2::new(self.r.float(t, "uoffset", 0.0)?, self.r.float(t, "voffset", 0.0)?);
+        let to_uv = self.r.transform(t, "to_uv")?;
+        let scale = Vec2::new(us * to_uv.matrix3.x_axis.x, vs * to_uv.matrix3.y_axis.y);
+        let offset = offset + Vec2::new(to_uv.translation.x, to_uv.translation.y);
+        let map = UvMap { scale, offset };
+        Ok((map != UvMap { scale: Vec2::ONE, offset: Vec2::ZERO }).then_some(map))
+    }
+
+    /// A GGX α from `alpha` (or `alpha_u`/`alpha_v`), warning of another distribution.
+    fn alpha(&mut self, node: Node, what: &str) -> Result<f32> {
+        let dist = self.r.string(node, "distribution")?.unwrap_or_else(|| "beckmann".into());
+        let a = if self.r.prop(node, "alpha_u").is_some() {
+            let (u, v) = (self.r.float(node, "alpha_u", 0.1)?, self.r.float(node, "alpha_v", 0.1)?);
+            if u != v {
+                self.warn(
+                    node,
+                    format!("{what}: anisotropic roughness ({u}, {v}) is rendered isotropic, α = {}", 0.5 * (u + v)),
+                );
+            }
+            0.5 * (u + v)
+        } else {
+            self.r.float(node, "alpha", 0.1)?
+        };
+        if dist != "ggx" {
+            self.warn(node, format!("{what}: the {dist} distribution is rendered as GGX of the same α"));
+        }
+        Ok(a.clamp(MIN_ALPHA, 1.0))
+    }
+
+    /// The material of `<bsdf>` element `node`, called `name`, and the texture coordinate map its
+    /// textures want.
+    pub(super) fn bsdf(&mut self, node: Node, name: &str) -> Result<(Material, Option<UvMap>)> {
+        let kind = node.attribute("type").unwrap_or("");
+        let inner = node.children().find(|c| c.is_element() && matches!(c.tag_name().name(), "bsdf" | "ref"));
+        let wrapper = |me: &mut Self, note: Option<&str>| -> Result<(Material, Option<UvMap>)> {
+            if let Some(note) = note {
+                me.warn(node, format!("bsdf `{kind}`: {note}"));
+            }
+            match inner {
+                Some(i) => {
+                    let i = if i.tag_name().name() == "ref" { me.referenced(i)? } else { i };
+                    me.bsdf(i, name)
+                }
+                None => Err(me.r.error(node, format!("bsdf `{kind}` has no inner <bsdf>"))),
+            }
+        };
+        let (bsdf, maps, uv) = match kind {
+            "twosided" => return wrapper(self, None),
+            "bumpmap" | "normalmap" => {
+                return wrapper(self, Some("the bump or normal map is not rendered yet (the shape's normals are used)"))
+            }
+            "mask" => return wrapper(self, Some("the opacity mask is not rendered yet: the surface is opaque")),
+            "coating" | "roughcoating" => return wrapper(self, Some("the coating is not rendered: its base alone is")),
+            "blendbsdf" | "mixturebsdf" => {
+                return wrapper(self, Some("only the first of the blended BSDFs is rendered"))
+            }
+            "diffuse" => {
+                let c = self.coloured(node, "reflectance", Vec3::splat(0.5), Encoding::Srgb)?;
+                (Bsdf::Lambert { kd: c.value.min(Vec3::ONE) }, Maps { kd: c.map, ..Maps::default() }, c.uv)
+            }
+            "dielectric" | "thindielectric" | "roughdielectric" => {
+                let ior = self.ior(node, "int_ior", 1.5046)? / self.ior(node, "ext_ior", 1.000277)?;
+                if kind == "thindielectric" {
+                    self.warn(
+                        node,
+                        "thindielectric is rendered as solid glass (refraction bends rays a thin sheet would not)"
+                            .to_string(),
+                    );
+                }
+                let bsdf = if kind == "roughdielectric" {
+                    Bsdf::RoughDielectric { ior, alpha: self.alpha(node, kind)? }
+                } else {
+                    Bsdf::Glass { ior }
+                };
+                (bsdf, Maps::default(), None)
+            }
+            "conductor" | "roughconductor" => {
+                let metal = self.r.string(node, "material")?.unwrap_or_else(|| {
+                    if self.version < 2 {
+                        "Cu".into()
+                    } else {
+                        "none".into()
+                    }
+                });
+                let f0 = match (self.r.prop(node, "eta"), self.r.prop(node, "k")) {
+                    (Some(e), Some(k)) => conductor_f0(self.r.colour_of(e)?, self.r.colour_of(k)?),
+                    _ => named_metal_f0(&metal).ok_or_else(|| {
+                        let known: Vec<&str> = crate::optics::METALS.iter().map(|m| m.0).collect();
+                        self.r.error(node, format!("metal `{metal}` is not known (known: {}, none)", known.join(", ")))
+                    })?,
+                };
+                let s = self.coloured(node, "specular_reflectance", Vec3::ONE, Encoding::Srgb)?;
+                let ks = (f0 * s.value).min(Vec3::ONE);
+                let maps = Maps { ks: s.map, ..Maps::default() };
+                let bsdf = if kind == "conductor" {
+                    Bsdf::Mirror { ks }
+                } else {
+                    Bsdf::RoughConductor { ks, alpha: self.alpha(node, kind)? }
+                };
+                (bsdf, maps, s.uv)
+            }
+            "plastic" | "roughplastic" => {
+                let ior = self.ior(node, "int_ior", 1.49)? / self.ior(node, "ext_ior", 1.000277)?;
+                let c = self.coloured(node, "diffuse_reflectance", Vec3::splat(0.5), Encoding::Srgb)?;
+                let alpha = if kind == "plastic" {
+                    self.warn(
+                        node,
+                        format!("plastic's smooth coat is rendered as a rough one of α = {SMOOTH_COAT_ALPHA}"),
+                    );
+                    SMOOTH_COAT_ALPHA
+                } else {
+                    self.alpha(node, kind)?
+                };
+                (
+                    Bsdf::RoughPlastic { kd: c.value.min(Vec3::ONE), ior, alpha },
+                    Maps { kd: c.map, ..Maps::default() },
+                    c.uv,
+                )
+            }
+            "phong" => {
+                let kd = self.coloured(node, "diffuse_reflectance", Vec3::splat(0.5), Encoding::Srgb)?;
+                let ks = self.coloured(node, "specular_reflectance", Vec3::splat(0.2), Encoding::Srgb)?;
+                let exponent = self.r.float(node, "exponent", 30.0)?.max(0.0);
+                let sum = (kd.value + ks.value).max_element().max(1.0);
+                let bsdf = Bsdf::Glossy { kd: kd.value / sum, ks: ks.value / sum, exponent };
+                (bsdf, Maps { kd: kd.map, ks: ks.map, ..Maps::default() }, kd.uv.or(ks.uv))
+            }
+            other => {
+                self.warn(node, format!("bsdf `{other}` is not read: it is rendered grey Lambertian (0.5)"));
+                (Bsdf::Lambert { kd: Vec3::splat(0.5) }, Maps::default(), None)
+            }
+        };
+        Ok((Material { name: name.to_string(), bsdf, emission: Vec3::ZERO, maps }, uv))
+    }
+}
