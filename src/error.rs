@@ -24,14 +24,31 @@ pub enum Error {
     Output { path: PathBuf, message: String },
 }
 
+/// The longest parse message kept whole, in bytes.
+pub const MAX_MESSAGE: usize = 400;
+
+/// `message` cut at a character boundary below [`MAX_MESSAGE`] bytes, with "…" where it was cut.
+fn shortened(mut message: String) -> String {
+    if message.len() > MAX_MESSAGE {
+        let mut end = MAX_MESSAGE;
+        while !message.is_char_boundary(end) {
+            end -= 1;
+        }
+        message.truncate(end);
+        message.push('…');
+    }
+    message
+}
+
 impl Error {
     /// An I/O error on `path`.
     pub fn io(path: &Path, err: impl fmt::Display) -> Self {
         Error::Io { path: path.to_path_buf(), message: err.to_string() }
     }
-    /// A parse error at `line` (1-based) of `path`.
+    /// A parse error at `line` (1-based) of `path`. A message that quotes a long line of the
+    /// file is cut to [`MAX_MESSAGE`] bytes: the file and line say where the rest is.
     pub fn parse(path: &Path, line: usize, message: impl Into<String>) -> Self {
-        Error::Parse { path: path.to_path_buf(), line, message: message.into() }
+        Error::Parse { path: path.to_path_buf(), line, message: shortened(message.into()) }
     }
     /// A scene-level error.
     pub fn scene(message: impl Into<String>) -> Self {

@@ -250,6 +250,23 @@ fn gltf_bad_files_are_errors_naming_the_element() {
     let e = load_doc(&d, &doc).err().unwrap().to_string();
     assert!(e.contains("accessor 0") && e.contains("past the end"), "{e}");
 
+    // What the crate's document model would unwrap or loop on (found in review): an image
+    // without a source, a camera without its projection, a node reached twice.
+    for (edit, want) in [
+        (json!({"images": [{}], "textures": [{"source": 0}]}), "images[0]"),
+        (
+            json!({"cameras": [{"type": "perspective", "orthographic": {"xmag": 1, "ymag": 1, "zfar": 2, "znear": 1}}]}),
+            "cameras[0]",
+        ),
+        (json!({"nodes": [{"children": [1, 1]}, {"mesh": 0}]}), "reached twice"),
+    ] {
+        let e = load_doc(&d, &gltf_doc(node.clone(), lambert.clone(), edit))
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("m.gltf") && e.contains(want), "{want}: {e}");
+    }
+
     let e = load_scene(&write(&d, "cut.glb", b"glTF\x02\0\0\0\xff\0\0\0")).err().unwrap().to_string();
     assert!(e.contains("cut.glb") && e.contains("GLB"), "{e}");
 }
@@ -282,6 +299,12 @@ fn ply_meshes_in_every_encoding() {
     write(&d, "q.ply", &big);
     let (lo, hi) = load_scene(&s).unwrap().scene.mesh_bounds();
     assert_eq!((lo, hi), (Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0)));
+    // Two vertex elements, only the second with normals: the column is padded (found in review).
+    let split = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n\
+element vertex 2\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\n\
+element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n";
+    write(&d, "q.ply", split);
+    assert_eq!(load_scene(&s).unwrap().scene.p0.len(), 1);
     for (bad, want) in [
         (ascii.replace("property float u\n", "property float128 u\n"), "q.ply:11:"),
         (ascii.replace("4 0 1 2 3", "4 0 1 2 9"), "vertex index 9"),
@@ -452,6 +475,9 @@ fn mitsuba_shapes_materials_emitters_and_errors() {
         ("<shape type=\"ply\"><string name=\"filename\" value=\"missing.ply\"/></shape>\n", "missing.ply"),
         ("<shape type=\"cube\"><transform name=\"to_world\"><scale value=\"0\"/></transform></shape>\n", "s.xml:8"),
         ("<shape type=\"cube\">\n", "XML"),
+        // Found in review: a wrapper that names itself, a negative colour.
+        ("<bsdf type=\"twosided\" id=\"w\"><ref id=\"w\"/></bsdf><shape type=\"cube\"><ref id=\"w\"/></shape>\n", "nest more than 16"),
+        ("<shape type=\"cube\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"-1\"/></bsdf></shape>\n", "not negative"),
     ] {
         let e = load_scene(&write(&d, "s.xml", scene(body))).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(e.contains(want), "{want}: {e}");

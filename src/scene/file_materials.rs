@@ -165,7 +165,7 @@ impl MaterialEntry {
                 if !(ior > 0.0 && ior.is_finite() && outside_ior > 0.0 && outside_ior.is_finite()) {
                     return Err(Error::setting(f("ior"), "`ior` and `outside_ior` must be positive numbers"));
                 }
-                (Bsdf::RoughDielectric { ior: ior / outside_ior, alpha }, emission)
+                (Bsdf::RoughDielectric { ior: finite_ratio(&f("ior"), ior / outside_ior)?, alpha }, emission)
             }
             MaterialEntry::Conductor { eta, k, ref metal, roughness, emission } => {
                 let ks = match (eta, k, metal) {
@@ -198,7 +198,7 @@ impl MaterialEntry {
                 if !(outside_ior > 0.0 && outside_ior.is_finite()) {
                     return Err(Error::setting(f("outside_ior"), "must be a positive number"));
                 }
-                (Bsdf::Glass { ior: ior / outside_ior }, emission)
+                (Bsdf::Glass { ior: finite_ratio(&f("ior"), ior / outside_ior)? }, emission)
             }
         };
         let emission = match emission {
@@ -211,4 +211,13 @@ impl MaterialEntry {
 
 fn one() -> f32 {
     1.0
+}
+
+/// `ior / outside_ior`, refused unless finite and positive (1e30 / 1e-30 is not).
+fn finite_ratio(field: &str, ratio: f32) -> Result<f32> {
+    if ratio.is_finite() && ratio > 0.0 {
+        Ok(ratio)
+    } else {
+        Err(Error::setting(field, format!("ior / outside_ior = {ratio} must be a finite positive ratio")))
+    }
 }

@@ -298,16 +298,27 @@ pub fn load_ply(
                 }
                 mesh.positions.push(p);
                 let n = get(nxyz);
+                // A column starts with the first vertex element that has it: pad what came before.
+                let before = mesh.positions.len() - 1;
                 if has_normals {
+                    mesh.normals.resize(before, Vec3::ZERO);
                     mesh.zero_normals += u64::from(n.try_normalize().is_none());
                     mesh.normals.push(if n.try_normalize().is_some() { n } else { Vec3::ZERO });
                 }
                 if has_uv {
                     let t = Vec2::new(values[uv[0].unwrap_or(0)] as f32, values[uv[1].unwrap_or(0)] as f32);
+                    mesh.texcoords.resize(before, Vec2::ZERO);
                     mesh.texcoords.push(if t.is_finite() { t } else { Vec2::ZERO });
                 }
             }
         }
+    }
+    // A later vertex element may lack a column an earlier one had.
+    if !mesh.normals.is_empty() {
+        mesh.normals.resize(mesh.positions.len(), Vec3::ZERO);
+    }
+    if !mesh.texcoords.is_empty() {
+        mesh.texcoords.resize(mesh.positions.len(), Vec2::ZERO);
     }
     if skipped_faces > 0 {
         warnings.push(format!("{}: {skipped_faces} faces with fewer than 3 vertices were skipped", path.display()));

@@ -43,6 +43,9 @@ pub const REQUIRED_READ: [&str; 6] = [
 /// Nodes deeper than this are a cycle or a hostile file.
 const MAX_DEPTH: usize = 256;
 
+/// The most vertices a model may place (instances counted): 2²⁸, within the u32 indices.
+const MAX_VERTICES: usize = 1 << 28;
+
 /// 1 W at 555 nm is 683 lm: candela to W/sr, lux to W/m².
 const LUMENS_PER_WATT: f32 = 683.0;
 
@@ -184,6 +187,30 @@ pub fn load_gltf(
             ));
         }
     }
+    // What the crate's document model would unwrap, checked here first: an image has a `uri` or a
+    // `bufferView` (with a `mimeType`), and a camera has the projection its `type` names.
+    for (i, image) in root.images.iter().enumerate() {
+        if image.uri.is_some() == image.buffer_view.is_some()
+            || (image.buffer_view.is_some() && image.mime_type.is_none())
+        {
+            return Err(Error::parse(
+                path,
+                0,
+                format!("images[{i}] needs a `uri`, or a `bufferView` and a `mimeType`"),
+            ));
+        }
+    }
+    for (i, camera) in root.cameras.iter().enumerate() {
+        use gltf::json::camera::Type;
+        let ok = match camera.type_ {
+            gltf::json::validation::Checked::Valid(Type::Perspective) => camera.perspective.is_some(),
+            gltf::json::validation::Checked::Valid(Type::Orthographic) => camera.orthographic.is_some(),
+            _ => true,
+        };
+        if !ok {
+            return Err(Error::parse(path, 0, format!("cameras[{i}] lacks the projection its `type` names")));
+        }
+    }
     // gltf-json's validator indexes the POSITION accessor unchecked: checked here first.
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
@@ -231,8 +258,15 @@ pub fn load_gltf(
         src.buffers.push(bytes);
     }
     let mut ids = Vec::new();
+    let mut names = std::collections::HashSet::new();
     for m in doc.materials() {
-        let name = m.name().map_or_else(|| format!("material {}", m.index().unwrap_or(0)), str::to_string);
+        let index = m.index().unwrap_or(0);
+        let mut name = m.name().map_or_else(|| format!("material {index}"), str::to_string);
+        // Names need not be unique in glTF; in the material table they must.
+        if !names.insert(name.clone()) {
+            name = format!("{name} (material {index})");
+            names.insert(name.clone());
+        }
         ids.push((materials::convert(&m, &name, &mut src, warnings)?, None));
     }
     let mut model = Model {
@@ -250,12 +284,18 @@ pub fn load_gltf(
     };
     let mut stack: Vec<(gltf::Node, Affine3A, usize)> = roots.into_iter().rev().map(|n| (n, transform.0, 0)).collect();
     let mut missing_material = false;
+    // The nodes form a forest (glTF 2.0, 5.25): a node reached twice is a cycle or a shared
+    // child, either of which could multiply the work without bound.
+    let mut reached = vec![false; doc.nodes().len()];
     while let Some((node, parent, depth)) = stack.pop() {
-        if depth > MAX_DEPTH {
+        if depth > MAX_DEPTH || std::mem::replace(&mut reached[node.index()], true) {
             return Err(Error::parse(
                 path,
                 0,
-                format!("node {} lies {MAX_DEPTH} levels deep: the hierarchy has a cycle", node.index()),
+                format!(
+                    "node {} is reached twice or lies {MAX_DEPTH} levels deep: the hierarchy must be a forest",
+                    node.index()
+                ),
             ));
         }
         let local = Affine3A::from_mat4(Mat4::from_cols_array_2d(&node.transform().matrix()));
@@ -316,6 +356,13 @@ pub fn load_gltf(
             };
             let uv = prim.material().index().and_then(|i| ids[i].0.uv);
             if let Some(mut part) = primitive(&prim, &src, &what, material, uv, warnings)? {
+                if model.mesh.positions.len() + part.positions.len() > MAX_VERTICES {
+                    return Err(Error::parse(
+                        path,
+                        0,
+                        format!("{what}: the model's meshes, as its nodes place them, exceed 2²⁸ vertices"),
+                    ));
+                }
                 place.apply(&mut part);
                 append(&mut model.mesh, part);
             }
@@ -351,11 +398,18 @@ fn punctual(
         ));
     }
     let position = world.transform_point3(Vec3::ZERO);
-    let direction = world.transform_vector3(-Vec3::Z).try_normalize()?;
+    let mut direction = || {
+        let d = world.transform_vector3(-Vec3::Z).try_normalize();
+        if d.is_none() {
+            warnings.push(format!("{}: {label}'s light is scaled to no direction; it is skipped", path.display()));
+        }
+        d
+    };
     Some(match light.kind() {
         Kind::Point => Light::Point { position, intensity: power },
-        Kind::Directional => Light::Directional { direction, irradiance: power },
+        Kind::Directional => Light::Directional { direction: direction()?, irradiance: power },
         Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+            let direction = direction()?;
             let outer = outer_cone_angle.clamp(1e-3, std::f32::consts::FRAC_PI_2);
             let inner = inner_cone_angle.clamp(0.0, outer);
             Light::Spot { position, direction, intensity: power, cos_inner: inner.cos(), cos_outer: outer.cos() }

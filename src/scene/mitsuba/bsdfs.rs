@@ -36,6 +36,9 @@ pub struct UvMap {
     pub offset: Vec2,
 }
 
+/// How deep wrappers (`twosided`, `mask`, …) may nest.
+const MAX_NESTING: usize = 16;
+
 /// GGX α of a smooth `plastic` coat (photonwave has no smooth coated diffuse).
 const SMOOTH_COAT_ALPHA: f32 = 0.01;
 
@@ -74,6 +77,16 @@ pub(super) struct Coloured {
 
 impl Ctx<'_> {
     /// An index of refraction property: a number or one of Mitsuba's names.
+    /// `int_ior` / `ext_ior` of `node`, refused unless a finite positive ratio.
+    fn ior_ratio(&self, node: Node, int_default: f32) -> Result<f32> {
+        let ratio = self.ior(node, "int_ior", int_default)? / self.ior(node, "ext_ior", 1.000277)?;
+        if ratio.is_finite() && ratio > 0.0 {
+            Ok(ratio)
+        } else {
+            Err(self.r.error(node, format!("int_ior / ext_ior = {ratio} is not a finite positive ratio")))
+        }
+    }
+
     fn ior(&self, node: Node, name: &str, default: f32) -> Result<f32> {
         let Some(p) = self.r.prop(node, name) else { return Ok(default) };
         let v = self.r.attr(p, "value")?.unwrap_or_default();
@@ -168,6 +181,12 @@ impl Ctx<'_> {
     /// textures want.
     pub(super) fn bsdf(&mut self, node: Node, name: &str) -> Result<(Material, Option<UvMap>)> {
         let kind = node.attribute("type").unwrap_or("");
+        if self.depth > MAX_NESTING {
+            return Err(self.r.error(
+                node,
+                format!("BSDFs nest more than {MAX_NESTING} deep (a <ref> that names its own wrapper?)"),
+            ));
+        }
         let inner = node.children().find(|c| c.is_element() && matches!(c.tag_name().name(), "bsdf" | "ref"));
         let wrapper = |me: &mut Self, note: Option<&str>| -> Result<(Material, Option<UvMap>)> {
             if let Some(note) = note {
@@ -176,7 +195,10 @@ impl Ctx<'_> {
             match inner {
                 Some(i) => {
                     let i = if i.tag_name().name() == "ref" { me.referenced(i)? } else { i };
-                    me.bsdf(i, name)
+                    me.depth += 1;
+                    let inner = me.bsdf(i, name);
+                    me.depth -= 1;
+                    inner
                 }
                 None => Err(me.r.error(node, format!("bsdf `{kind}` has no inner <bsdf>"))),
             }
@@ -196,7 +218,7 @@ impl Ctx<'_> {
                 (Bsdf::Lambert { kd: c.value.min(Vec3::ONE) }, Maps { kd: c.map, ..Maps::default() }, c.uv)
             }
             "dielectric" | "thindielectric" | "roughdielectric" => {
-                let ior = self.ior(node, "int_ior", 1.5046)? / self.ior(node, "ext_ior", 1.000277)?;
+                let ior = self.ior_ratio(node, 1.5046)?;
                 if kind == "thindielectric" {
                     self.warn(
                         node,
@@ -237,7 +259,7 @@ impl Ctx<'_> {
                 (bsdf, maps, s.uv)
             }
             "plastic" | "roughplastic" => {
-                let ior = self.ior(node, "int_ior", 1.49)? / self.ior(node, "ext_ior", 1.000277)?;
+                let ior = self.ior_ratio(node, 1.49)?;
                 let c = self.coloured(node, "diffuse_reflectance", Vec3::splat(0.5), Encoding::Srgb)?;
                 let alpha = if kind == "plastic" {
                     self.warn(

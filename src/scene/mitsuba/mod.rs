@@ -60,6 +60,8 @@ pub(super) struct Ctx<'a> {
     inputs: &'a mut Vec<PathBuf>,
     images: HashMap<(PathBuf, Encoding), Arc<Texture>>,
     materials: HashMap<NodeId, (u32, Option<UvMap>)>,
+    /// How deep the BSDF being read is nested in wrappers.
+    depth: usize,
 }
 
 impl<'a> Ctx<'a> {
@@ -98,14 +100,17 @@ impl<'a> Ctx<'a> {
         if let Some(m) = self.materials.get(&node.id()) {
             return Ok(*m);
         }
-        let name = node.attribute("id").map_or_else(|| format!("bsdf at line {}", self.r.line(node)), str::to_string);
+        let pos = self.r.doc.text_pos_at(node.range().start);
+        let name = node
+            .attribute("id")
+            .map_or_else(|| format!("bsdf at line {}, column {}", pos.row, pos.col), str::to_string);
         let (material, uv) = self.bsdf(node, &name)?;
         let id = self.table.insert(self.r.path, material, self.warnings);
         self.materials.insert(node.id(), (id, uv));
         Ok((id, uv))
     }
 
-    /// The mesh of `<shape>` element `node`; its area emitter's radiance is returned apart.
+    /// The mesh of `<shape>` element `node` (its area emitter makes its material emit).
     fn shape(&mut self, node: Node<'a, 'a>) -> Result<Option<MeshInput>> {
         let kind = node.attribute("type").unwrap_or("");
         let to_world = Transform::checked(
@@ -145,7 +150,8 @@ impl<'a> Ctx<'a> {
                 let radiance =
                     self.r.prop(e, "radiance").map_or(Ok(Vec3::ONE), |p| self.r.colour_of(p))?.max(Vec3::ZERO);
                 let mut lit = self.table.materials[material as usize].clone();
-                lit.name = format!("{} (area light, line {})", lit.name, self.r.line(e));
+                let pos = self.r.doc.text_pos_at(e.range().start);
+                lit.name = format!("{} (area light at line {}, column {})", lit.name, pos.row, pos.col);
                 lit.emission = radiance;
                 material = self.table.insert(self.r.path, lit, self.warnings);
             }
@@ -212,6 +218,9 @@ impl<'a> Ctx<'a> {
             me.r.prop(node, name).map_or(Ok(Vec3::ONE), |p| me.r.colour_of(p)).map(|c| c.max(Vec3::ZERO))
         };
         let scale = self.r.float(node, "scale", 1.0)?;
+        if scale < 0.0 {
+            return Err(self.r.error(node, "an emitter's `scale` must not be negative"));
+        }
         match kind {
             "point" => {
                 let position = self.r.point(node, "position")?.unwrap_or(to_world.transform_point3(Vec3::ZERO));
@@ -341,7 +350,9 @@ pub fn load_mitsuba(
 ) -> Result<MitsubaScene> {
     let text = read_text(path, "a Mitsuba scene file", MAX_SCENE_FILE)?;
     inputs.push(path.to_path_buf());
-    let options = roxmltree::ParsingOptions { allow_dtd: true, ..Default::default() };
+    // No DTD: entity expansion would let a small file grow without bound, and Mitsuba scenes
+    // have none.
+    let options = roxmltree::ParsingOptions { allow_dtd: false, ..Default::default() };
     let doc = roxmltree::Document::parse_with_options(&text, options)
         .map_err(|e| Error::parse(path, e.pos().row as usize, format!("XML: {e}")))?;
     let root = doc.root_element();
@@ -362,7 +373,8 @@ pub fn load_mitsuba(
         .filter_map(|n| n.attribute("id").map(|id| (id.to_string(), n)))
         .collect();
     let r = Reader { path, doc: &doc, params, read: Default::default(), visited: Default::default() };
-    let mut cx = Ctx { r, version, ids, table, warnings, inputs, images: HashMap::new(), materials: HashMap::new() };
+    let mut cx =
+        Ctx { r, version, ids, table, warnings, inputs, images: HashMap::new(), materials: HashMap::new(), depth: 0 };
     let mut scene =
         MitsubaScene { meshes: Vec::new(), lights: Vec::new(), environment: None, camera: None, size: None };
     for node in root.children().filter(Node::is_element) {

@@ -178,10 +178,10 @@ impl Reader<'_> {
             "float" | "integer" => Vec3::splat(self.number(p, "value")?.unwrap_or(0.0)),
             other => return Err(self.error(p, format!("<{other}> is not a colour"))),
         };
-        if v.is_finite() {
+        if v.is_finite() && v.min_element() >= 0.0 {
             Ok(v)
         } else {
-            Err(self.error(p, "the colour must be finite"))
+            Err(self.error(p, format!("the colour {v} must be finite and not negative")))
         }
     }
 
