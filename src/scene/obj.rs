@@ -78,21 +78,13 @@ impl MaterialTable {
         let dir = mtl_path.parent().unwrap_or(Path::new("."));
         let mut load = |key: &str, encoding: Encoding| -> Result<Option<Arc<Texture>>> {
             let Some(st) = m.map(key) else { return Ok(None) };
-            let path = dir.join(&st.file);
-            let cache_key = (path.clone(), encoding);
-            if let Some(t) = self.textures.get(&cache_key) {
-                return Ok(Some(t.clone()));
-            }
             let what = format!("a `{key}` texture");
-            let texture = load_texture(&path, encoding, &what).map_err(|e| {
+            let texture = self.texture(&dir.join(&st.file), encoding, &what, inputs).map_err(|e| {
                 named_by_statement(
                     e,
                     &format!("`{key}` of material `{}` at {}:{}", m.name, mtl_path.display(), st.line),
                 )
             })?;
-            inputs.push(path);
-            let texture = Arc::new(texture);
-            self.textures.insert(cache_key, texture.clone());
             Ok(Some(texture))
         };
         Ok(Maps {
@@ -102,6 +94,25 @@ impl MaterialTable {
             ke: load("map_Ke", Encoding::Srgb)?,
             metallic: load("map_Pm", Encoding::Linear)?,
         })
+    }
+
+    /// The image at `path` decoded with `encoding`, read once per scene (`what` names its use in
+    /// messages); the file is added to `inputs` when read.
+    pub fn texture(
+        &mut self,
+        path: &Path,
+        encoding: Encoding,
+        what: &str,
+        inputs: &mut Vec<PathBuf>,
+    ) -> Result<Arc<Texture>> {
+        let key = (path.to_path_buf(), encoding);
+        if let Some(t) = self.textures.get(&key) {
+            return Ok(t.clone());
+        }
+        let texture = Arc::new(load_texture(path, encoding, what)?);
+        inputs.push(path.to_path_buf());
+        self.textures.insert(key, texture.clone());
+        Ok(texture)
     }
 
     /// Index of the grey Lambertian used for faces without a material.

@@ -58,7 +58,6 @@ pub(super) struct Ctx<'a> {
     table: &'a mut MaterialTable,
     warnings: &'a mut Vec<String>,
     inputs: &'a mut Vec<PathBuf>,
-    images: HashMap<(PathBuf, Encoding), Arc<Texture>>,
     materials: HashMap<NodeId, (u32, Option<UvMap>)>,
     /// How deep the BSDF being read is nested in wrappers.
     depth: usize,
@@ -83,15 +82,8 @@ impl<'a> Ctx<'a> {
 
     /// The image `file` (read once per encoding), named by `node` in errors.
     fn image(&mut self, node: Node, file: &str, encoding: Encoding) -> Result<Arc<Texture>> {
-        let path = self.file(file);
-        if let Some(t) = self.images.get(&(path.clone(), encoding)) {
-            return Ok(t.clone());
-        }
         let what = format!("the texture at {}:{}", self.r.path.display(), self.r.line(node));
-        let t = Arc::new(super::image::load_texture(&path, encoding, &what)?);
-        self.inputs.push(path.clone());
-        self.images.insert((path, encoding), t.clone());
-        Ok(t)
+        self.table.texture(&self.file(file), encoding, &what, self.inputs)
     }
 
     /// The table index of the material of `<bsdf>` element `node` (converted once).
@@ -170,7 +162,6 @@ impl<'a> Ctx<'a> {
                 } else {
                     load_ply(&path, material, self.warnings, self.inputs)?
                 };
-                mesh.material.fill(material);
                 if self.r.boolean(node, "face_normals", false)? {
                     mesh.normals.clear();
                 }
@@ -373,8 +364,7 @@ pub fn load_mitsuba(
         .filter_map(|n| n.attribute("id").map(|id| (id.to_string(), n)))
         .collect();
     let r = Reader { path, doc: &doc, params, read: Default::default(), visited: Default::default() };
-    let mut cx =
-        Ctx { r, version, ids, table, warnings, inputs, images: HashMap::new(), materials: HashMap::new(), depth: 0 };
+    let mut cx = Ctx { r, version, ids, table, warnings, inputs, materials: HashMap::new(), depth: 0 };
     let mut scene =
         MitsubaScene { meshes: Vec::new(), lights: Vec::new(), environment: None, camera: None, size: None };
     for node in root.children().filter(Node::is_element) {
