@@ -61,7 +61,9 @@ pub fn mesh_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), String> {
         gather_rays: 2,
         ..loaded.settings
     };
-    let camera = loaded.camera.unwrap_or_else(|| crate::scene::file::fitted_camera(&loaded.scene, 40.0, 1.0));
+    let camera = loaded
+        .camera
+        .unwrap_or_else(|| crate::scene::file::fitted_camera(&loaded.scene, crate::scene::camera::DEFAULT_FOV, 1.0));
     let Ok(rays) = camera.prepare(s.width, s.height) else { return Ok(()) };
     renders_finite(loaded.scene, &rays, &s).map_err(|e| format!("{name}, {e}"))
 }

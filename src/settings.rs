@@ -314,15 +314,18 @@ impl Overrides {
     }
 }
 
+/// The largest image width or height a render takes, in pixels.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
 impl Settings {
     /// Rejects values that make no sense, naming the field.
     pub fn validate(&self) -> Result<()> {
         let err = |f: &str, m: &str| Err(Error::setting(f, m));
-        if !(1..=16384).contains(&self.width) {
-            return err("width", "must be between 1 and 16384");
+        if !(1..=MAX_IMAGE_SIDE).contains(&self.width) {
+            return err("width", &format!("must be between 1 and {MAX_IMAGE_SIDE}"));
         }
-        if !(1..=16384).contains(&self.height) {
-            return err("height", "must be between 1 and 16384");
+        if !(1..=MAX_IMAGE_SIDE).contains(&self.height) {
+            return err("height", &format!("must be between 1 and {MAX_IMAGE_SIDE}"));
         }
         if !(1..=65536).contains(&self.spp) {
             return err("spp", "must be between 1 and 65536");

@@ -80,6 +80,23 @@ fn malformed_mtl_names_the_line() {
     assert!(err(&d.join("a.obj")).contains("before any `newmtl`"));
 }
 
+/// A `[camera]` without `fov` takes the default users expect (40°, as for a scene without a
+/// camera) instead of an error (issue 53); `up` defaults to +y.
+#[test]
+fn a_camera_without_fov_takes_the_default() {
+    let d = scratch_dir("fov");
+    write(&d, "m.mtl", MTL);
+    write(&d, "a.obj", OBJ);
+    let s = write(&d, "s.toml", "[[mesh]]\nfile = \"a.obj\"\n[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n");
+    let camera = load_scene(&s).unwrap().camera.unwrap();
+    assert_eq!(camera.fov_deg, photonwave::scene::camera::DEFAULT_FOV);
+    assert_eq!(camera.fov_deg, 40.0);
+    assert_eq!(camera.up, glam::Vec3::Y);
+    let s =
+        write(&d, "t.toml", "[[mesh]]\nfile = \"a.obj\"\n[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nfov = 25\n");
+    assert_eq!(load_scene(&s).unwrap().camera.unwrap().fov_deg, 25.0);
+}
+
 #[test]
 fn malformed_scene_files_name_the_line_or_field() {
     let d = scratch_dir("toml");

@@ -240,6 +240,21 @@ fn gltf_bad_files_are_errors_naming_the_element() {
     let e = load_doc(&d, &doc).err().unwrap().to_string();
     assert!(e.contains("m.gltf") && e.contains("POSITION"), "{e}");
 
+    // glTF 1.0 is another schema: refused by name, whether or not its fields fit 2.0's (issue
+    // 53: a 2.0 layout labelled "1.0" rendered silently).
+    for (asset, want) in [
+        (json!({"version": "1.0"}), "asset.version is \"1.0\""),
+        (json!({"version": "2.0", "minVersion": "3.0"}), "asset.minVersion is \"3.0\""),
+    ] {
+        doc = gltf_doc(node.clone(), lambert.clone(), json!({}));
+        doc["asset"] = asset;
+        let e = load_doc(&d, &doc).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains("m.gltf") && e.contains(want) && e.contains("glTF 2.0"), "{want}: {e}");
+    }
+    let v1 = json!({"asset": {"version": "1.0"}, "meshes": {"box": {"primitives": []}}, "scene": "main"});
+    let e = load_doc(&d, &v1).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(e.contains("asset.version is \"1.0\""), "{e}");
+
     doc = gltf_doc(node.clone(), lambert.clone(), json!({}));
     doc["bufferViews"][0]["byteStride"] = json!(8);
     let e = load_doc(&d, &doc).err().unwrap().to_string();
@@ -283,6 +298,29 @@ fn ply_meshes_in_every_encoding() {
         "ascii",
         "property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n",
     ) + "0 0 0 0 0 1 0 0\n1 0 0 0 0 1 1 0\n1 1 0 0 0 1 1 1\n0 1 0 0 0 1 0 1\n4 0 1 2 3\n";
+    // The columns themselves, as read: texture coordinates and normals that differ per vertex
+    // (normals all equal to the face's would not show a dropped column).
+    let columns = header(
+        "ascii",
+        "property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n",
+    )
+        + "0 0 0 0 0 1 0.25 0.5\n1 0 0 0 0.6 0.8 0.75 0\n1 1 0 0.6 0 0.8 1 1\n0 1 0 0 0 2 0 0.125\n4 0 1 2 3\n";
+    let mesh = photonwave::scene::ply::load_ply(&write(&d, "c.ply", &columns), 0, &mut vec![], &mut vec![]).unwrap();
+    let uv = [[0.25, 0.5], [0.75, 0.0], [1.0, 1.0], [0.0, 0.125]].map(Vec2::from_array);
+    assert_eq!(mesh.texcoords, uv);
+    let normals = [[0.0, 0.0, 1.0], [0.0, 0.6, 0.8], [0.6, 0.0, 0.8], [0.0, 0.0, 2.0]].map(Vec3::from_array);
+    assert_eq!(mesh.normals, normals);
+    assert_eq!(mesh.triangles, [[0, 1, 2], [0, 2, 3]]);
+    // A second vertex element without the columns the first had: its vertices get zeros, not
+    // their x as both u and v (found in review, issue 53).
+    let lacking = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n\
+property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n\
+element vertex 1\nproperty float x\nproperty float y\nproperty float z\n\
+element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+0 0 0 0 0 1 0.5 0.5\n1 0 0 0 0 1 0.25 0.25\n0.75 1 0\n3 0 1 2\n";
+    let mesh = photonwave::scene::ply::load_ply(&write(&d, "l.ply", lacking), 0, &mut vec![], &mut vec![]).unwrap();
+    assert_eq!(mesh.texcoords, [Vec2::splat(0.5), Vec2::splat(0.25), Vec2::ZERO]);
+    assert_eq!(mesh.normals, [Vec3::Z, Vec3::Z, Vec3::ZERO]);
     let toml = "[[mesh]]\nfile = \"q.ply\"\nmaterial = \"grey\"\n[materials.grey]\ntype = \"lambert\"\nkd = [0.5, 0.5, 0.5]\n[[light]]\ntype = \"point\"\nposition = [0, 0, 1]\nintensity = [1, 1, 1]\n";
     write(&d, "q.ply", &ascii);
     let s = write(&d, "s.toml", toml);
@@ -481,5 +519,17 @@ fn mitsuba_shapes_materials_emitters_and_errors() {
     ] {
         let e = load_scene(&write(&d, "s.xml", scene(body))).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(e.contains(want), "{want}: {e}");
+    }
+    // A film the settings would refuse is refused at its own line, naming the file (issue 53:
+    // 4 000 000 000² was "setting `width`: must be between 1 and 16384", naming neither).
+    for (film, want) in [
+        ("<integer name=\"width\" value=\"4000000000\"/>", "s.xml:6: the film's `width` is 4000000000"),
+        ("<integer name=\"height\" value=\"0\"/>", "s.xml:6: the film's `height` is 0"),
+        ("<float name=\"width\" value=\"12.5\"/>", "s.xml:6: the film's `width` is 12.5"),
+    ] {
+        let xml =
+            scene("").replace("<integer name=\"width\" value=\"40\"/><integer name=\"height\" value=\"20\"/>", film);
+        let e = load_scene(&write(&d, "s.xml", xml)).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains(want) && e.contains("16384"), "{want}: {e}");
     }
 }

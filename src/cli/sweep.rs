@@ -83,7 +83,9 @@ pub fn run(args: SweepArgs) -> Result<()> {
     std::fs::create_dir_all(&args.output).map_err(|e| Error::output(&args.output, e))?;
     let csv = args.output.join("sweep.csv");
     check_outputs(&[Output { flag: "--output", path: &csv, ext: "csv" }], &inputs)?;
-    let camera = loaded.camera.unwrap_or_else(|| fitted_camera(&scene, 40.0, base.width as f32 / base.height as f32));
+    let camera = loaded.camera.unwrap_or_else(|| {
+        fitted_camera(&scene, photonwave::scene::camera::DEFAULT_FOV, base.width as f32 / base.height as f32)
+    });
     let rays = camera.prepare(base.width, base.height)?;
 
     for w in &scene.warnings {

@@ -4,6 +4,10 @@ use crate::error::{Error, Result};
 use crate::geometry::{in_range, MAX_COORDINATE};
 use glam::Vec3;
 
+/// The vertical field of view, in degrees, of a camera that names none: a `[camera]` without
+/// `fov`, a scene with no camera (framed by [`super::file::fitted_camera`]).
+pub const DEFAULT_FOV: f32 = 40.0;
+
 /// Where the camera is and where it looks.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {

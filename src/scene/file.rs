@@ -10,7 +10,7 @@
 //! eye = [0, 1, 3.4]
 //! target = [0, 1, 0]
 //! up = [0, 1, 0]                # optional
-//! fov = 40                      # vertical, degrees
+//! fov = 40                      # vertical, degrees; optional (40)
 //!
 //! [[light]]
 //! type = "point"                # point | spot | directional
@@ -38,7 +38,7 @@
 //! spp = 16
 //! ```
 
-use super::camera::Camera;
+use super::camera::{Camera, DEFAULT_FOV};
 use super::environment::Environment;
 use super::file_materials::{colour, finite3, MaterialEntry};
 use super::file_meshes::{Brought, MeshEntry};
@@ -101,7 +101,12 @@ struct CameraEntry {
     target: [f32; 3],
     #[serde(default = "y_up")]
     up: [f32; 3],
+    #[serde(default = "default_fov")]
     fov: f32,
+}
+
+fn default_fov() -> f32 {
+    DEFAULT_FOV
 }
 
 fn y_up() -> [f32; 3] {

@@ -214,7 +214,7 @@ pub fn load_ply(
     let (format, elements, start, first_line) = parse_header(path, &data)?;
     let mut body = Body { format, data: &data, at: start, line: first_line };
     let mut mesh = MeshInput { source: path.display().to_string(), ..Default::default() };
-    let (mut skipped_faces, mut has_normals, mut has_uv) = (0u64, false, false);
+    let mut skipped_faces = 0u64;
     for e in &elements {
         let fail = |body: &Body, i: u64, m: String| {
             Error::parse(
@@ -243,8 +243,7 @@ pub fn load_ply(
         if is_vertex && xyz.iter().any(Option::is_none) {
             return Err(Error::parse(path, e.line, "the `vertex` element needs properties x, y and z"));
         }
-        has_normals |= is_vertex && nxyz.iter().all(Option::is_some);
-        has_uv |= is_vertex && uv.iter().all(Option::is_some);
+        let own_normals = is_vertex && nxyz.iter().all(Option::is_some);
         let faces = e
             .properties
             .iter()
@@ -299,14 +298,16 @@ pub fn load_ply(
                 mesh.positions.push(p);
                 let n = get(nxyz);
                 // A column starts with the first vertex element that has it: pad what came before.
+                // An element without it adds nothing here; the padding after the loop (or before
+                // a later element that has it) gives its vertices zeros.
                 let before = mesh.positions.len() - 1;
-                if has_normals {
+                if own_normals {
                     mesh.normals.resize(before, Vec3::ZERO);
                     mesh.zero_normals += u64::from(n.try_normalize().is_none());
                     mesh.normals.push(if n.try_normalize().is_some() { n } else { Vec3::ZERO });
                 }
-                if has_uv {
-                    let t = Vec2::new(values[uv[0].unwrap_or(0)] as f32, values[uv[1].unwrap_or(0)] as f32);
+                if let [Some(u), Some(v)] = uv {
+                    let t = Vec2::new(values[u] as f32, values[v] as f32);
                     mesh.texcoords.resize(before, Vec2::ZERO);
                     mesh.texcoords.push(if t.is_finite() { t } else { Vec2::ZERO });
                 }

@@ -91,6 +91,32 @@ fn glb_chunks<'b>(path: &Path, data: &'b [u8]) -> Result<(&'b [u8], Option<&'b [
     Ok((json, bin))
 }
 
+/// Refuses a model whose `asset.version` (or `minVersion`) is not 2.x, before the typed reader
+/// sees it: glTF 1.0 is another schema (objects keyed by name, techniques and shaders), which
+/// would either be refused with an unrelated message or, where its fields happen to fit, render
+/// as something else. A JSON the check cannot read, or one without a version, is left to the
+/// typed reader's message.
+fn asset_version(path: &Path, json: &[u8]) -> Result<()> {
+    let Ok(root) = serde_json::from_slice::<serde_json::Value>(json) else { return Ok(()) };
+    let asset = root.get("asset");
+    for field in ["version", "minVersion"] {
+        let Some(v) = asset.and_then(|a| a.get(field)) else { continue };
+        let text = v.as_str().map_or_else(|| v.to_string(), str::to_owned);
+        if text.split('.').next() != Some("2") {
+            return Err(Error::parse(
+                path,
+                0,
+                format!(
+                    "asset.{field} is \"{}\": photonwave reads glTF 2.0 (glTF 1.0 is another schema; \
+                     convert the model to 2.0 first, e.g. with Khronos' glTF converters or Blender)",
+                    text.chars().take(40).collect::<String>()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The bytes a `data:` URI holds (base64 only).
 fn data_uri(uri: &str) -> Option<Vec<u8>> {
     use base64::Engine;
@@ -173,6 +199,7 @@ pub fn load_gltf(
     let data = read_input(path, "a glTF model", MAX_MESH_FILE)?;
     inputs.push(path.to_path_buf());
     let (json, bin) = if data.starts_with(b"glTF") { glb_chunks(path, &data)? } else { (&data[..], None) };
+    asset_version(path, json)?;
     let root: gltf::json::Root =
         gltf::json::deserialize::from_slice(json).map_err(|e| Error::parse(path, e.line(), format!("glTF: {e}")))?;
     for ext in &root.extensions_required {

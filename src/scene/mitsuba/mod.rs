@@ -26,6 +26,7 @@ use super::transform::Transform;
 use super::MeshInput;
 use crate::error::{Error, Result};
 use crate::files::{read_text, MAX_SCENE_FILE};
+use crate::settings::MAX_IMAGE_SIDE;
 use crate::texture::{Encoding, Texture};
 use bsdfs::UvMap;
 use glam::{Affine3A, Vec3};
@@ -258,6 +259,21 @@ impl<'a> Ctx<'a> {
         Environment::from_map(map, scale.max(0.0), angle).map_err(|e| self.r.error(node, e))
     }
 
+    /// The film's `width` or `height` (`default` where it has none): a whole number of pixels
+    /// within [`MAX_IMAGE_SIDE`], refused at its own line otherwise (a film the size of a
+    /// planet would be refused later by the settings, naming neither the file nor the line).
+    fn film_side(&self, film: Node<'a, 'a>, name: &str, default: u32) -> Result<u32> {
+        let Some(p) = self.r.prop(film, name) else { return Ok(default) };
+        let v = self.r.float(film, name, default as f32)?;
+        if v.fract() != 0.0 || !(1.0..=MAX_IMAGE_SIDE as f32).contains(&v) {
+            return Err(self.r.error(
+                p,
+                format!("the film's `{name}` is {v}: it must be a whole number of pixels from 1 to {MAX_IMAGE_SIDE}"),
+            ));
+        }
+        Ok(v as u32)
+    }
+
     /// The camera and film of a `<sensor>`.
     fn sensor(&mut self, node: Node<'a, 'a>, scene: &mut MitsubaScene) -> Result<()> {
         let kind = node.attribute("type").unwrap_or("");
@@ -274,8 +290,8 @@ impl<'a> Ctx<'a> {
         }
         let (mut w, mut h) = (768u32, 576u32);
         if let Some(film) = node.children().find(|c| c.is_element() && c.tag_name().name() == "film") {
-            w = self.r.float(film, "width", 768.0)?.clamp(1.0, 65536.0) as u32;
-            h = self.r.float(film, "height", 576.0)?.clamp(1.0, 65536.0) as u32;
+            w = self.film_side(film, "width", w)?;
+            h = self.film_side(film, "height", h)?;
         }
         scene.size = Some((w, h));
         if let Some(s) = node.children().find(|c| c.is_element() && c.tag_name().name() == "sampler") {
