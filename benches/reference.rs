@@ -70,7 +70,7 @@ fn density(c: &mut Criterion) {
                     k: settings.k as usize,
                     r_max: r,
                     kernel: settings.kernel,
-                    filter: Filter { n: *n, flags_mask: 0, plane: 0.0 },
+                    filter: Filter { n: *n, flags_mask: 0, plane: 0.0, slack: 0.0 },
                 };
                 sum +=
                     maps.global.estimate(CodePath::Simd, &q, Reflectance::Constant(Vec3::ONE), &mut scratch).radiance;

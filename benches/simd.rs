@@ -73,7 +73,7 @@ fn density(c: &mut Criterion) {
             k,
             r_max,
             kernel: settings.kernel,
-            filter: Filter { n, flags_mask: 0, plane: 0.0 },
+            filter: Filter { n, flags_mask: 0, plane: 0.0, slack: 0.0 },
         };
         let f = |n| Reflectance::Hemisphere { value: Vec3::splat(0.2), ng: n };
         g.bench_function(BenchmarkId::new("knn", &name), |b| {

@@ -151,7 +151,7 @@ fn every_kernel_returns_a_uniform_density() {
             k: 100_000,
             r_max: 50.0 * h,
             kernel,
-            filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+            filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
         };
         let e = map.estimate(CodePath::Simd, &q, Reflectance::Constant(Vec3::ONE), &mut scratch);
         let rel = e.radiance.x * h * h;
@@ -187,7 +187,7 @@ fn knn_estimate_is_unbiased_on_a_uniform_plane() {
                 k: 16,
                 r_max: 0.1,
                 kernel: Kernel::Box,
-                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
             };
             let e = map.estimate(CodePath::Simd, &look, Reflectance::Constant(Vec3::ONE), &mut scratch);
             sum += e.radiance.x as f64 / n as f64;
@@ -365,7 +365,7 @@ fn directional_light_irradiance_is_cosine_weighted_by_both_methods() {
                     k: 400,
                     r_max: 1.0,
                     kernel: Kernel::Box,
-                    filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+                    filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
                 };
                 let eval = |wi| mat.bsdf.eval(&sp.frame, Vec3::Y, wi);
                 let e = maps.global.estimate(CodePath::Simd, &q, Reflectance::PerPhoton(&eval), &mut scratch);
@@ -421,7 +421,7 @@ fn boundary_corrected_estimates_do_not_darken_edges_and_corners() {
                 k: 0,
                 r_max: r,
                 kernel,
-                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
             };
             let f = Reflectance::Constant(Vec3::ONE);
             let inner = Vec3::new(-0.5, 0.0, -0.5);
@@ -467,7 +467,7 @@ fn open_edges_cut_the_disk_where_no_photons_show_it() {
         k: 0,
         r_max: r,
         kernel: Kernel::Cone,
-        filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+        filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
     };
     let f = Reflectance::Constant(Vec3::ONE);
     let interior = map.estimate_radius(CodePath::Scalar, &q(Vec3::new(-0.5, 0.0, 0.0)), f).radiance.x;
@@ -514,7 +514,13 @@ fn bias_estimates_return_the_kernel_bias_of_quadratic_radiance() {
     for (kernel, mu2) in [(Kernel::Box, 0.25f32), (Kernel::Cone, 0.15), (Kernel::Epanechnikov, 1.0 / 6.0)] {
         let want = 2.0 * c * mu2 * r * r;
         for p in [Vec3::ZERO, Vec3::new(0.03, 0.0, -0.05)] {
-            let q = Lookup { p, k: 0, r_max: r, kernel, filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 } };
+            let q = Lookup {
+                p,
+                k: 0,
+                r_max: r,
+                kernel,
+                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
+            };
             let scalar = map.estimate_radius(CodePath::Scalar, &q, f);
             let simd = map.estimate_radius(CodePath::Simd, &q, f);
             let what = format!("{kernel:?} at {p}");
@@ -542,7 +548,13 @@ fn bias_estimates_return_the_kernel_bias_of_quadratic_radiance() {
     let map = PhotonMap::build(photons);
     for kernel in [Kernel::Box, Kernel::Cone] {
         for p in [Vec3::ZERO, Vec3::new(-0.05, 0.0, 0.0), Vec3::new(-0.15, 0.0, 0.0)] {
-            let q = Lookup { p, k: 0, r_max: r, kernel, filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 } };
+            let q = Lookup {
+                p,
+                k: 0,
+                r_max: r,
+                kernel,
+                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
+            };
             for set in [CodePath::Scalar, CodePath::Simd] {
                 let e = map.estimate_radius_on_surface(set, &q, f, &[]);
                 let what = format!("{kernel:?} at {p}, {set:?}");

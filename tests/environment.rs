@@ -94,7 +94,7 @@ fn photon_estimate(scene: &Scene) -> f32 {
                 k: 400,
                 r_max: 1.0,
                 kernel: Kernel::Box,
-                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
             };
             let eval = |wi| white().bsdf.eval(&sp.frame, Vec3::Y, wi);
             sum += maps.global.estimate(CodePath::Simd, &q, Reflectance::PerPhoton(&eval), &mut scratch).radiance.x;

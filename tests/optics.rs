@@ -93,7 +93,7 @@ fn grazing_light_follows_the_cosine_law() {
                     k: 0,
                     r_max: 0.8,
                     kernel: Kernel::Box,
-                    filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+                    filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
                 };
                 let e = maps.global.estimate_radius(CodePath::Simd, &q, Reflectance::Constant(Vec3::ONE));
                 (seed, f64::from(e.radiance.x / cos), 1.0 / f64::from(e.count).sqrt())
@@ -138,8 +138,13 @@ fn light_inside_glass_reaches_the_walls_only_as_caustics() {
         let per_seed: Vec<(u64, f64, f64)> = common::SEEDS
             .map(|seed| {
                 let (_, maps) = maps_at(&scene, &s, seed);
-                let q =
-                    Lookup { p, k: 0, r_max: r, kernel: Kernel::Box, filter: Filter { n, flags_mask: 0, plane: 0.0 } };
+                let q = Lookup {
+                    p,
+                    k: 0,
+                    r_max: r,
+                    kernel: Kernel::Box,
+                    filter: Filter { n, flags_mask: 0, plane: 0.0, slack: 0.0 },
+                };
                 let e = maps.caustic.estimate_radius(CodePath::Simd, &q, Reflectance::Constant(Vec3::ONE));
                 (seed, f64::from(e.radiance.x / expected), 1.0 / f64::from(e.count).sqrt())
             })

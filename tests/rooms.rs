@@ -90,7 +90,7 @@ fn no_estimate_inside_reads_a_photon_from_outside() {
                         // A grid from the face's edges in, 0.98 of its half-widths.
                         let (fa, fb) = (-0.98 + 1.96 * a as f32 / 5.0, -0.98 + 1.96 * b as f32 / 5.0);
                         let p = centre + u * fa + v * fb;
-                        let filter = Filter { n, flags_mask: 0, plane: OFF_PLANE };
+                        let filter = Filter::at(p, n, 0).with_plane(OFF_PLANE);
                         for (k, r_max) in [(64usize, 0.5f32), (usize::MAX, 0.3)] {
                             let q = Lookup { p, k, r_max, kernel: Kernel::Box, filter };
                             for &(_, i) in map.nearest(photonwave::code_path::CodePath::Simd, &q, &mut scratch) {
@@ -104,7 +104,7 @@ fn no_estimate_inside_reads_a_photon_from_outside() {
                                 checked += 1;
                             }
                         }
-                        let visible = off_plane_visibility(&scene, p, n, OFF_PLANE);
+                        let visible = off_plane_visibility(&scene, p, &filter);
                         let q = Lookup { p, k: 0, r_max: 0.3, kernel: Kernel::Box, filter };
                         for (_, i) in map.off_plane_photons(&q) {
                             let ph = map.photon(i as usize);

@@ -82,7 +82,7 @@ fn simd_lookups_find_the_same_photons_as_the_scalar_twins() {
     for (qi, (p, n)) in queries().into_iter().enumerate() {
         for (k, r_max, flags_mask) in [(1, 0.05, 0), (16, 0.02, 0), (64, 0.1, flags::DIRECT), (200, 0.01, 0)] {
             for kernel in [Kernel::Box, Kernel::Cone, Kernel::Epanechnikov] {
-                let q = Lookup { p, k, r_max, kernel, filter: Filter { n, flags_mask, plane: 0.0 } };
+                let q = Lookup { p, k, r_max, kernel, filter: Filter { n, flags_mask, plane: 0.0, slack: 0.0 } };
                 let simd = map.nearest(CodePath::Simd, &q, &mut a).to_vec();
                 let scalar = map.nearest(CodePath::Scalar, &q, &mut b).to_vec();
                 assert_eq!(sorted(simd), sorted(scalar), "query {qi} {q:?}: different photons");
@@ -128,7 +128,13 @@ fn fixed_radius_lookups_find_what_a_brute_force_scan_finds() {
     let mut checked = 0;
     for (qi, (p, n)) in queries().into_iter().enumerate().step_by(7) {
         for r in [0.01f32, 0.03, 0.1, 2.0] {
-            let q = Lookup { p, k: 0, r_max: r, kernel: Kernel::Box, filter: Filter { n, flags_mask: 0, plane: 0.0 } };
+            let q = Lookup {
+                p,
+                k: 0,
+                r_max: r,
+                kernel: Kernel::Box,
+                filter: Filter { n, flags_mask: 0, plane: 0.0, slack: 0.0 },
+            };
             // The lookup's own distance arithmetic, photon by photon.
             let (mut summed, mut turned) = (0u32, 0u32);
             for i in 0..map.len() {
@@ -159,7 +165,7 @@ fn fixed_radius_lookups_find_what_a_brute_force_scan_finds() {
             k: 0,
             r_max: 1.0,
             kernel: Kernel::Box,
-            filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+            filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
         };
         let e = empty.estimate_radius(set, &q, f);
         assert_eq!((e.count, e.rejected, e.radiance), (0, 0, Vec3::ZERO), "{set:?}");
@@ -200,7 +206,7 @@ fn query_packets_match_single_estimates_to_the_bit() {
                 k: 0,
                 r_max: radii[j % radii.len()],
                 kernel: Kernel::Epanechnikov,
-                filter: Filter { n, flags_mask, plane: 0.0 },
+                filter: Filter { n, flags_mask, plane: 0.0, slack: 0.0 },
             },
             f,
             edges: j.is_multiple_of(2).then_some(&cut[..]),
@@ -284,7 +290,7 @@ fn lookups_honour_the_radius_and_the_filters_exactly() {
             k: 100,
             r_max: r,
             kernel: Kernel::Box,
-            filter: Filter { n: Vec3::Y, flags_mask: flags::DIRECT | flags::CAUSTIC, plane: 0.0 },
+            filter: Filter { n: Vec3::Y, flags_mask: flags::DIRECT | flags::CAUSTIC, plane: 0.0, slack: 0.0 },
         };
         let mut out = Nearest::default();
         assert_eq!(map.nearest(set, &q, &mut out).len(), 4, "{set:?}: only the four at half the radius");

@@ -83,7 +83,7 @@ pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize,
         k,
         r_max: r,
         kernel: settings.kernel,
-        filter: Filter { n, flags_mask: 0, plane: 0.0 },
+        filter: Filter { n, flags_mask: 0, plane: 0.0, slack: 0.0 },
     };
     let f = |n: Vec3| Reflectance::Hemisphere { value: Vec3::splat(0.5 / std::f32::consts::PI), ng: n };
     let knn = |set: CodePath| {

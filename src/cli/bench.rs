@@ -100,12 +100,12 @@ pub fn run(args: BenchArgs) -> Result<()> {
         };
         let label = std::path::Path::new(name).file_stem().map_or(name.clone(), |s| s.to_string_lossy().into_owned());
         let camera = loaded.camera.unwrap_or_else(|| {
-            let mut c = fitted_camera(&loaded.scene, args.fov.unwrap_or(40.0), 1.0);
+            let mut c = fitted_camera(&loaded.scene, args.fov.unwrap_or(photonwave::scene::camera::DEFAULT_FOV), 1.0);
             if let Some(e) = args.eye {
-                c.eye = e;
+                c.eye = loaded.scene.to_frame(e);
             }
             if let Some(t) = args.target {
-                c.target = t;
+                c.target = loaded.scene.to_frame(t);
             }
             c
         });

@@ -174,13 +174,20 @@ pub struct RenderArgs {
 }
 
 /// The camera a render uses: the scene file's, else one fitted to `bounds` for an image of
-/// `aspect`, with the CLI's `--eye`, `--target`, `--up` and `--fov` over either.
-fn view(args: &RenderArgs, file: Option<Camera>, bounds: (Vec3, Vec3), aspect: f32) -> Camera {
-    let fov = args.fov.or(file.map(|c| c.fov_deg)).unwrap_or(40.0);
+/// `aspect`, with the CLI's `--eye`, `--target`, `--up` and `--fov` over either (`--eye` and
+/// `--target` are in the files' coordinates: `frame` moves them where `file` and `bounds` are).
+fn view(
+    args: &RenderArgs,
+    file: Option<Camera>,
+    bounds: (Vec3, Vec3),
+    aspect: f32,
+    frame: &dyn Fn(Vec3) -> Vec3,
+) -> Camera {
+    let fov = args.fov.or(file.map(|c| c.fov_deg)).unwrap_or(photonwave::scene::camera::DEFAULT_FOV);
     let mut camera = file.unwrap_or_else(|| fitted_camera_to(bounds, fov, aspect));
     camera.fov_deg = fov;
-    camera.eye = args.eye.unwrap_or(camera.eye);
-    camera.target = args.target.unwrap_or(camera.target);
+    camera.eye = args.eye.map_or(camera.eye, frame);
+    camera.target = args.target.map_or(camera.target, frame);
     camera.up = args.up.unwrap_or(camera.up);
     camera
 }
@@ -229,7 +236,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let default = photonwave::settings::Settings::default();
     let cli_aspect = args.width.unwrap_or(default.width) as f32 / args.height.unwrap_or(default.height).max(1) as f32;
     let added = |bounds: (Vec3, Vec3), file: Option<Camera>| -> Vec<Light> {
-        let c = view(&args, file, bounds, cli_aspect);
+        let c = view(&args, file, bounds, cli_aspect, &|p| p);
         args.light.iter().map(|preset| preset.light(c.eye, c.target, c.up)).collect()
     };
     let loaded = load_scene_lit(&args.scene, &added)?;
@@ -253,7 +260,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
             )
         })?),
     };
-    let camera = view(&args, file_camera, scene.mesh_bounds(), settings.width as f32 / settings.height as f32);
+    let aspect = settings.width as f32 / settings.height as f32;
+    let camera = view(&args, file_camera, scene.mesh_bounds(), aspect, &|p| scene.to_frame(p));
     let rays = camera.prepare(settings.width, settings.height)?;
     let load_s = t0.elapsed().as_secs_f64();
 

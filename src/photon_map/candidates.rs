@@ -94,7 +94,7 @@ mod tests {
                 k: 0,
                 r_max: 0.1,
                 kernel: Kernel::Epanechnikov,
-                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+                filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
             };
             let ours = map.estimate_radius_with(CodePath::Scalar, &q, f, None, false);
             let mut found: Vec<(f32, u32)> = (0..map.len())

@@ -18,7 +18,9 @@ impl PhotonMap {
     /// (no square root); then for a flat query the plane test, which sets aside the photons
     /// behind its plane by more than `plane` of their distance ((x − p)·n < 0 and
     /// ((x − p)·n)² > plane²·d2, [`Filter::plane`]), and for any other the offset test
-    /// ((x − p)·(n + m̂))² ≤ [`OFFSET2`]·d2 — the same operations as the 8-wide form. A
+    /// ((x − p)·(n + m̂))² ≤ [`OFFSET2`]·d2, each allowing the filter's absolute
+    /// [`Filter::slack`] (slack² and (2·slack)² added to the bound: the offset is measured along
+    /// n + m̂, up to twice a unit) — the same operations as the 8-wide form. A
     /// rejection says which test failed. (Each test adds a sixth to a packet of estimates'
     /// instructions, so a query makes one: what a flat point's offset test would turn away lies
     /// behind its plane, set aside, or in front of it, kept as it always was.)
@@ -33,9 +35,10 @@ impl PhotonMap {
         if !(dot > 0.0 && dot * dot > 0.49 * len2) {
             return Test::Normal;
         }
+        let slack2 = filter.slack * filter.slack;
         if filter.plane > 0.0 {
             let height = delta[0] * filter.n.x + delta[1] * filter.n.y + delta[2] * filter.n.z;
-            return if height < 0.0 && height * height > filter.plane * filter.plane * d2 {
+            return if height < 0.0 && height * height > filter.plane * filter.plane * d2 + slack2 {
                 Test::OffPlane
             } else {
                 Test::Accepted
@@ -44,7 +47,7 @@ impl PhotonMap {
         let inv = 1.0 / len2.sqrt();
         let h = [filter.n.x + m.x * inv, filter.n.y + m.y * inv, filter.n.z + m.z * inv];
         let s = delta[0] * h[0] + delta[1] * h[1] + delta[2] * h[2];
-        if s * s > OFFSET2 * d2 {
+        if s * s > OFFSET2 * d2 + 4.0 * slack2 {
             Test::Normal
         } else {
             Test::Accepted
@@ -104,11 +107,13 @@ impl PhotonMap {
             let n = filter.n;
             let height = dx * f32x8::splat(n.x) + dy * f32x8::splat(n.y) + dz * f32x8::splat(n.z);
             let below = height.simd_lt(f32x8::ZERO);
-            let off = facing & below & (height * height).simd_gt(f32x8::splat(filter.plane * filter.plane) * d2);
+            let bound = f32x8::splat(filter.plane * filter.plane) * d2 + f32x8::splat(filter.slack * filter.slack);
+            let off = facing & below & (height * height).simd_gt(bound);
             return Filtered8 { inside: facing & !off, turned, off_plane: off.to_bitmask() };
         }
         let s = dx * hx + dy * hy + dz * hz;
-        let on_surface = facing & !(s * s).simd_gt(f32x8::splat(OFFSET2) * d2);
+        let bound = f32x8::splat(OFFSET2) * d2 + f32x8::splat(4.0 * (filter.slack * filter.slack));
+        let on_surface = facing & !(s * s).simd_gt(bound);
         Filtered8 { inside: on_surface, turned: turned | (facing & !on_surface).to_bitmask(), off_plane: 0 }
     }
 }

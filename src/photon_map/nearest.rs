@@ -394,7 +394,7 @@ mod tests {
                     k,
                     r_max: 0.5,
                     kernel: Kernel::Epanechnikov,
-                    filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+                    filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
                 };
                 let a = map.estimate(set, &q, f, &mut guided);
                 let b = map.estimate(set, &q, f, &mut Nearest::default());
@@ -431,7 +431,7 @@ mod tests {
                             k,
                             r_max,
                             kernel: Kernel::Box,
-                            filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0 },
+                            filter: Filter { n: Vec3::Y, flags_mask: 0, plane: 0.0, slack: 0.0 },
                         };
                         let mut want: Vec<(u32, u32)> = (0..map.len())
                             .map(|i| ((map.position(i) - p).length_squared(), i as u32))

@@ -55,7 +55,7 @@ pub fn median_knn_radius(map: &PhotonMap, k: u32, r_max: f32, code_path: CodePat
                 k: k as usize,
                 r_max,
                 kernel: Kernel::Box,
-                filter: Filter { n: p.normal, flags_mask: 0, plane: 0.0 },
+                filter: Filter::at(p.position, p.normal, 0),
             };
             let found = map.nearest(code_path, &q, &mut scratch);
             (found.len() == k as usize).then(|| found.iter().map(|c| c.0).fold(0.0, f32::max).sqrt())
@@ -123,13 +123,7 @@ pub fn camera_knn_radii(scene: &Scene, rays: &CameraRays, job: &Job, maps: &Phot
     let (global_on, gather) = (ctx.effects.global_map.on, ctx.effects.final_gather.on);
     let found = probe_first_surfaces(&ctx, job, rays, (None, None), |_, s, sp, d, scratch, counts| {
         let (ng, _) = sp.frame.oriented(-d);
-        let at = |p, n, mask| Lookup {
-            p,
-            k: 0,
-            r_max: 0.0,
-            kernel: settings.kernel,
-            filter: Filter { n, flags_mask: mask, plane: 0.0 },
-        };
+        let at = |p, n, mask| Lookup { p, k: 0, r_max: 0.0, kernel: settings.kernel, filter: Filter::at(p, n, mask) };
         let caustic = knn(&maps.caustic, settings.caustic_k, ctx.caustic_radius, at(sp.p, ng, 0), scratch);
         let global = match (global_on, gather) {
             (false, _) => None,
@@ -195,16 +189,10 @@ pub fn pixel_radii(
     let miss = (fallback.global, fallback.caustic);
     let found = probe_first_surfaces(&ctx, job, rays, miss, |_, _, sp, d, scratch, _| {
         let (ng, _) = sp.frame.oriented(-d);
-        let q = Lookup {
-            p: sp.p,
-            k: 0,
-            r_max: 0.0,
-            kernel: settings.kernel,
-            filter: Filter { n: ng, flags_mask: 0, plane: 0.0 },
-        };
+        let q = Lookup { p: sp.p, k: 0, r_max: 0.0, kernel: settings.kernel, filter: Filter::at(sp.p, ng, 0) };
         let caustic = knn(&maps.caustic, settings.caustic_k, ctx.caustic_radius, q, scratch);
         let global = if want_global {
-            let q = Lookup { filter: Filter { n: ng, flags_mask: flags::OWN_TERMS, plane: 0.0 }, ..q };
+            let q = Lookup { filter: Filter::at(sp.p, ng, flags::OWN_TERMS), ..q };
             knn(&maps.global, settings.k, ctx.global_radius, q, scratch)
         } else {
             fallback.global

@@ -20,12 +20,35 @@ impl Scene {
 
     /// [`Scene::build`] with an environment light.
     pub fn build_lit(
-        meshes: Vec<MeshInput>,
+        mut meshes: Vec<MeshInput>,
         materials: Vec<Material>,
         mut extra_lights: Vec<Light>,
         environment: Option<Environment>,
         mut warnings: Vec<String>,
     ) -> Result<Scene> {
+        for m in &meshes {
+            // `load_obj` names the line; this catches meshes made in code.
+            if let Some(k) = m.positions.iter().position(|p| !in_range(*p)) {
+                return Err(Error::scene(format!(
+                    "{}: vertex {} lies at {}, outside ±{MAX_COORDINATE:e}, the range in which photonwave's \
+                     f32 geometry stays watertight (docs/src/bad-input.md, \"Limits\")",
+                    m.source,
+                    k + 1,
+                    m.positions[k]
+                )));
+            }
+        }
+        let origin = frame_origin(&meshes);
+        if origin != Vec3::ZERO {
+            for p in meshes.iter_mut().flat_map(|m| m.positions.iter_mut()) {
+                *p = relative_to(*p, origin);
+            }
+            for l in &mut extra_lights {
+                if let Light::Point { position, .. } | Light::Spot { position, .. } = l {
+                    *position = relative_to(*position, origin);
+                }
+            }
+        }
         if environment.is_some() {
             extra_lights.push(Light::Environment);
         }
@@ -40,16 +63,6 @@ impl Scene {
         let mut emitter_area = vec![0.0f64; materials.len()];
         let mut emitter_seen = vec![false; materials.len()];
         for m in &meshes {
-            // `load_obj` names the line; this catches meshes made in code.
-            if let Some(k) = m.positions.iter().position(|p| !in_range(*p)) {
-                return Err(Error::scene(format!(
-                    "{}: vertex {} lies at {}, outside ±{MAX_COORDINATE:e}, the range in which photonwave's \
-                     f32 geometry stays watertight (docs/src/bad-input.md, \"Limits\")",
-                    m.source,
-                    k + 1,
-                    m.positions[k]
-                )));
-            }
             for (t, tri) in m.triangles.iter().enumerate() {
                 let v = tri.map(|i| m.positions[i as usize]);
                 let material = m.material[t];
@@ -189,6 +202,7 @@ impl Scene {
             delta_lights: vec![],
             suns: vec![],
             bounds: (lo, hi),
+            origin,
             dropped_degenerate: dropped,
             zero_normals,
             encloses_lights: false,
@@ -253,4 +267,36 @@ fn textured_mean(t: &crate::texture::Texture, uv: &[Vec2; 3]) -> Vec3 {
     } else {
         sum / 16.0
     }
+}
+
+/// How many of its own diagonals a scene's centre must lie from the origin for the scene to be
+/// moved to it ([`frame_origin`]): 8, where its coordinates have lost 3 bits or more to their
+/// magnitude. Nearer, the scene keeps the coordinates of its files (and its images their bits).
+const FAR: f64 = 8.0;
+
+/// Where the scene's own frame puts its origin, in the coordinates of its files: the centre of
+/// its meshes' bounds where that lies further than [`FAR`] diagonals from the origin, else the
+/// origin itself (no move). f32 resolves a coordinate to 2⁻²⁴ of its magnitude, so a
+/// Cornell box 30 000 units out is drawn on a grid of 2 mm: rays leaving a wall's top edge
+/// started above the ceiling, error bounds and ray offsets grew to centimetres, and the image
+/// came out 2.7 % dark. Moved to its own centre (each position's difference taken in f64 and
+/// rounded once, so equal positions stay equal bit for bit), the scene renders as it would at
+/// the origin; cameras and lights move with it ([`Scene::to_frame`]). Positions are rounded to
+/// f32 as the files are read, so what the far placement already lost (vertices on the 2 mm grid)
+/// stays lost.
+fn frame_origin(meshes: &[MeshInput]) -> Vec3 {
+    let (lo, hi) = bounds_of(meshes.iter().flat_map(|m| m.positions.iter()));
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Vec3::ZERO;
+    }
+    let centre = 0.5 * (lo.as_dvec3() + hi.as_dvec3());
+    if centre.length() <= FAR * (hi.as_dvec3() - lo.as_dvec3()).length() {
+        return Vec3::ZERO;
+    }
+    centre.as_vec3()
+}
+
+/// `p` relative to `origin`: the exact difference, rounded once.
+fn relative_to(p: Vec3, origin: Vec3) -> Vec3 {
+    (p.as_dvec3() - origin.as_dvec3()).as_vec3()
 }

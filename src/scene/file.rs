@@ -146,14 +146,30 @@ pub struct LoadedScene {
     /// The assembled scene.
     pub scene: Scene,
     /// Camera from the file, if it had one: the TOML `[camera]`, else the first a glTF file
-    /// brings.
+    /// brings; in the scene's frame ([`Scene::to_frame`]).
     pub camera: Option<Camera>,
-    /// The named cameras mesh files bring (glTF), for `--camera NAME`.
+    /// The named cameras mesh files bring (glTF), for `--camera NAME`; in the scene's frame.
     pub cameras: Vec<(String, Camera)>,
     /// Settings from the file's `[render]` table (defaults otherwise).
     pub settings: Settings,
     /// Every file read: the scene file, its OBJ and MTL files (outputs must not overwrite them).
     pub inputs: Vec<PathBuf>,
+}
+
+impl LoadedScene {
+    /// The loaded scene with its file's cameras (given in the file's coordinates) moved into the
+    /// scene's frame.
+    fn framed(
+        scene: Scene,
+        camera: Option<Camera>,
+        cameras: Vec<(String, Camera)>,
+        settings: Settings,
+        inputs: Vec<PathBuf>,
+    ) -> LoadedScene {
+        let camera = camera.map(|c| scene.camera_to_frame(c));
+        let cameras = cameras.into_iter().map(|(name, c)| (name, scene.camera_to_frame(c))).collect();
+        LoadedScene { scene, camera, cameras, settings, inputs }
+    }
 }
 
 impl LightEntry {
@@ -273,7 +289,7 @@ pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
         if let Some((width, height)) = m.size {
             (settings.width, settings.height) = (width, height);
         }
-        return Ok(LoadedScene { scene, camera: m.camera, cameras: Vec::new(), settings, inputs });
+        return Ok(LoadedScene::framed(scene, m.camera, Vec::new(), settings, inputs));
     }
     if MESH_FORMATS.contains(&ext.as_str()) {
         // A bare mesh file: its own camera and lights if it brings them, `added` besides.
@@ -288,7 +304,7 @@ pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
         lights.extend(added(bounds(&meshes), camera));
         let scene = Scene::build(meshes, table.materials, lights, warnings)?;
         let (settings, cameras) = (Settings::default(), brought.cameras);
-        return Ok(LoadedScene { scene, camera, cameras, settings, inputs });
+        return Ok(LoadedScene::framed(scene, camera, cameras, settings, inputs));
     }
     let text = read_text(path, "a scene file", MAX_SCENE_FILE)?;
     let mut inputs = vec![path.to_path_buf()];
@@ -349,7 +365,7 @@ pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
     settings.validate()?;
     let environment = file.environment.as_ref().map(|e| e.to_environment(dir, &mut inputs)).transpose()?;
     let scene = Scene::build_lit(meshes, table.materials, lights, environment, warnings)?;
-    Ok(LoadedScene { scene, camera, cameras: brought.cameras, settings, inputs })
+    Ok(LoadedScene::framed(scene, camera, brought.cameras, settings, inputs))
 }
 
 /// A camera that frames the bounding sphere of the scene's triangles from +z, looking down −z, for an image of

@@ -2,6 +2,7 @@
 //! directional lights of the scene file; their power, emission sampling (photons) and
 //! illumination sampling (direct light).
 
+use crate::geometry::offset::barycentric_error;
 use crate::sampling::{concentric_disk, uniform_cone, uniform_sphere, uniform_triangle, Frame};
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -53,6 +54,11 @@ pub struct Incident {
     pub distance: f32,
     /// The light-side point and its geometric normal, for shadow rays (None for distant lights).
     pub point: Option<(Vec3, Vec3)>,
+    /// The rounding error bound of that point, per axis (zero for point and spot lights, whose
+    /// position is given): a shadow ray stops short of it by as much, or the emitter's own
+    /// triangle, which a sample computed a rounding behind it lies beyond, blocks the ray (the
+    /// Cornell box 30 000 units out lost 3 % of its direct light so).
+    pub point_error: Vec3,
 }
 
 /// Triangle geometry an area light needs.
@@ -187,7 +193,8 @@ impl Light {
             Light::Area { radiance, .. } => {
                 let t = tri?;
                 let (b1, b2) = uniform_triangle(u);
-                let q = t.p[0] * (1.0 - b1 - b2) + t.p[1] * b1 + t.p[2] * b2;
+                let b = [1.0 - b1 - b2, b1, b2];
+                let q = t.p[0] * b[0] + t.p[1] * b[1] + t.p[2] * b[2];
                 let d = q - p;
                 let dist2 = d.length_squared();
                 let dist = dist2.sqrt();
@@ -197,7 +204,13 @@ impl Light {
                     return None;
                 }
                 // Area measure → solid angle: Le·cos_l·A/d².
-                Some(Incident { wi, value: radiance * (cos_l * t.area / dist2), distance: dist, point: Some((q, t.n)) })
+                Some(Incident {
+                    wi,
+                    value: radiance * (cos_l * t.area / dist2),
+                    distance: dist,
+                    point: Some((q, t.n)),
+                    point_error: barycentric_error(b, t.p[0], t.p[1], t.p[2]),
+                })
             }
             Light::Point { position, intensity } => {
                 let d = position - p;
@@ -208,6 +221,7 @@ impl Light {
                     value: intensity / dist2,
                     distance: dist,
                     point: Some((position, Vec3::ZERO)),
+                    point_error: Vec3::ZERO,
                 })
             }
             Light::Spot { position, direction, intensity, cos_inner, cos_outer } => {
@@ -224,11 +238,16 @@ impl Light {
                     value: intensity * fall / dist2,
                     distance: dist,
                     point: Some((position, Vec3::ZERO)),
+                    point_error: Vec3::ZERO,
                 })
             }
-            Light::Directional { direction, irradiance } => {
-                Some(Incident { wi: -direction, value: irradiance, distance: f32::INFINITY, point: None })
-            }
+            Light::Directional { direction, irradiance } => Some(Incident {
+                wi: -direction,
+                value: irradiance,
+                distance: f32::INFINITY,
+                point: None,
+                point_error: Vec3::ZERO,
+            }),
             Light::Sun { direction, irradiance, one_minus_cos } => {
                 // Uniform in the cone: pdf 1/(2π(1 − cos θ)).
                 let cos = 1.0 - u[0] * one_minus_cos;
@@ -236,7 +255,7 @@ impl Light {
                 let phi = 2.0 * PI * u[1];
                 let wi = Frame::new(-direction).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos));
                 let value = Self::sun_radiance(irradiance, one_minus_cos) * (2.0 * PI * one_minus_cos);
-                Some(Incident { wi, value, distance: f32::INFINITY, point: None })
+                Some(Incident { wi, value, distance: f32::INFINITY, point: None, point_error: Vec3::ZERO })
             }
             // Sampled by the scene (`Scene::sample_incident`).
             Light::Environment => None,

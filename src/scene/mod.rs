@@ -111,6 +111,11 @@ pub struct Scene {
     suns: Vec<u32>,
     /// Bounding box of all triangles and lights.
     pub bounds: (Vec3, Vec3),
+    /// Where the scene's frame has its origin in the coordinates its files use: every position
+    /// in the scene is relative to it (zero for a scene near the origin; a scene far from it is
+    /// moved to its centre as it is built, for precision). [`Scene::to_frame`] moves a point or
+    /// camera given in the files' coordinates (the command line's `--eye`) into the scene.
+    pub origin: Vec3,
     /// Degenerate (zero-area) triangles dropped at load.
     pub dropped_degenerate: usize,
     /// Vertex normals given with zero length (their faces use the geometric normal there).
@@ -129,6 +134,24 @@ pub struct Scene {
     bvh: Bvh,
     /// (any delta, any glass, any non-delta) material on a triangle, computed once.
     kinds: (bool, bool, bool),
+}
+
+impl Scene {
+    /// Point `p`, given in the coordinates of the scene's files, in the scene's frame
+    /// ([`Scene::origin`]).
+    #[must_use]
+    pub fn to_frame(&self, p: Vec3) -> Vec3 {
+        if self.origin == Vec3::ZERO {
+            return p;
+        }
+        (p.as_dvec3() - self.origin.as_dvec3()).as_vec3()
+    }
+
+    /// Camera `c`, placed in the coordinates of the scene's files, in the scene's frame.
+    #[must_use]
+    pub fn camera_to_frame(&self, c: Camera) -> Camera {
+        Camera { eye: self.to_frame(c.eye), target: self.to_frame(c.target), ..c }
+    }
 }
 
 /// The bounding box (lo, hi) of `points`; (+∞, −∞) for none.
@@ -279,6 +302,7 @@ impl Scene {
                     value: radiance / pdf,
                     distance: f32::INFINITY,
                     point: None,
+                    point_error: Vec3::ZERO,
                 })
             }
             (Light::Area { tri, .. }, _) if self.textured_emitter(*tri) => {

@@ -50,7 +50,10 @@ pub fn direct_light_rays(
         }
         let origin = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, inc.wi);
         let (direction, t_max) = match inc.point {
-            Some((q, _)) => (q - origin, 1.0 - SHADOW_SHORTEN),
+            // The light point moved off its emitter toward the shading point, out of its error
+            // box, as the origin is off the surface (pbrt-v4's spawn-ray-to between two
+            // surface points).
+            Some((q, n)) => (offset_ray_origin(q, inc.point_error, n, -inc.wi) - origin, 1.0 - SHADOW_SHORTEN),
             None => (inc.wi, f32::INFINITY),
         };
         emit(ShadowRay { origin, direction, t_max, contribution: f * inc.value * (cos * weight) });

@@ -18,7 +18,7 @@ use crate::code_path::CodePath;
 use crate::material::Bsdf;
 use crate::photon_map::boundary::{Cut, MAX_EXTRA_CUTS};
 use crate::photon_map::query_packet::{RadiusQuery, PACKET};
-use crate::photon_map::{flags, Estimate, Filter, Lookup, Nearest, PhotonMap, Reflectance, OFF_PLANE};
+use crate::photon_map::{flags, position_slack, Estimate, Filter, Lookup, Nearest, PhotonMap, Reflectance, OFF_PLANE};
 use crate::scene::{Scene, SurfacePoint};
 use glam::Vec3;
 use std::sync::atomic::Ordering;
@@ -135,11 +135,11 @@ fn plan_map<'m>(
         k: k as usize,
         r_max: radius,
         kernel: ctx.settings.kernel,
-        filter: Filter {
-            n: ng,
-            flags_mask: mask,
-            plane: if sp.flat && !ctx.settings.visibility { OFF_PLANE } else { 0.0 },
-        },
+        filter: Filter::at(sp.p, ng, mask).with_plane(if sp.flat && !ctx.settings.visibility {
+            OFF_PLANE
+        } else {
+            0.0
+        }),
     };
     let eval = |wi| if base { bsdf.eval_base(&sp.frame, wo, wi) } else { bsdf.eval(&sp.frame, wo, wi) };
     let f = match *bsdf {
@@ -222,7 +222,7 @@ pub fn complete_off_plane(
     if e.off_plane == 0 {
         return e;
     }
-    let keep = off_plane_visibility(scene, lookup.p, lookup.filter.n, lookup.filter.plane);
+    let keep = off_plane_visibility(scene, lookup.p, &lookup.filter);
     if lookup.k > 0 {
         let open = Lookup { filter: Filter { plane: 0.0, ..lookup.filter }, ..*lookup };
         return map.estimate_visible(set, &open, f, scratch, &keep);
@@ -242,17 +242,19 @@ pub fn complete_off_plane(
 /// both lifted off their surfaces, meets nothing. (Tracing the photons in front too — a corner's
 /// other wall — cost the modern hall's gather a third of its time and kept fewer of them than
 /// the filter does wherever no photon was behind.)
-/// The lift is ¾ of the photon's height above the plane (at least 10⁻³ of its distance): enough
-/// to clear a convex crease or a curved neighbour between them (a chord dips below a sphere by a
-/// quarter of that height), not enough to lift a photon under a floor above it.
-pub fn off_plane_visibility(scene: &Scene, q: Vec3, n: Vec3, plane: f32) -> impl Fn(Vec3, Vec3) -> bool + '_ {
+/// The lift is ¾ of the photon's height above the plane (at least 10⁻³ of its distance, and at
+/// least the filter's [`Filter::slack`], the points' rounding): enough to clear a convex crease
+/// or a curved neighbour between them (a chord dips below a sphere by a quarter of that height),
+/// not enough to lift a photon under a floor above it. `filter` is the query's, with its plane.
+pub fn off_plane_visibility<'s>(scene: &'s Scene, q: Vec3, filter: &Filter) -> impl Fn(Vec3, Vec3) -> bool + 's {
+    let (n, plane, slack) = (filter.n, filter.plane, filter.slack);
     move |p, m| {
         let d = p - q;
         let (h, d2) = (d.dot(n), d.length_squared());
-        if h >= 0.0 || h * h <= plane * plane * d2 {
+        if h >= 0.0 || h * h <= plane * plane * d2 + slack * slack {
             return true;
         }
-        let lift = (0.75 * h.abs()).max(1e-3 * d2.sqrt());
+        let lift = (0.75 * h.abs()).max(1e-3 * d2.sqrt()).max(slack);
         let from = q + n * lift;
         !scene.occluded(from, p + m * lift - from, 1.0)
     }
@@ -260,10 +262,12 @@ pub fn off_plane_visibility(scene: &Scene, q: Vec3, n: Vec3, plane: f32) -> impl
 
 /// Whether a photon (position, normal) is visible from the point `q` (normal `n`, on the side
 /// the estimate looks from), for [`Settings::visibility`]: the segment between them, both lifted
-/// off their surfaces by 10⁻³ of the search radius `r` (far above rounding, far below any wall
-/// worth stopping light), meets nothing.
+/// off their surfaces by 10⁻³ of the search radius `r` (far below any wall worth stopping light)
+/// or by the points' rounding ([`position_slack`]: far from the origin 10⁻³ of a radius can be
+/// less than an ulp of a coordinate, and the segment would start inside its own surface),
+/// whichever is more, meets nothing.
 pub fn photon_visibility(scene: &Scene, q: Vec3, n: Vec3, r: f32) -> impl Fn(Vec3, Vec3) -> bool + '_ {
-    let lift = 1e-3 * r;
+    let lift = (1e-3 * r).max(position_slack(q, n));
     let from = q + n * lift;
     move |p, m| !scene.occluded(from, p + m * lift - from, 1.0)
 }
@@ -369,7 +373,7 @@ pub fn map_radiance<'a>(
             r_max: ctx.global_radius,
             kernel: ctx.settings.kernel,
             // At a flat point, a point off its plane (under a thin floor) is never the nearest.
-            filter: Filter { n: ng, flags_mask: 0, plane: if sp.flat { OFF_PLANE } else { 0.0 } },
+            filter: Filter::at(sp.p, ng, 0).with_plane(if sp.flat { OFF_PLANE } else { 0.0 }),
         };
         if let Some(&(_, i)) = irr.nearest(ctx.settings.code_path, &lookup, scratch).first() {
             // With visibility on, a point behind a wall is not read: the full estimate below is.

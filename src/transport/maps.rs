@@ -88,7 +88,7 @@ fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings,
                         k: settings.k as usize,
                         r_max: radius,
                         kernel: settings.kernel,
-                        filter: Filter { n: src.normal, flags_mask: 0, plane },
+                        filter: Filter::at(src.position, src.normal, 0).with_plane(plane),
                     };
                     let f = Reflectance::Constant(Vec3::ONE);
                     let set = settings.code_path;
