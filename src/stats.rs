@@ -514,9 +514,10 @@ pub struct ParallelStats {
     pub outside_regions_s: f64,
     /// Parallel regions (each a fork and a join where the threads are more than one).
     pub regions: u64,
-    /// `busy_s / (threads × wall_s)`, in [0, 1]: the share of the threads' time spent working.
+    /// `busy_s / (threads × wall_s)`, in [0, 1] when the meter is right (not clamped): the
+    /// share of the threads' time spent working.
     pub utilisation: f64,
-    /// `busy_s / Σ threads × region wall`, in [0, 1]: the same inside the parallel regions only
+    /// `busy_s / Σ threads × region wall`, in [0, 1] likewise: the same inside the parallel regions only
     /// (what barriers, idle workers and too few chunks cost).
     pub region_utilisation: f64,
 }
@@ -525,14 +526,16 @@ impl ParallelStats {
     /// The stats of a render that took `wall_s` on `threads` threads, its meter read at the end.
     #[must_use]
     pub fn new(m: crate::parallel::MeterReading, threads: usize, wall_s: f64) -> ParallelStats {
+        // Not clamped: a metering fault (busy time above the capacity, regions longer than the
+        // render) must show in the figures, and the tests assert they stay in range.
         let threads = threads.max(1);
-        let share = |num: f64, den: f64| if den > 0.0 { (num / den).clamp(0.0, 1.0) } else { 0.0 };
+        let share = |num: f64, den: f64| if den > 0.0 { num / den } else { 0.0 };
         ParallelStats {
             threads,
             wall_s,
             busy_s: m.busy_s,
-            in_regions_s: m.in_regions_s.min(wall_s),
-            outside_regions_s: (wall_s - m.in_regions_s).max(0.0),
+            in_regions_s: m.in_regions_s,
+            outside_regions_s: wall_s - m.in_regions_s,
             regions: m.regions,
             utilisation: share(m.busy_s, threads as f64 * wall_s),
             region_utilisation: share(m.busy_s, m.capacity_s),

@@ -11,7 +11,9 @@
 //! (24², 2 spp, 10 000 photons per map, 4 gather rays; the engines alternate by seed, as they
 //! agree per pixel: tests/wavefront.rs) gives a mean `v_s`. Its spread over the seeds, σ, is
 //! estimated robustly (1.4826 × the median absolute deviation, which one runaway seed cannot
-//! inflate). The claims, with σ and the path tracer's truth T ± se (24², 512 spp, 64 bounces):
+//! inflate), must stay within 1.25 times the value recorded in [`SIGMA`], and the claims take σ
+//! from that record, so that a noisier renderer cannot widen its own tolerance. The claims, with
+//! σ and the path tracer's truth T ± se (24², 512 spp, 64 bounces):
 //! - no seed gains energy: `v_s ≤ 2 · 1.01 + 6σ` — 1 % for the density estimates' bias (their
 //!   kernel and boundary: measured at most 0.6 % above T over the seeds' mean), and 6σ, whose
 //!   chance excess for a normal spread is 2·10⁻⁹ a seed;
@@ -84,12 +86,41 @@ fn median(v: &[f64]) -> f64 {
     }
 }
 
+/// The seeds' spread σ of each object's mean, per variant, as measured at issue 53 (robust:
+/// 1.4826 × the median absolute deviation over the 32 seeds; the smooth, one-ulp and f64-normal
+/// variants measure alike). The claims below take their σ from here, not from the run, so a
+/// noisier renderer cannot widen its own tolerance: a run whose measured σ exceeds 1.25 times
+/// this fails (the MAD estimate over 32 seeds has a sampling error of about 20 % of σ, so a
+/// change of renderer that keeps the noise may move it that far; each seed's render is
+/// deterministic, so the figure moves only when the renderer does, and is then looked at and
+/// recorded again). Every object listed must
+/// be found in the image, and every object found must be listed. White and glossy are noisy:
+/// their direct light is sampled from the furnace's own surface alone, with no BSDF sampling
+/// to weigh it against (multiple importance sampling, not built yet), so a light sample across
+/// a crease of the tessellated sphere or in the glossy lobe's peak weighs tens of times the
+/// mean.
+const SIGMA: &[(&str, &[(&str, f64)])] = &[
+    ("smooth", &[("furnace", 0.0107), ("white", 0.1756), ("mirror", 0.0390), ("glass", 0.0308), ("glossy", 0.4067)]),
+    ("flat", &[("furnace", 0.0146), ("white", 0.1865), ("mirror", 0.0317), ("glass", 0.0316), ("glossy", 0.3649)]),
+    ("one ulp", &[("furnace", 0.0107), ("white", 0.1756), ("mirror", 0.0390), ("glass", 0.0308), ("glossy", 0.4067)]),
+    (
+        "f64 normals",
+        &[("furnace", 0.0107), ("white", 0.1756), ("mirror", 0.0390), ("glass", 0.0308), ("glossy", 0.4067)],
+    ),
+    ("rough", &[("furnace", 0.0139), ("white", 0.1515), ("mirror", 0.3217), ("glass", 0.0811), ("glossy", 0.0408)]),
+    ("nested", &[("furnace", 0.0541), ("glass", 0.0284), ("water", 0.0075)]),
+];
+
 /// Renders `scene` at every seed and checks the claims of the module notes per object; returns
 /// (object, seeds' mean) for the caller's own claims.
 fn furnace_at_every_seed(name: &str, scene: Scene, camera: photonwave::scene::Camera) -> Vec<(String, f64)> {
     let scene = Arc::new(scene);
     let rays = camera.prepare(SIZE as u32, SIZE as u32).unwrap();
     let objects = regions(&scene, &rays);
+    let recorded = SIGMA.iter().find(|(v, _)| *v == name).unwrap_or_else(|| panic!("{name}: no recorded σ")).1;
+    let found: Vec<&str> = objects.iter().map(|(o, _)| o.as_str()).collect();
+    let listed: Vec<&str> = recorded.iter().map(|(o, _)| *o).collect();
+    assert_eq!(found, listed, "{name}: the objects in view");
     let base = Settings {
         width: SIZE as u32,
         height: SIZE as u32,
@@ -121,7 +152,12 @@ fn furnace_at_every_seed(name: &str, scene: Scene, camera: photonwave::scene::Ca
         let v: Vec<f64> = per_seed.iter().map(|m| m[k]).collect();
         let (t, se) = truth[k];
         let mid = median(&v);
-        let sigma = 1.4826 * median(&v.iter().map(|x| (x - mid).abs()).collect::<Vec<f64>>());
+        let measured = 1.4826 * median(&v.iter().map(|x| (x - mid).abs()).collect::<Vec<f64>>());
+        let sigma = recorded[k].1;
+        assert!(
+            measured <= 1.25 * sigma,
+            "{name}, {object}: the seeds' spread σ {measured:.4} exceeds 1.25 × the recorded {sigma}"
+        );
         let mean = v.iter().sum::<f64>() / n;
         let (worst_seed, worst) = common::SEEDS
             .zip(&v)
@@ -130,8 +166,8 @@ fn furnace_at_every_seed(name: &str, scene: Scene, camera: photonwave::scene::Ca
             .unwrap();
         let brightest = v.iter().copied().fold(f64::MIN, f64::max);
         println!(
-            "{name}, {object}: path tracer {t:.4} ± {se:.4}; seeds' mean {mean:.4}, median {mid:.4}, σ {sigma:.4}, \
-             brightest {brightest:.4}, worst seed {worst_seed} at {worst:.4} ({:+.1}σ)",
+            "{name}, {object}: path tracer {t:.4} ± {se:.4}; seeds' mean {mean:.4}, median {mid:.4}, σ {measured:.4} \
+             (recorded {sigma}), brightest {brightest:.4}, worst seed {worst_seed} at {worst:.4} ({:+.1}σ)",
             (worst - mid) / sigma.max(1e-12)
         );
         assert!(t <= 2.0 + 4.0 * se + 0.01, "{name}, path tracer, {object}: {t} > 2");
@@ -152,8 +188,7 @@ fn furnace_at_every_seed(name: &str, scene: Scene, camera: photonwave::scene::Ca
 #[test]
 fn a_smooth_shaded_furnace_never_gains_energy_at_any_seed() {
     let loaded = hard("furnace-materials.toml");
-    let objects = furnace_at_every_seed("smooth", loaded.scene, loaded.camera.unwrap());
-    assert_eq!(objects.len(), 5, "{objects:?}");
+    furnace_at_every_seed("smooth", loaded.scene, loaded.camera.unwrap());
 }
 
 /// The same spheres flat-shaded: every vertex normal is its triangle's geometric normal, so
@@ -230,7 +265,6 @@ fn nested_dielectrics_conserve_energy_at_every_seed() {
     assert!(coincident.iter().any(|w| w.contains("triangle pairs of `glass` and `water`")), "{coincident:?}");
     let loaded = hard("nested.toml");
     let objects = furnace_at_every_seed("nested", loaded.scene, loaded.camera.unwrap());
-    assert!(objects.iter().any(|(o, _)| o == "water") && objects.iter().any(|(o, _)| o == "glass"), "{objects:?}");
     for (object, mean) in objects {
         assert!(mean > 2.0 * 0.98, "{object}: {mean}, not 2");
     }

@@ -533,3 +533,96 @@ fn mitsuba_shapes_materials_emitters_and_errors() {
         assert!(e.contains(want) && e.contains("16384"), "{want}: {e}");
     }
 }
+
+/// The Mitsuba paths the first test leaves out (issue 53): every `fov_axis`, `phong`, the
+/// Beckmann default and anisotropic `alpha_u`/`alpha_v` (each rendered as GGX of the mean α and
+/// warned of), `bitmap` and `checkerboard` textures, and the `envmap` emitter's quarter turn:
+/// Mitsuba's lat-long u is atan2(x, −z)/2π, so the texel it shows at direction (sin φ, 0, −cos φ)
+/// is column φ/2π of its file; photonwave must return that texel there.
+#[test]
+fn mitsuba_textures_envmaps_phong_and_every_fov_axis() {
+    let d = scratch_dir("mitsuba-more");
+    let png = |name: &str, w: u32, h: u32, rgb: &[u8]| {
+        let mut bytes = Vec::new();
+        {
+            let mut enc = png::Encoder::new(&mut bytes, w, h);
+            enc.set_color(png::ColorType::Rgb);
+            enc.set_depth(png::BitDepth::Eight);
+            enc.write_header().unwrap().write_image_data(rgb).unwrap();
+        }
+        write(&d, name, bytes);
+    };
+    // An 8 × 4 sky: column c has red 30·c, green 200 and blue 0 in every row.
+    let sky: Vec<u8> = (0..4).flat_map(|_| (0..8u8).flat_map(|c| [30 * c, 200, 0])).collect();
+    png("sky.png", 8, 4, &sky);
+    png("wood.png", 2, 1, &[255, 0, 0, 0, 0, 255]);
+    let scene = |axis: &str, body: &str| {
+        format!(
+            "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><string name=\"fov_axis\" value=\"{axis}\"/>\
+<float name=\"fov\" value=\"50\"/><transform name=\"to_world\"><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform>\
+<film type=\"hdrfilm\"><integer name=\"width\" value=\"40\"/><integer name=\"height\" value=\"20\"/></film></sensor>\n{body}</scene>\n"
+        )
+    };
+    // Every fov_axis of a 40 × 20 film: the vertical half-angle's tangent.
+    let t = 25f32.to_radians().tan();
+    for (axis, want) in [
+        ("x", t * 0.5),
+        ("y", t),
+        ("diagonal", t * 20.0 / (40f32 * 40.0 + 20.0 * 20.0).sqrt()),
+        ("smaller", t),
+        ("larger", t * 0.5),
+    ] {
+        let loaded =
+            load_scene(&write(&d, "a.xml", scene(axis, "<shape type=\"cube\"/><emitter type=\"constant\"/>\n")))
+                .unwrap();
+        let fov = loaded.camera.unwrap().fov_deg;
+        assert!((fov - 2.0 * want.atan().to_degrees()).abs() < 1e-4, "fov_axis {axis}: {fov}°");
+    }
+    let body = "<shape type=\"cube\"><bsdf type=\"phong\"><rgb name=\"diffuse_reflectance\" value=\"0.6\"/>\
+<rgb name=\"specular_reflectance\" value=\"0.8\"/><float name=\"exponent\" value=\"40\"/></bsdf></shape>\n\
+<shape type=\"sphere\"><bsdf type=\"roughconductor\"><string name=\"material\" value=\"Ag\"/>\
+<float name=\"alpha_u\" value=\"0.1\"/><float name=\"alpha_v\" value=\"0.3\"/></bsdf></shape>\n\
+<shape type=\"disk\"><bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\">\
+<string name=\"filename\" value=\"wood.png\"/><float name=\"uvscale\" value=\"2\"/></texture></bsdf></shape>\n\
+<shape type=\"rectangle\"><bsdf type=\"diffuse\"><texture type=\"checkerboard\" name=\"reflectance\">\
+<rgb name=\"color0\" value=\"0.1, 0.2, 0.3\"/><rgb name=\"color1\" value=\"0.7\"/></texture></bsdf></shape>\n\
+<emitter type=\"envmap\"><string name=\"filename\" value=\"sky.png\"/><float name=\"scale\" value=\"2\"/></emitter>\n";
+    let loaded = load_scene(&write(&d, "b.xml", scene("x", body))).unwrap();
+    let s = &loaded.scene;
+    let kinds: Vec<String> = s.materials.iter().map(|m| format!("{:?}", m.bsdf)).collect();
+    // Phong: kd + ks = 1.4 > 1, both scaled by 1/1.4 (energy), exponent as written.
+    assert!(
+        s.materials.iter().any(|m| matches!(m.bsdf, Bsdf::Glossy { kd, ks, exponent }
+            if (kd - Vec3::splat(0.6 / 1.4)).abs().max_element() < 1e-6
+                && (ks - Vec3::splat(0.8 / 1.4)).abs().max_element() < 1e-6 && exponent == 40.0)),
+        "{kinds:?}"
+    );
+    // Anisotropic Beckmann (the default distribution): GGX of the mean α, 0.2, both warned of.
+    assert!(s
+        .materials
+        .iter()
+        .any(|m| matches!(m.bsdf, Bsdf::RoughConductor { alpha, .. } if (alpha - 0.2).abs() < 1e-6)));
+    let w = s.warnings.join("\n");
+    assert!(
+        w.contains("anisotropic roughness (0.1, 0.3)") && w.contains("beckmann distribution is rendered as GGX"),
+        "{w}"
+    );
+    // The bitmap: sRGB decoded, its uvscale kept.
+    let wood = s.materials.iter().find_map(|m| m.maps.kd.as_ref().filter(|t| t.width == 2)).expect("the bitmap");
+    assert_eq!((wood.texels[0], wood.texels[1]), (Vec3::X, Vec3::Z));
+    // The checkerboard: color0 in the first quarter, color1 beside it (linear colours).
+    let board = s.materials.iter().find_map(|m| m.maps.kd.as_ref().filter(|t| t.width == 256)).expect("the board");
+    assert_eq!((board.texels[0], board.texels[200]), (Vec3::new(0.1, 0.2, 0.3), Vec3::splat(0.7)));
+    assert_eq!(board.texels[200 * 256], Vec3::splat(0.7));
+    // The envmap: at azimuth φ from −z toward +x, Mitsuba shows column φ/2π of its file.
+    let env = s.environment.as_ref().expect("the envmap");
+    // An envmap is radiance: its 8-bit texels are read as linear values.
+    let linear = |b: u8| f32::from(b) / 255.0;
+    for column in 0..8u8 {
+        let phi = (f32::from(column) + 0.5) / 8.0 * std::f32::consts::TAU;
+        let up = Vec3::new(phi.sin(), 0.5, -phi.cos()).normalize();
+        let want = 2.0 * Vec3::new(linear(30 * column), linear(200), 0.0);
+        let got = env.radiance(up);
+        assert!((got - want).abs().max_element() < 1e-5, "column {column}: {got} against {want}");
+    }
+}

@@ -296,9 +296,11 @@ fn per_pixel_radii_apply_to_their_own_pixel_only() {
 }
 
 /// Each pixel's first radius is a k-NN radius capped at the maximum radius: small in the glass
-/// sphere's focused caustic (a few pixels find their 48 photons within it, one within half of
-/// it), the maximum where the caustic is sparse; global radii only where the camera reads the
-/// global map.
+/// sphere's focused caustic, the maximum where the caustic is sparse; global radii only where
+/// the camera reads the global map. Measured (issue 53): 46 of the 576 pixels find their 48
+/// photons within the maximum radius and 43 within half of it (the spot under the sphere, about
+/// 7 pixels across); at least 10 of each are asserted — a caustic lost, or blurred to the
+/// maximum radius, leaves none. (Commit 25a6eb9 had relaxed it from 3 to 1 focused pixel.)
 #[test]
 fn pixel_radii_follow_the_photon_density() {
     use photonwave::progressive::{initial_radii, pixel_radii};
@@ -314,7 +316,12 @@ fn pixel_radii_follow_the_photon_density() {
     let mut sorted = pixels.caustic.clone();
     sorted.sort_by(f32::total_cmp);
     let dense = pixels.caustic.iter().filter(|&&r| r < r_max).count();
-    assert!(dense >= 3 && focused >= 1, "{dense} pixels with a dense caustic, {focused} focused: {:?}", &sorted[..10]);
+    println!("{dense} pixels with a dense caustic, {focused} focused: {:?}", &sorted[..10]);
+    assert!(
+        dense >= 10 && focused >= 10,
+        "{dense} pixels with a dense caustic, {focused} focused: {:?}",
+        &sorted[..10]
+    );
     assert!(pixels.caustic.iter().filter(|&&r| r == r_max).count() > 24 * 24 / 2);
     assert!(pixels.global.iter().all(|&r| r > 0.0 && r <= s.global_radius * d));
 

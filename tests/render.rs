@@ -129,7 +129,6 @@ fn more_threads_than_work_give_the_same_image_and_utilisation_is_a_share() {
                     let most = f64::from(threads) * st.seconds * 1.01 + 1e-4;
                     assert!((0.0..=most).contains(&st.busy_seconds), "{what}: {name} busy {st:?}");
                 }
-                assert!(p.amdahl_speedup(16) >= 1.0 && p.amdahl_speedup(16) <= 16.0, "{what}: {p:?}");
             }
         }
     }
