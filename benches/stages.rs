@@ -7,7 +7,6 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::system::RunSystemOnce;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec3;
-use photonwave::film::Terms;
 use photonwave::reference::build_maps;
 use photonwave::rng::Domain;
 use photonwave::scene::file::load_scene;
@@ -48,7 +47,8 @@ fn setup(threads: usize) -> World {
         classified: Classified::default(),
         shadows: ShadowQueue::default(),
         terms: Vec::new(),
-        film: vec![Terms::default(); 128 * 128],
+        film: Vec::new(),
+        open: Default::default(),
         rays: Default::default(),
         numerics: Default::default(),
     });

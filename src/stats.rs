@@ -390,6 +390,10 @@ pub struct StageStat {
     pub runs: u64,
     /// Lanes it processed.
     pub items: u64,
+    /// The most lanes one run processed: for the camera pass's stages, the most one worker's
+    /// queues held at once (what bounds its memory).
+    #[serde(default)]
+    pub max_items: u64,
     /// Wall time inside it, summed over the workers that ran it where it runs inside each
     /// worker's own tiles (the camera pass's stages).
     pub seconds: f64,
@@ -411,6 +415,7 @@ impl std::ops::AddAssign<&StageStats> for StageStats {
             let e = self.0.entry(name.clone()).or_default();
             e.runs += s.runs;
             e.items += s.items;
+            e.max_items = e.max_items.max(s.max_items);
             e.seconds += s.seconds;
             e.busy_seconds += s.busy_seconds;
         }
@@ -441,6 +446,7 @@ impl StageStats {
         let e = self.0.entry(system.to_string()).or_default();
         e.runs += 1;
         e.items += items as u64;
+        e.max_items = e.max_items.max(items as u64);
         let seconds = start.start.elapsed().as_secs_f64();
         e.seconds += seconds;
         e.busy_seconds += match (start.busy_s, crate::parallel::busy_seconds()) {

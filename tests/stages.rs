@@ -183,7 +183,8 @@ fn camera_world(segments: &[(usize, PathKind)]) -> World {
         classified: Classified::default(),
         shadows: ShadowQueue::default(),
         terms: vec![Terms::default(); 8],
-        film: vec![Terms::default(); 2],
+        film: Vec::new(),
+        open: Default::default(),
         rays: Default::default(),
         numerics: Default::default(),
     });

@@ -243,3 +243,45 @@ fn tiles_of_any_size_at_any_thread_count_give_the_same_image() {
         }
     }
 }
+
+/// Memory at any spp (issue 53): a camera tile is whole pixels, so a pixel of 65 536 samples
+/// once made one wave of 65 536 samples and their gather rays on every worker, whatever the
+/// in-flight bound. Now such a pixel runs as waves of the tile's size: at 16 threads no stage
+/// of the camera pass holds more than `tile_for`'s 512 samples and their gather rays, and the
+/// pixel is the reference engine's to 10⁻⁶ (its mean carried from wave to wave in sample
+/// order).
+#[test]
+fn a_pixel_of_65536_samples_keeps_the_in_flight_bound() {
+    use photonwave::engine::{render, Engine};
+    use photonwave::wavefront::camera_pass::tile_for;
+    let loaded = load("cornell-spheres.toml");
+    let s = Settings {
+        width: 1,
+        height: 1,
+        spp: 65_536,
+        photons: 2_000,
+        caustic_photons: 1_000,
+        gather_rays: 2,
+        threads: 16,
+        ..Default::default()
+    };
+    let rays = loaded.camera.unwrap().prepare(1, 1).unwrap();
+    let scene = Arc::new(loaded.scene);
+    let (wave, stats) = render(&scene, &rays, &s, Engine::Wavefront, None, &NoProgress).unwrap();
+    let tile = tile_for(65_536, 16) as u64;
+    assert_eq!(tile, 512);
+    let stages = &stats.stages.expect("the wavefront engine's stages").0;
+    let most = |name: &str| stages.get(name).map_or(0, |st| st.max_items);
+    assert_eq!(most("emit_camera_rays"), tile);
+    assert_eq!(stages["emit_camera_rays"].items, 65_536);
+    assert_eq!(most("resolve_wave"), tile);
+    // A bounce's queue holds the wave's paths and, from the second bounce, their gather rays.
+    let lanes = tile * (1 + u64::from(s.gather_rays));
+    for name in ["intersect_paths", "classify_paths", "shade_direct", "spawn_gather_rays", "gather_global"] {
+        assert!((1..=lanes).contains(&most(name)), "{name}: {} lanes in one run (at most {lanes})", most(name));
+    }
+    let reference =
+        render(&scene, &rays, &Settings { threads: 2, ..s.clone() }, Engine::Reference, None, &NoProgress).unwrap().0;
+    let d = max_rel_diff(&reference, &wave);
+    assert!(d < 1e-6, "max relative difference {d}");
+}

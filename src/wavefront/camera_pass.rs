@@ -17,7 +17,7 @@ use super::queues::{Classified, PathQueue, ShadowQueue};
 use super::resources::{CameraWork, Maps};
 use super::schedule::CameraPass;
 use super::{new_world, IdleWorlds, StageStats};
-use crate::film::Terms;
+use crate::film::{PixelMean, Terms};
 use crate::job::Job;
 use crate::parallel::map_chunks;
 use crate::progress::Progress;
@@ -35,9 +35,10 @@ use std::sync::Arc;
 pub const TILE: usize = 4096;
 /// Samples per tile at least, where smaller images or many workers cut finer ([`tile_for`]).
 pub const MIN_TILE: usize = 512;
-/// Samples in flight over all workers at most (down to [`MIN_TILE`] per worker): a worker's
-/// queues take ~9 MB per 4 096 samples at 16 gather rays (measured on cornell-spheres), so
-/// without this bound 16 workers held 3.3× the queues of two.
+/// Samples in flight over all workers at most (down to [`MIN_TILE`] per worker), at any spp (a
+/// pixel of more samples than a tile runs as several waves): a worker's queues take ~9 MB per
+/// 4 096 samples at 16 gather rays (measured on cornell-spheres), so without this bound 16
+/// workers held 3.3× the queues of two.
 pub const IN_FLIGHT: usize = 2 * TILE;
 /// Tiles per worker wanted, so that the last tiles even out the workers' loads.
 const TILES_PER_WORKER: usize = 8;
@@ -79,6 +80,7 @@ fn worker_world(scene: &Arc<Scene>, job: &Job, maps: &Arc<PhotonMaps>, camera: &
         shadows: ShadowQueue::default(),
         terms: Vec::new(),
         film: Vec::new(),
+        open: PixelMean::default(),
         rays: RayCounts::default(),
         numerics: Numerics::default(),
     });
@@ -87,8 +89,10 @@ fn worker_world(scene: &Arc<Scene>, job: &Job, maps: &Arc<PhotonMaps>, camera: &
 
 /// Renders every sample of `job`'s image through the camera schedule, in tiles of `tile`
 /// samples (whole pixels, at least one; the render uses [`tile_for`]) on `job.threads` workers, each
-/// with its own world (built on first use, kept for its next tiles). The image is the same for
-/// any `tile` and thread count.
+/// with its own world (built on first use, kept for its next tiles). A tile of one pixel with more
+/// samples than `tile` (`--spp` above it) runs as waves of `tile` samples, so a worker's queues
+/// never hold more than `tile` samples whatever the spp. The image is the same for any `tile` and
+/// thread count.
 #[must_use]
 pub fn camera_pass(
     scene: &Arc<Scene>,
@@ -115,12 +119,19 @@ pub fn camera_pass(
             let film = idle.with(
                 || worker_world(scene, &worker_job, maps, camera),
                 |world| {
-                    {
-                        let mut w = world.resource_mut::<CameraWork>();
-                        w.first_sample = (first * spp) as u64;
-                        w.count = count * spp;
+                    // One wave of the tile's samples, or, for a pixel of more samples than a
+                    // tile holds, waves of `tile` samples each, the pixel's mean carried from
+                    // one to the next in sample order (the same sums, so the same image).
+                    let samples = count * spp;
+                    world.resource_mut::<CameraWork>().film.clear();
+                    for start in (0..samples).step_by(tile.max(1)) {
+                        {
+                            let mut w = world.resource_mut::<CameraWork>();
+                            w.first_sample = (first * spp + start) as u64;
+                            w.count = tile.max(1).min(samples - start);
+                        }
+                        world.run_schedule(CameraPass);
                     }
-                    world.run_schedule(CameraPass);
                     std::mem::take(&mut world.resource_mut::<CameraWork>().film)
                 },
             );

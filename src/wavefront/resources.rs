@@ -2,7 +2,7 @@
 //! and the state of the photon pass and of a camera wave, with their queues.
 
 use super::queues::{Classified, PathQueue, PhotonQueue, ShadowQueue};
-use crate::film::Terms;
+use crate::film::{PixelMean, Terms};
 use crate::job::Job;
 use crate::photon_map::Photon;
 use crate::rng::Domain;
@@ -78,8 +78,12 @@ pub struct CameraWork {
     pub shadows: ShadowQueue,
     /// Per-sample terms of the wave.
     pub terms: Vec<Terms>,
-    /// The tile's pixels, resolved after its bounce loop.
+    /// The tile's pixels, resolved after each wave's bounce loop (a tile of one pixel with more
+    /// samples than a wave holds takes several waves: [`super::camera_pass::camera_pass`]).
     pub film: Vec<Terms>,
+    /// The running mean of a pixel whose samples the wave so far has not finished (its next
+    /// wave goes on adding to it).
+    pub open: PixelMean,
     /// Rays traced, over the worker's tiles.
     pub rays: RayCounts,
     /// Samples dropped as non-finite, and pixel sums that overflowed, over the worker's tiles.

@@ -7,7 +7,7 @@
 
 use super::queues::{PathKind, PathQueue, PhotonLane, PhotonQueue, Segment, ShadowLane, ShadowQueue};
 use super::{par_columns, par_lanes, CameraWork, Maps, PhotonWork, Shared, StageClock, StageStats, CHUNK};
-use crate::film::{PixelMean, Term};
+use crate::film::Term;
 use crate::rng::{Domain, Sampler};
 use crate::transport::direct::{direct_light_rays, ShadowRay};
 use crate::transport::gather::{gather_rays, glossy_ray};
@@ -343,19 +343,21 @@ pub fn refract_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stat
 }
 
 /// Averages each pixel's samples (dropping non-finite ones, as the reference does) into the
-/// tile's pixels.
+/// tile's pixels, in sample order; a pixel whose samples go on in the tile's next wave is left
+/// open ([`CameraWork::open`]).
 pub fn resolve_wave(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = StageClock::start();
-    let spp = shared.job.settings.spp as usize;
+    let spp = shared.job.settings.spp as u64;
+    let inv = 1.0 / spp as f32;
     let w = &mut *work;
-    w.film.clear();
-    for samples in w.terms.chunks(spp) {
-        let mut mean = PixelMean::default();
-        for t in samples {
-            mean.add(*t, 1.0 / spp as f32);
+    // In sample order, each pixel's mean finished at its last sample; a pixel this wave does
+    // not finish stays open for the tile's next wave.
+    for (lane, t) in w.terms.iter().enumerate() {
+        w.open.add(*t, inv);
+        if (w.first_sample + lane as u64 + 1).is_multiple_of(spp) {
+            let pixel = std::mem::take(&mut w.open).finish(inv, &mut w.numerics);
+            w.film.push(pixel);
         }
-        let pixel = mean.finish(1.0 / spp as f32, &mut w.numerics);
-        w.film.push(pixel);
     }
     stats.record("resolve_wave", w.count, t);
 }
