@@ -180,6 +180,42 @@ fn the_cli_reports_errors_with_a_nonzero_exit() {
     assert!(code != 0 && e.contains("/no/such/dir/x.exr"), "{e}");
 }
 
+/// A scene far from the origin is rendered in its own frame (issue 53): the CLI says so, and
+/// its `--eye` and `--target`, given in the file's coordinates, move with the scene — the same
+/// camera given on the command line renders the file's camera's image, byte for byte.
+#[test]
+fn the_cli_places_a_far_scene_and_its_camera_in_its_frame() {
+    let d = scratch_dir("cli-far");
+    let obj = bundled("cornell-box.obj");
+    let toml = format!(
+        "[[mesh]]\nfile = {obj:?}\ntranslate = [30000, -20000, 10000]\n[camera]\neye = [30000, -19999.727, 10001.08]\n\
+         target = [30000, -19999.727, 10000]\nfov = 39.3\n"
+    );
+    let scene = d.join("far.toml");
+    std::fs::write(&scene, toml).unwrap();
+    let render = |png: &str, extra: &[&str]| {
+        let out = d.join(png);
+        let mut args = vec!["render", scene.to_str().unwrap(), "-o"];
+        let exr = d.join(format!("{png}.exr"));
+        args.extend([exr.to_str().unwrap(), "--png", out.to_str().unwrap(), "--width", "16", "--height", "16"]);
+        args.extend(["--spp", "1", "--photons", "2000", "--caustic-photons", "1000", "--threads", "1"]);
+        args.extend(extra);
+        let (code, e) = cli(&args);
+        assert_eq!(code, 0, "{e}");
+        (std::fs::read(out).unwrap(), e)
+    };
+    let (file_camera, said) = render("a.png", &[]);
+    assert!(said.contains("frame: the scene lies") && said.contains("moved to its centre"), "{said}");
+    let mut reader = png::Decoder::new(std::io::Cursor::new(&file_camera)).read_info().unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+    reader.next_frame(&mut pixels).unwrap();
+    assert!(pixels.iter().filter(|&&b| b > 8).count() > pixels.len() / 4, "a dark image: the camera looks away");
+    let (flags, _) = render("b.png", &["--eye", "30000,-19999.727,10001.08", "--target", "30000,-19999.727,10000"]);
+    assert!(file_camera == flags, "the command line's camera renders another image");
+    let (aside, _) = render("c.png", &["--eye", "30000.1,-19999.727,10001.08"]);
+    assert!(file_camera != aside, "--eye was not read");
+}
+
 #[test]
 fn the_cli_renders_and_writes_stats() {
     let d = scratch_dir("cli-ok");

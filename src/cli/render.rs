@@ -284,6 +284,17 @@ pub fn run(args: RenderArgs) -> Result<()> {
         scene.area_lights.len(),
         significant(scene.total_power().element_sum() / 3.0)
     ));
+    if scene.origin != Vec3::ZERO {
+        let o = scene.origin;
+        say.info(format!(
+            "frame: the scene lies {} units from the origin, far for its size; it is rendered moved to its centre \
+             ({}, {}, {}), where f32 holds its detail (the camera and lights move with it)\n",
+            significant(o.length()),
+            significant(o.x),
+            significant(o.y),
+            significant(o.z)
+        ));
+    }
     if args.engine == Engine::Path {
         say.info(
             "plan: path tracing with next-event estimation — every term sampled from the camera; no photon maps\n",
