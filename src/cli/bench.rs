@@ -113,8 +113,10 @@ pub fn run(args: BenchArgs) -> Result<()> {
         if !args.json {
             eprintln!("{label}: {} triangles", loaded.scene.triangle_count());
         }
+        // `--light` is in the file's coordinates; the shadow rays aim at it in the scene's frame.
+        let options = bench::Options { light: args.light.map(|p| loaded.scene.to_frame(p)), ..options.clone() };
         if args.thin_sweep && options.traversal {
-            let sets = bench::RaySets::with_light(&loaded.scene, &cam, args.light);
+            let sets = bench::RaySets::with_light(&loaded.scene, &cam, options.light);
             for (rays, query, thin, mrays) in
                 bench::thin_sweep(&loaded.scene, &sets, &[0, 1, 2, 3, 4], args.reps as usize)
             {
