@@ -578,3 +578,52 @@ impl ParallelStats {
         )
     }
 }
+
+#[cfg(test)]
+mod meter_tests {
+    use crate::parallel::{map_chunks, metered, Meter};
+    use std::sync::Arc;
+    use std::time::{Duration, Instant};
+
+    /// The meter on a workload of known busy time, read raw (no clamp between it and the test):
+    /// 4 chunks of a 20 ms sleep on 4 threads, the first of which also starts a nested region
+    /// of 8 such chunks on 4 threads (sleeping takes no core, so 4 threads run at once even on 2
+    /// cores). The nested region is part of its chunk's time and is neither counted again nor
+    /// counted as a region: busy is at least the sleeps' 4 × 20 ms + 2 rounds of the nested 8
+    /// on 4 threads (120 ms), it is one region, and busy never exceeds the capacity (4 × the
+    /// region's wall) — which counting the nested chunks again (160 ms more, 280 ms against a
+    /// capacity of about 4 × 60 ms) would break, as would busy time taken from the wrong clock.
+    #[test]
+    fn the_meter_counts_known_busy_time_once() {
+        let sleep = || std::thread::sleep(Duration::from_millis(20));
+        let meter = Arc::new(Meter::default());
+        let start = Instant::now();
+        let sizes = metered(&meter, || {
+            map_chunks(
+                4,
+                1,
+                4,
+                |r| {
+                    sleep();
+                    if r.start == 0 {
+                        map_chunks(8, 1, 4, |_| sleep(), |_| {}).len()
+                    } else {
+                        0
+                    }
+                },
+                |_| {},
+            )
+        });
+        let wall = start.elapsed().as_secs_f64();
+        assert_eq!(sizes, [8, 0, 0, 0]);
+        let m = meter.reading();
+        assert_eq!(m.regions, 1, "{m:?}");
+        assert!(m.busy_s >= 0.120, "{m:?}");
+        assert!(m.busy_s <= m.capacity_s, "busy above capacity: {m:?}");
+        assert!((m.capacity_s - 4.0 * m.in_regions_s).abs() <= 1e-6, "{m:?}");
+        assert!(m.in_regions_s <= wall, "{m:?} in {wall} s");
+        let p = super::ParallelStats::new(m, 4, wall);
+        assert!(p.utilisation > 0.0 && p.utilisation <= 1.0 && p.region_utilisation <= 1.0, "{p:?}");
+        assert!(p.outside_regions_s >= 0.0 && (p.in_regions_s + p.outside_regions_s - wall).abs() < 1e-9, "{p:?}");
+    }
+}

@@ -295,8 +295,3 @@ fn frame_origin(meshes: &[MeshInput]) -> Vec3 {
     }
     centre.as_vec3()
 }
-
-/// `p` relative to `origin`: the exact difference, rounded once.
-fn relative_to(p: Vec3, origin: Vec3) -> Vec3 {
-    (p.as_dvec3() - origin.as_dvec3()).as_vec3()
-}

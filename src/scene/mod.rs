@@ -144,7 +144,7 @@ impl Scene {
         if self.origin == Vec3::ZERO {
             return p;
         }
-        (p.as_dvec3() - self.origin.as_dvec3()).as_vec3()
+        relative_to(p, self.origin)
     }
 
     /// Camera `c`, placed in the coordinates of the scene's files, in the scene's frame.
@@ -152,6 +152,12 @@ impl Scene {
     pub fn camera_to_frame(&self, c: Camera) -> Camera {
         Camera { eye: self.to_frame(c.eye), target: self.to_frame(c.target), ..c }
     }
+}
+
+/// `p` relative to `origin`: the exact difference (in f64), rounded once, so equal points stay
+/// equal bit for bit.
+fn relative_to(p: Vec3, origin: Vec3) -> Vec3 {
+    (p.as_dvec3() - origin.as_dvec3()).as_vec3()
 }
 
 /// The bounding box (lo, hi) of `points`; (+∞, −∞) for none.
