@@ -10,7 +10,8 @@ use std::path::Path;
 pub struct Terms {
     /// Emission seen directly by the camera.
     pub emitted: Vec3,
-    /// Direct light at the first non-specular hit (light sampling).
+    /// Direct light at the first non-specular hit: light sampling, and with MIS the emission
+    /// its gather and glossy rays hit straight away.
     pub direct: Vec3,
     /// Everything seen through mirrors and glass, and the glossy lobe's reflection.
     pub specular: Vec3,

@@ -267,6 +267,22 @@ pub fn plastic_sample(wo: Vec3, kd: Vec3, eta: f32, alpha: f32, u: [f32; 3]) -> 
     Some(LocalSample { wi, weight: plastic_eval(wo, wi, kd, eta, alpha) * (wi.z / pdf) })
 }
 
+/// The plastic's coat alone (its glossy lobe): F(wo·m)·D(m)·G2 / (4·wo.z·wi.z).
+#[must_use]
+pub fn plastic_coat_eval(wo: Vec3, wi: Vec3, eta: f32, alpha: f32) -> f32 {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return 0.0;
+    }
+    let m = (wo + wi).normalize();
+    fresnel_dielectric(wo.dot(m), eta) * d(m, alpha) * g2(wo, wi, alpha) / (4.0 * wo.z * wi.z)
+}
+
+/// The pdf of [`plastic_coat_sample`]: D_wo(m)/(4·wo·m), as the conductor's.
+#[must_use]
+pub fn plastic_coat_pdf(wo: Vec3, wi: Vec3, alpha: f32) -> f32 {
+    conductor_pdf(wo, wi, alpha)
+}
+
 /// Samples the plastic's coat alone (its glossy lobe): weight F(wo·m)·G2/G1(wo).
 #[must_use]
 pub fn plastic_coat_sample(wo: Vec3, eta: f32, alpha: f32, u: [f32; 2]) -> Option<LocalSample> {

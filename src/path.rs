@@ -2,7 +2,10 @@
 //! energy: same scene, materials, light sampling and random streams, no photon maps.
 //!
 //! Emission is added when the camera sees an emitter directly or through mirrors and glass;
-//! after a non-specular bounce it is left to light sampling (no double counting, no MIS).
+//! after a non-specular bounce an emissive triangle's is weighted by MIS against the light
+//! sample taken at that bounce (`transport::mis`: the power heuristic, one BSDF sample against
+//! `light_samples` light samples), and with `mis = false` left to light sampling. The
+//! environment and the sun are left to light sampling after a non-specular bounce.
 //! Terms, as the photon mapper defines them: `emitted` (seen directly), `direct` (light sampling
 //! at a non-specular first hit), `specular` (everything seen when the first hit is a mirror or
 //! glass), `indirect` (everything else; the photon mapper splits it into caustic, indirect and the
@@ -18,7 +21,8 @@ use crate::scene::Scene;
 use crate::settings::Settings;
 use crate::stats::{MapStats, Numerics, PhaseTimes, RayCounts, RenderStats};
 use crate::transport::camera::render_pixels;
-use crate::transport::direct::direct_light;
+use crate::transport::direct::weighted_direct_light;
+use crate::transport::mis::{emission_found, Strategies};
 use crate::transport::specular::{continue_ray, emission_toward};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
@@ -88,6 +92,9 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
     // the photon mapper's layers.
     let mut via_specular = false;
     let mut last_delta = true; // previous vertex was the camera or a delta bounce
+                               // The density with which the last non-delta bounce picked this ray's direction (0: MIS off).
+    let mut bsdf_density = 0.0;
+    let mis = if ctx.settings.mis { Strategies::Whole } else { Strategies::LightOnly };
     for depth in 0..=ctx.settings.max_depth {
         rays.camera += 1;
         let Some(hit) = scene.intersect(o, d, f32::INFINITY) else {
@@ -103,17 +110,24 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
         let e = emission_toward(scene, &hit, wo);
         if last_delta && e != Vec3::ZERO {
             terms.add(path_term(Term::Emitted, depth, via_specular), beta * e);
+        } else if !last_delta && e != Vec3::ZERO {
+            // Found by the previous bounce's BSDF sample: light sampling's partner there.
+            let found = emission_found(ctx, &hit, d, bsdf_density);
+            terms.add(path_term(Term::Direct, depth - 1, via_specular), beta * found);
         }
         if depth == ctx.settings.max_depth {
             break;
         }
         if !bsdf.is_delta() {
-            let l = beta * direct_light(ctx, &sp, &bsdf, wo, &s.fork(streams::path_light(depth)), rays);
+            let l = beta * weighted_direct_light(ctx, &sp, &bsdf, wo, &s.fork(streams::path_light(depth)), &mis, rays);
             terms.add(path_term(Term::Direct, depth, via_specular), l);
         }
         let Some(bs) = continue_ray(&sp, &bsdf, wo, s, streams::CAMERA_CHAIN_BOUNCE + depth) else { break };
         beta *= bs.weight;
         last_delta = bs.delta;
+        if ctx.settings.mis && !bs.delta {
+            bsdf_density = bsdf.pdf(&sp.frame, wo, bs.dir);
+        }
         if depth == 0 && bs.delta {
             via_specular = true;
         }

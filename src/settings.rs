@@ -104,6 +104,11 @@ pub struct Settings {
     pub max_depth: u32,
     /// Area-light samples per shading point.
     pub light_samples: u32,
+    /// Multiple importance sampling of emissive triangles (`transport::mis`): light samples are
+    /// weighted by the power heuristic against the final-gather and glossy rays (the path
+    /// tracer: its next bounce), which add the emission they hit, weighted likewise. On by
+    /// default; `false` leaves emitters to light sampling alone, for comparison.
+    pub mis: bool,
     /// The user's seed: a single render and the first progressive pass draw every random
     /// stream from it; later passes and the pilot pass mix their own from it.
     pub seed: u64,
@@ -176,6 +181,7 @@ impl Default for Settings {
             secondary_gather: SECONDARY_GATHER,
             max_depth: DEFAULT_MAX_DEPTH,
             light_samples: 1,
+            mis: true,
             seed: 1,
             threads: 0,
             force: Vec::new(),
@@ -258,6 +264,8 @@ pub struct Overrides {
     pub no_boundary_correction: bool,
     /// `--no-aim-caustics`.
     pub no_aim_caustics: bool,
+    /// `--no-mis`.
+    pub no_mis: bool,
     /// `--diagnostics` (turns them on; the scene file may too).
     pub diagnostics: bool,
     /// `--force`, added to the scene file's.
@@ -304,6 +312,9 @@ impl Overrides {
         }
         if self.no_aim_caustics {
             s.aim_caustics = false;
+        }
+        if self.no_mis {
+            s.mis = false;
         }
         let given = PerPass {
             spp: self.spp.is_some(),

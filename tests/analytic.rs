@@ -1,5 +1,6 @@
 //! Known answers: the white furnace, flux conservation, kernel normalisation, k-NN bias, and
-//! irradiance from an area light against Lambert's polygon formula.
+//! irradiance from an area light against Lambert's polygon formula, by light sampling and by
+//! light samples weighed against BSDF samples (MIS).
 
 mod common;
 
@@ -13,7 +14,9 @@ use photonwave::reference::photons::trace_photons;
 use photonwave::rng::{Domain, Sampler};
 use photonwave::scene::{Light, MeshInput, Scene, SurfacePoint};
 use photonwave::settings::{Kernel, Settings};
-use photonwave::transport::direct::direct_light;
+use photonwave::transport::direct::{direct_light, weighted_direct_light};
+use photonwave::transport::gather::{gather_rays, glossy_ray};
+use photonwave::transport::mis::{emission_found, Strategies};
 use photonwave::transport::photon::first_hit_power;
 use photonwave::transport::{Context, PhotonMaps};
 
@@ -210,12 +213,11 @@ fn polygon_irradiance(p: Vec3, n: Vec3, corners: &[Vec3], le: f32) -> f32 {
     0.5 * le * sum.abs()
 }
 
-#[test]
-fn quad_light_irradiance_matches_lamberts_formula() {
-    let le = 3.0f32;
+/// The quad light of radiance `le` the next two tests sit under: 1 × 1 at height 1, facing down
+/// (wound (c0, c1, c2) and (c0, c2, c3)); returns the scene and its corners.
+fn quad_light(le: f32) -> (Scene, [Vec3; 4]) {
     let corners =
         [Vec3::new(-0.5, 1.0, -0.5), Vec3::new(0.5, 1.0, -0.5), Vec3::new(0.5, 1.0, 0.5), Vec3::new(-0.5, 1.0, 0.5)];
-    // Wound to face down (−y): (c0, c1, c2) and (c0, c2, c3).
     let mesh = MeshInput {
         source: "quad".into(),
         positions: corners.to_vec(),
@@ -225,22 +227,33 @@ fn quad_light_irradiance_matches_lamberts_formula() {
         ..Default::default()
     };
     let light = Material::new("light", Bsdf::Lambert { kd: Vec3::ZERO }, Vec3::splat(le));
-    let scene = Scene::build(vec![mesh], vec![light], vec![], vec![]).unwrap();
+    (Scene::build(vec![mesh], vec![light], vec![], vec![]).unwrap(), corners)
+}
+
+/// A point of a floor facing +y at `p` (material and triangle 0).
+fn floor_point(p: Vec3) -> SurfacePoint {
+    SurfacePoint {
+        p,
+        p_error: Vec3::ZERO,
+        frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y },
+        material: 0,
+        tri: 0,
+        uv: Vec2::ZERO,
+        flat: true,
+    }
+}
+
+#[test]
+fn quad_light_irradiance_matches_lamberts_formula() {
+    let le = 3.0f32;
+    let (scene, corners) = quad_light(le);
     let settings = Settings { light_samples: 256, ..Default::default() };
     let maps = PhotonMaps::default();
     let job = job(&scene, &settings);
     let ctx = Context::new(&scene, &maps, &job);
     let white = Bsdf::Lambert { kd: Vec3::ONE };
     for p in [Vec3::ZERO, Vec3::new(0.7, 0.0, 0.3), Vec3::new(2.0, 0.3, -1.0)] {
-        let sp = SurfacePoint {
-            p,
-            p_error: Vec3::ZERO,
-            frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y },
-            material: 0,
-            tri: 0,
-            uv: Vec2::ZERO,
-            flat: true,
-        };
+        let sp = floor_point(p);
         let mut rays = Default::default();
         // E = π·L_reflected for a white Lambertian; each call averages 256 light samples.
         let values: Vec<f32> = (0..256)
@@ -255,6 +268,72 @@ fn quad_light_irradiance_matches_lamberts_formula() {
     }
 }
 
+/// Multiple importance sampling (`transport::mis`) under the quad light of the test above: one
+/// light sample weighed against 16 gather rays, plus the emission those rays hit weighed
+/// likewise, is again Lambert's formula for a white Lambertian (within 4 standard errors of 512
+/// estimates; weights that did not sum to one, such as a density missing its sample count, would
+/// be off by far more). On a Phong surface whose lobe points at the light, the light sample
+/// weighed against the gather rays and the glossy ray, plus both kinds' emission, agrees with the
+/// light sample alone (2 048 estimates each, 4 standard errors of the difference), and is the
+/// less noisy of the two (measured: standard error 0.014 against 0.033): the one shadow ray is
+/// the same, the gather and glossy rays are those the camera hit sends anyway.
+#[test]
+fn light_samples_weighed_against_gather_and_glossy_rays_keep_the_direct_light() {
+    let le = 3.0f32;
+    let (scene, corners) = quad_light(le);
+    let settings = Settings::default();
+    let maps = PhotonMaps::default();
+    let job = job(&scene, &settings);
+    let ctx = Context::new(&scene, &maps, &job);
+    let point = floor_point;
+    let n = 16;
+    // One camera sample's direct light at `sp` on `bsdf` seen from `wo` with MIS: the weighed light
+    // sample, the gather rays' emission (weight kd/n each) and the glossy ray's.
+    let mis_sample = |sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, i: u64| {
+        let s = Sampler::new(9, Domain::Camera, i);
+        let mis = Strategies::Split { gather: n, glossy: bsdf.has_glossy_lobe() };
+        let mut value = weighted_direct_light(&ctx, sp, bsdf, wo, &s.fork(1), &mis, &mut Default::default()).x;
+        gather_rays(sp, wo, n, &s.fork(2), |_, o, d| {
+            if let Some(hit) = scene.intersect(o, d, f32::INFINITY) {
+                let e = emission_found(&ctx, &hit, d, mis.gather_density(sp, wo, d));
+                value += bsdf.diffuse().x / n as f32 * e.x;
+            }
+        });
+        if let Some(ray) = glossy_ray(sp, bsdf, wo, &s.fork(3)) {
+            if let Some(hit) = scene.intersect(ray.origin, ray.dir, f32::INFINITY) {
+                value +=
+                    ray.weight.x * emission_found(&ctx, &hit, ray.dir, mis.glossy_density(sp, bsdf, wo, ray.dir)).x;
+            }
+        }
+        value
+    };
+    let white = Bsdf::Lambert { kd: Vec3::ONE };
+    for p in [Vec3::ZERO, Vec3::new(0.7, 0.0, 0.3), Vec3::new(2.0, 0.3, -1.0)] {
+        let values: Vec<f32> =
+            (0..512).map(|i| std::f32::consts::PI * mis_sample(&point(p), &white, Vec3::Y, i)).collect();
+        let (mean, se) = mean_and_se(&values);
+        let want = polygon_irradiance(p, Vec3::Y, &corners, le) as f64;
+        assert!((mean - want).abs() < 4.0 * se + 1e-5 * want, "at {p}: {mean} vs {want} (se {se})");
+    }
+    // The glossy point: its mirror direction toward the light's centre.
+    let glossy = Bsdf::Glossy { kd: Vec3::splat(0.3), ks: Vec3::splat(0.7), exponent: 30.0 };
+    let sp = point(Vec3::new(0.6, 0.0, 0.2));
+    let to_light = (Vec3::new(0.0, 1.0, 0.0) - sp.p).normalize();
+    let wo = Vec3::new(-to_light.x, to_light.y, -to_light.z);
+    let with: Vec<f32> = (0..2048).map(|i| mis_sample(&sp, &glossy, wo, i)).collect();
+    let without: Vec<f32> = (0..2048)
+        .map(|i| {
+            let s = Sampler::new(9, Domain::Camera, i);
+            direct_light(&ctx, &sp, &glossy, wo, &s.fork(1), &mut Default::default()).x
+        })
+        .collect();
+    let (a, sa) = mean_and_se(&with);
+    let (b, sb) = mean_and_se(&without);
+    println!("glossy: MIS {a:.4} ± {sa:.4}, light samples alone {b:.4} ± {sb:.4}");
+    assert!((a - b).abs() < 4.0 * (sa * sa + sb * sb).sqrt(), "glossy: MIS {a} ± {sa} against {b} ± {sb}");
+    assert!(sa < sb, "glossy: MIS is noisier ({sa}) than light samples alone ({sb})");
+}
+
 #[test]
 fn point_light_irradiance_is_inverse_square_cosine() {
     let mesh = closed_cube(10.0);
@@ -266,15 +345,7 @@ fn point_light_irradiance_is_inverse_square_cosine() {
     let job = job(&scene, &settings);
     let ctx = Context::new(&scene, &maps, &job);
     let p = Vec3::new(1.5, 0.0, 0.0);
-    let sp = SurfacePoint {
-        p,
-        p_error: Vec3::ZERO,
-        frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y },
-        material: 0,
-        tri: 0,
-        uv: Vec2::ZERO,
-        flat: true,
-    };
+    let sp = floor_point(p);
     let l = direct_light(
         &ctx,
         &sp,
@@ -338,15 +409,7 @@ fn directional_light_irradiance_is_cosine_weighted_by_both_methods() {
         for i in 0..8 {
             for j in 0..8 {
                 let p = Vec3::new(-4.0 + i as f32, 0.0, -4.0 + j as f32);
-                let sp = SurfacePoint {
-                    p,
-                    p_error: Vec3::ZERO,
-                    frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y },
-                    material: 0,
-                    tri: 0,
-                    uv: Vec2::ZERO,
-                    flat: true,
-                };
+                let sp = floor_point(p);
                 let direct = direct_light(
                     &ctx,
                     &sp,

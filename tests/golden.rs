@@ -18,16 +18,16 @@ use std::sync::Arc;
 
 /// (scene, engine, passes) → FNV-1a 64 of the film's f32 bits.
 const GOLDEN: &[(&str, &str, u32, u64)] = &[
-    ("cornell-box.toml", "wavefront", 1, 0x65db47bab6e2e1c3),
-    ("cornell-box.toml", "reference", 1, 0xa59e48a3f41b6ca0),
-    ("cornell-box.toml", "path", 1, 0xd3159bbc928efad9),
-    ("cornell-spheres.toml", "wavefront", 1, 0x40cd9a681fd1fe77),
-    ("cornell-spheres.toml", "reference", 1, 0x0450b051cc1bf9cc),
-    ("cornell-spheres.toml", "wavefront", 3, 0x662c89e3e7e999b3),
-    ("cornell-spheres.toml", "reference", 3, 0x7e4c361acb8b96d9),
-    ("hard/furnace-materials.toml", "wavefront", 1, 0x93e4e7301afa4d9b),
-    ("hard/furnace-materials.toml", "reference", 1, 0x9eb570813f5e4066),
-    ("hard/nested.toml", "wavefront", 2, 0x0896f03bd3da855a),
+    ("cornell-box.toml", "wavefront", 1, 0x77270da02c783bb8),
+    ("cornell-box.toml", "reference", 1, 0xea1d6280e26210f7),
+    ("cornell-box.toml", "path", 1, 0x9d75264d7f03385e),
+    ("cornell-spheres.toml", "wavefront", 1, 0xcd9797a83e22b176),
+    ("cornell-spheres.toml", "reference", 1, 0xbc327d29dcf86e3d),
+    ("cornell-spheres.toml", "wavefront", 3, 0x2ffacae15b787cc5),
+    ("cornell-spheres.toml", "reference", 3, 0x92288ea3e94ad440),
+    ("hard/furnace-materials.toml", "wavefront", 1, 0xfbbb4cc2c50e7f2a),
+    ("hard/furnace-materials.toml", "reference", 1, 0x3c0f1cdf74dba9e3),
+    ("hard/nested.toml", "wavefront", 2, 0xdbb7587d3d2f46d0),
 ];
 
 /// FNV-1a over the bits of every term of every pixel, in film order.

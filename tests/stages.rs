@@ -172,6 +172,7 @@ fn camera_world(segments: &[(usize, PathKind)]) -> World {
             beta: Vec3::ONE,
             term: Term::Indirect,
             through_specular: false,
+            mis: 0.0,
         });
     }
     w.insert_resource(CameraWork {

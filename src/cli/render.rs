@@ -83,6 +83,11 @@ pub struct RenderArgs {
     /// the mirrors, glass and smooth rough metal that make caustics (for comparison) [aimed].
     #[arg(long)]
     pub no_aim_caustics: bool,
+    /// Leave emitters to light sampling alone instead of weighing light samples against the
+    /// final-gather and glossy rays (the path tracer: its next bounce) by multiple importance
+    /// sampling (for comparison) [MIS on].
+    #[arg(long)]
+    pub no_mis: bool,
     /// Add diagnostic EXR layers: per pixel, the radius and photon count of the caustic and the
     /// global density estimates (`radius.caustic`, `photons.caustic`, `radius.global`,
     /// `photons.global`), probed at one camera sample of the last pass; costs one pass's photon
@@ -206,6 +211,7 @@ fn overrides(args: &RenderArgs) -> Overrides {
         gather_rays: args.gather_rays,
         no_final_gather: args.no_final_gather,
         no_aim_caustics: args.no_aim_caustics,
+        no_mis: args.no_mis,
         secondary_gather: args.secondary_gather,
         visibility: args.visibility,
         no_boundary_correction: args.no_boundary_correction,

@@ -23,7 +23,7 @@ pub struct SweepArgs {
     /// A knob and its values, NAME=V1,V2,… (repeatable; the grid is every combination). Any
     /// setting but width, height and force: spp, photons, caustic_photons, k, caustic_k,
     /// global_radius, caustic_radius, kernel, gather_rays, final_gather, precompute_irradiance,
-    /// secondary_gather, per_pixel_radii, passes, alpha, max_depth, light_samples, seed, threads, code_path.
+    /// secondary_gather, per_pixel_radii, passes, alpha, max_depth, light_samples, mis, seed, threads, code_path.
     #[arg(long = "knob", required = true)]
     pub knobs: Vec<photonwave::tools::sweep::Knob>,
     /// Equal-time mode: time budgets, e.g. `1s,4s,16s`; every configuration renders progressive

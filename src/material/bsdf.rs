@@ -19,6 +19,12 @@ impl Bsdf {
         matches!(self, Bsdf::Mirror { .. } | Bsdf::Glass { .. })
     }
 
+    /// True for materials that let light through (glass, rough glass).
+    #[must_use]
+    pub fn transmits(&self) -> bool {
+        matches!(self, Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. })
+    }
+
     /// True for surfaces photons pass on as specular (neither stored there nor ending a caustic
     /// path): delta materials, rough dielectrics, rough conductors below
     /// [`PHOTON_SPECULAR_ALPHA`].
@@ -129,12 +135,11 @@ impl Bsdf {
         }
     }
 
-    /// The glossy lobe alone (zero for other materials).
+    /// f(wo, wi) of the part the glossy ray samples ([`Bsdf::sample_glossy`]): the Phong lobe,
+    /// the whole rough conductor or dielectric, the rough plastic's coat; zero for the others.
+    /// With [`Bsdf::eval_base`] it makes up [`Bsdf::eval`].
     #[must_use]
-    pub fn eval_glossy(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Vec3 {
-        if let Some(f) = self.eval_rough(frame, wo, wi) {
-            return f;
-        }
+    pub fn eval_lobe(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Vec3 {
         match *self {
             Bsdf::Glossy { ks, exponent, .. } => {
                 let (ng, ns) = frame.oriented(wo);
@@ -143,7 +148,39 @@ impl Bsdf {
                 }
                 ks * phong_lobe(reflect(wo, ns), wi, exponent)
             }
-            _ => Vec3::ZERO,
+            Bsdf::RoughPlastic { ior, alpha, .. } => {
+                let (ng, f, _) = self.rough_frame(frame, wo);
+                if wi.dot(ng) <= 0.0 {
+                    return Vec3::ZERO;
+                }
+                Vec3::splat(microfacet::plastic_coat_eval(f.to_local(wo), f.to_local(wi), ior, alpha))
+            }
+            _ => self.eval_rough(frame, wo, wi).unwrap_or(Vec3::ZERO),
+        }
+    }
+
+    /// The pdf per steradian with which [`Bsdf::sample_glossy`] picks `wi` (0 for materials
+    /// without a glossy lobe, and where the glossy ray would be dropped: below the geometric
+    /// surface, or for Phong below the shading one).
+    #[must_use]
+    pub fn glossy_pdf(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> f32 {
+        match *self {
+            Bsdf::Glossy { exponent, .. } => {
+                let (ng, ns) = frame.oriented(wo);
+                if wi.dot(ng) <= 0.0 || wi.dot(ns) <= 0.0 {
+                    return 0.0;
+                }
+                phong_pdf(reflect(wo, ns), wi, exponent)
+            }
+            Bsdf::RoughPlastic { alpha, .. } => {
+                let (ng, f, _) = self.rough_frame(frame, wo);
+                if wi.dot(ng) <= 0.0 {
+                    return 0.0;
+                }
+                microfacet::plastic_coat_pdf(f.to_local(wo), f.to_local(wi), alpha)
+            }
+            Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } => self.pdf(frame, wo, wi),
+            _ => 0.0,
         }
     }
 

@@ -5,9 +5,11 @@
 //! glossy lobe by one traced ray. Every vertex is the
 //! transport core's; only the loops are here.
 //!
-//! Double counting is avoided by construction: final-gather and glossy rays never add emission
-//! (that is the direct term) and read full map estimates only at non-specular hits; a gather ray
-//! that ends on an emitter through mirrors is an `LS+D` caustic, already in the caustic map.
+//! Double counting is avoided by construction: emission that a final-gather or glossy ray hits
+//! straight away belongs to the direct term, weighted by MIS against the light samples
+//! (`transport::mis`; with `mis = false` it is left to light sampling); the rays read full map
+//! estimates only at non-specular hits; a gather ray that ends on an emitter through mirrors is
+//! an `LS+D` caustic, already in the caustic map.
 
 use crate::film::{Film, Term, Terms};
 use crate::job::Job;
@@ -19,9 +21,10 @@ use crate::scene::camera::CameraRays;
 use crate::scene::{Scene, SurfacePoint};
 use crate::stats::{Numerics, RayCounts};
 use crate::transport::camera::render_pixels;
-use crate::transport::direct::{delta_light, direct_light};
+use crate::transport::direct::{delta_light, direct_light, weighted_direct_light};
 use crate::transport::estimate::{camera_indirect_estimate, caustic_estimate, indirect_estimate, map_radiance};
 use crate::transport::gather::{glossy_ray, lands_near, trace_gather_rays};
+use crate::transport::mis::{emission_found, Strategies};
 use crate::transport::specular::{continue_chain, emission_toward, first_non_specular, ChainEnd};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
@@ -93,14 +96,18 @@ pub fn trace_camera_path(
             (o, d) = (next.origin, next.dir);
             continue;
         }
-        let direct = beta * direct_light(ctx, &sp, &bsdf, wo, &s.fork(streams::light(depth)), rays);
+        let mis = Strategies::at_camera_hit(ctx, &bsdf);
+        let lit = weighted_direct_light(ctx, &sp, &bsdf, wo, &s.fork(streams::light(depth)), &mis, rays);
         let caustic = caustic_estimate(ctx, &sp, &bsdf, wo, Some(pixel), scratch).finish(ctx);
         let indirect = if ctx.effects.final_gather.on {
-            final_gather(ctx, &sp, &bsdf, wo, &s.fork(streams::gather(depth)), rays, scratch)
+            final_gather(ctx, &sp, &bsdf, wo, &s.fork(streams::gather(depth)), &mis, rays, scratch)
         } else {
             camera_indirect_estimate(ctx, &sp, &bsdf, wo, Some(pixel), scratch).finish(ctx).into()
         };
-        let glossy = glossy_reflection(ctx, &sp, &bsdf, wo, &s.fork(streams::glossy(depth)), rays, scratch);
+        let glossy = glossy_reflection(ctx, &sp, &bsdf, wo, &s.fork(streams::glossy(depth)), &mis, rays, scratch);
+        // Light sampling's share of the emitters' light, then what the gather and glossy rays
+        // found of it.
+        let direct = beta * lit + beta * indirect.emission + beta * glossy.emission;
         let (caustic_l, indirect_l, glossy_l) =
             (beta * caustic.radiance, beta * indirect.radiance, beta * glossy.radiance);
         if through_specular {
@@ -117,30 +124,36 @@ pub fn trace_camera_path(
     terms
 }
 
-/// Radiance found by photon-map estimates, with their estimated bias weighted the same way.
+/// Radiance found by photon-map estimates, with their estimated bias weighted the same way,
+/// and the emission the rays that made them hit straight away (MIS-weighted: the direct term's).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Estimated {
     /// Radiance.
     pub radiance: Vec3,
     /// Its bias ([`crate::photon_map::Estimate::bias`]).
     pub bias: Vec3,
+    /// Emission found by the rays, weighted against light sampling ([`emission_found`]).
+    pub emission: Vec3,
 }
 
 impl From<crate::photon_map::Estimate> for Estimated {
     fn from(e: crate::photon_map::Estimate) -> Self {
-        Estimated { radiance: e.radiance, bias: e.bias }
+        Estimated { radiance: e.radiance, bias: e.bias, emission: Vec3::ZERO }
     }
 }
 
 /// Final gather: `kd/N · Σ L(x, ωi)` over the N gather rays, L read from the photon maps at
-/// each ray's first non-specular hit (following mirrors and glass, adding no emission), or by
-/// the secondary gather where that hit is near ([`gather_hit`]).
+/// each ray's first non-specular hit (following mirrors and glass), or by the secondary gather
+/// where that hit is near ([`gather_hit`]); and the emission the rays hit straight away,
+/// weighted against light sampling by `mis`.
+#[allow(clippy::too_many_arguments)]
 pub fn final_gather(
     ctx: &Context,
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
     s: &Sampler,
+    mis: &Strategies,
     rays: &mut RayCounts,
     scratch: &mut Nearest,
 ) -> Estimated {
@@ -149,7 +162,7 @@ pub fn final_gather(
         return Estimated::default();
     }
     let n = ctx.settings.gather_rays;
-    let (mut sum, mut bias) = (Vec3::ZERO, Vec3::ZERO);
+    let (mut sum, mut bias, mut emission) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
     // A rough plastic weighs each ray by its base's share seen through the coat; for the others
     // the weight is kd for every ray, applied once at the end.
     let varies = bsdf.gather_varies();
@@ -158,9 +171,12 @@ pub fn final_gather(
         let w = if varies { bsdf.gather_weight(&sp.frame, wo, wi) * end.beta } else { end.beta };
         sum += w * e.radiance;
         bias += w * e.bias;
+        if end.bounces == 0 {
+            emission += w * emission_found(ctx, &end.hit, end.dir, mis.gather_density(sp, wo, wi));
+        }
     });
     let scale = if varies { Vec3::ONE } else { kd };
-    Estimated { radiance: scale * sum / n as f32, bias: scale * bias / n as f32 }
+    Estimated { radiance: scale * sum / n as f32, bias: scale * bias / n as f32, emission: scale * emission / n as f32 }
 }
 
 /// Radiance a gather ray (stream `chain`) finds where it ends: the photon maps' there, or, where
@@ -175,7 +191,7 @@ fn gather_hit(
 ) -> Estimated {
     let (y, wo) = (&end.point, -end.dir);
     let bsdf = &ctx.scene.bsdf(y);
-    if !lands_near(end.t, end.bounces, bsdf, ctx.secondary_gather) {
+    if !lands_near(end.hit.t, end.bounces, bsdf, ctx.secondary_gather) {
         return map_radiance(ctx, y, bsdf, wo, scratch).finish(ctx).into();
     }
     let direct = direct_light(ctx, y, bsdf, wo, &chain.fork(streams::SECONDARY_LIGHT), rays);
@@ -186,27 +202,33 @@ fn gather_hit(
     if kd != Vec3::ZERO {
         trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, _, _| {
             let e = map_radiance(ctx, &z.point, &ctx.scene.bsdf(&z.point), -z.dir, scratch).finish(ctx);
-            far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias };
+            far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias, emission: Vec3::ZERO };
         });
     }
-    Estimated { radiance: direct + caustic.radiance + kd * far.radiance, bias: caustic.bias + kd * far.bias }
+    Estimated {
+        radiance: direct + caustic.radiance + kd * far.radiance,
+        bias: caustic.bias + kd * far.bias,
+        emission: Vec3::ZERO,
+    }
 }
 
 /// The glossy lobe's reflection: one ray sampled from the lobe; at its first non-specular hit,
 /// direct light, caustics and the global map without direct and caustic photons (so each path
-/// is counted once: emission reached by this ray is already in the direct term). The bias is
-/// that of the two estimates.
+/// is counted once), and the emission it hits straight away, weighted against light sampling by
+/// `mis` (the direct term's). The bias is that of the two estimates.
+#[allow(clippy::too_many_arguments)]
 pub fn glossy_reflection(
     ctx: &Context,
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
     s: &Sampler,
+    mis: &Strategies,
     rays: &mut RayCounts,
     scratch: &mut Nearest,
 ) -> Estimated {
     let Some(ray) = glossy_ray(sp, bsdf, wo, s) else { return Estimated::default() };
-    let Some(ChainEnd { point: y, dir: d, beta, .. }) =
+    let Some(ChainEnd { point: y, dir: d, beta, hit, bounces }) =
         first_non_specular(ctx, ray.origin, ray.dir, s, streams::GLOSSY_CHAIN_BOUNCE, rays)
     else {
         return Estimated::default();
@@ -216,5 +238,14 @@ pub fn glossy_reflection(
     let caustic = caustic_estimate(ctx, &y, b, -d, None, scratch).finish(ctx);
     let rest = indirect_estimate(ctx, &y, b, -d, None, scratch).finish(ctx);
     let w = ray.weight * beta;
-    Estimated { radiance: w * (direct + caustic.radiance + rest.radiance), bias: w * (caustic.bias + rest.bias) }
+    let emission = if bounces == 0 {
+        w * emission_found(ctx, &hit, d, mis.glossy_density(sp, bsdf, wo, ray.dir))
+    } else {
+        Vec3::ZERO
+    };
+    Estimated {
+        radiance: w * (direct + caustic.radiance + rest.radiance),
+        bias: w * (caustic.bias + rest.bias),
+        emission,
+    }
 }

@@ -246,6 +246,15 @@ impl Scene {
         }
     }
 
+    /// The light of emissive triangle `tri`: its index in `lights`, which is also its index in
+    /// `area_lights` and `area_power` (area lights come first, in triangle order). `None` for a
+    /// triangle that emits nothing.
+    #[must_use]
+    pub fn area_light_of(&self, tri: u32) -> Option<usize> {
+        let k = self.lights.partition_point(|l| matches!(l, Light::Area { tri: t, .. } if *t < tri));
+        matches!(self.lights.get(k), Some(Light::Area { tri: t, .. }) if *t == tri).then_some(k)
+    }
+
     /// Length of the bounding-box diagonal.
     #[must_use]
     pub fn diagonal(&self) -> f32 {

@@ -1,11 +1,14 @@
 //! Direct light by light sampling (Jensen's first term): at a non-specular point, every delta
 //! light once and `light_samples` area-light samples chosen by power, each a shadow ray that
-//! carries its contribution if nothing blocks it.
+//! carries its contribution if nothing blocks it. Where BSDF samples can find the same emitters
+//! ([`super::mis::Strategies`]), an emissive triangle's sample is weighted against them.
 
+use super::mis::{light_density, weighed_light, Strategies};
 use super::Context;
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::Bsdf;
 use crate::rng::Sampler;
+use crate::scene::light::Light;
 use crate::scene::SurfacePoint;
 use crate::stats::RayCounts;
 use glam::Vec3;
@@ -27,8 +30,10 @@ pub struct ShadowRay {
 }
 
 /// The shadow rays of direct light at `sp` toward `wo`: every delta light once, then (unless
-/// `delta_only`) `light_samples` area-light samples chosen by power. Lights that cannot contribute (behind
-/// the surface, back faces, outside a spot cone) get no ray.
+/// `delta_only`) `light_samples` area-light samples chosen by power, an emissive triangle's
+/// weighted by MIS against `mis`. Lights that cannot contribute (behind the surface, back
+/// faces, outside a spot cone) get no ray.
+#[allow(clippy::too_many_arguments)]
 pub fn direct_light_rays(
     ctx: &Context,
     sp: &SurfacePoint,
@@ -36,6 +41,7 @@ pub fn direct_light_rays(
     wo: Vec3,
     s: &Sampler,
     delta_only: bool,
+    mis: &Strategies,
     mut emit: impl FnMut(ShadowRay),
 ) {
     let scene = ctx.scene;
@@ -43,8 +49,25 @@ pub fn direct_light_rays(
     let mut add = |light_index: u32, u: [f32; 2], weight: f32| {
         let light = &scene.lights[light_index as usize];
         let Some(inc) = scene.sample_incident(light, sp.p, ns, u) else { return };
-        let f = bsdf.eval(&sp.frame, wo, inc.wi);
-        let cos = inc.wi.dot(ns).abs();
+        let weighed = match (mis, light) {
+            (Strategies::LightOnly, _) => None,
+            (_, Light::Area { tri, .. }) => weighed_light(scene, *tri).map(|k| (k, *tri)),
+            _ => None,
+        };
+        let f = match weighed {
+            Some((k, tri)) => {
+                let density = light_density(scene, ctx.settings.light_samples, k, tri, inc.distance, inc.wi);
+                mis.weighted_f(sp, bsdf, wo, inc.wi, density)
+            }
+            None => bsdf.eval(&sp.frame, wo, inc.wi),
+        };
+        // A surface that only reflects takes no light from below its shading normal's
+        // hemisphere (above the geometric surface, where smooth normals tilt): there neither
+        // the gather rays nor the glossy ray could find it, so MIS could not weigh it, and a
+        // light point across a crease of a smooth-shaded emitter, d² near zero, made a pixel 38
+        // times its neighbours (the rough materials' frames, and pbrt's, exclude it too).
+        // Rough glass takes light through itself.
+        let cos = if bsdf.transmits() { inc.wi.dot(ns).abs() } else { inc.wi.dot(ns).max(0.0) };
         if f == Vec3::ZERO || cos == 0.0 {
             return;
         }
@@ -74,7 +97,8 @@ pub fn direct_light_rays(
     }
 }
 
-/// Direct light at `sp` toward `wo`: the unblocked shadow rays' contributions summed.
+/// Direct light at `sp` toward `wo` by light sampling alone: the unblocked shadow rays'
+/// contributions summed.
 pub fn direct_light(
     ctx: &Context,
     sp: &SurfacePoint,
@@ -83,8 +107,22 @@ pub fn direct_light(
     s: &Sampler,
     rays: &mut RayCounts,
 ) -> Vec3 {
+    weighted_direct_light(ctx, sp, bsdf, wo, s, &Strategies::LightOnly, rays)
+}
+
+/// [`direct_light`] with emissive triangles weighted by MIS against `mis`: the light
+/// sampling's share, to which the BSDF samples add theirs ([`super::mis::emission_found`]).
+pub fn weighted_direct_light(
+    ctx: &Context,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    s: &Sampler,
+    mis: &Strategies,
+    rays: &mut RayCounts,
+) -> Vec3 {
     let mut sum = Vec3::ZERO;
-    direct_light_rays(ctx, sp, bsdf, wo, s, false, |r| {
+    direct_light_rays(ctx, sp, bsdf, wo, s, false, mis, |r| {
         rays.shadow += 1;
         if !ctx.scene.occluded(r.origin, r.direction, r.t_max) {
             sum += r.contribution;
@@ -98,7 +136,7 @@ pub fn direct_light(
 /// light, and the other lights are found as emission along the sampled path.
 pub fn delta_light(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler, rays: &mut RayCounts) -> Vec3 {
     let mut sum = Vec3::ZERO;
-    direct_light_rays(ctx, sp, bsdf, wo, s, true, |r| {
+    direct_light_rays(ctx, sp, bsdf, wo, s, true, &Strategies::LightOnly, |r| {
         rays.shadow += 1;
         if !ctx.scene.occluded(r.origin, r.direction, r.t_max) {
             sum += r.contribution;

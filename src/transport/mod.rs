@@ -7,6 +7,7 @@
 //! - [`specular`]: continuing a ray at a surface, and following mirrors and glass;
 //! - [`photon`]: photon emission, deposit, scattering and the exact-count emission tally;
 //! - [`direct`]: direct light by light sampling (shadow rays);
+//! - [`mis`]: multiple importance sampling of emitters, light samples against BSDF samples;
 //! - [`gather`]: final-gather and glossy ray generation, and where the secondary gather applies;
 //! - [`estimate`]: photon-map density estimates at a surface point;
 //! - [`maps`]: the photon maps of a render and Christensen's precomputed irradiance.
@@ -22,6 +23,7 @@ pub mod direct;
 pub mod estimate;
 pub mod gather;
 pub mod maps;
+pub mod mis;
 pub mod photon;
 pub mod specular;
 pub mod streams;

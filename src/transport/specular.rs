@@ -83,8 +83,8 @@ pub struct ChainEnd {
     pub dir: Vec3,
     /// Throughput of the specular chain (1 without mirrors or glass on the way).
     pub beta: Vec3,
-    /// Length of the arriving segment (the hit's ray distance; directions are unit).
-    pub t: f32,
+    /// The hit itself (its `t` is the length of the arriving segment; directions are unit).
+    pub hit: crate::geometry::Hit,
     /// Mirrors and glass on the way (0: the ray's own first hit).
     pub bounces: u32,
 }
@@ -111,7 +111,7 @@ pub fn first_non_specular(
         let sp = scene.surface(&hit);
         let bsdf = &scene.bsdf(&sp);
         if !(bsdf.is_delta() || bsdf.photon_specular()) {
-            return Some(ChainEnd { point: sp, dir: d, beta, t: hit.t, bounces: depth });
+            return Some(ChainEnd { point: sp, dir: d, beta, hit, bounces: depth });
         }
         if depth == ctx.settings.max_depth {
             ctx.cut();

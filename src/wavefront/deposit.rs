@@ -7,8 +7,10 @@ use super::{par_columns, CameraWork, PhotonWork, Shared, StageClock, StageStats,
 use crate::film::Term;
 use crate::photon_map::Photon;
 use crate::rng::Domain;
+use crate::transport::mis::emission_found;
 use crate::transport::photon::{deposit_photon, PhotonRay};
 use crate::transport::specular::emission_toward;
+use crate::transport::Context;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 
@@ -63,16 +65,31 @@ pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
     stats.record("deposit_photons", lanes.len(), t);
 }
 
-/// Camera rays (not gather or glossy rays, whose emission is the direct term's) add the
-/// radiance of emitters whose front face they hit, and of the environment and the sun when they
-/// leave the scene.
-pub fn deposit_emission(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+/// Camera rays add the radiance of emitters whose front face they hit, and of the environment
+/// and the sun when they leave the scene; gather and glossy rays add the emission they hit
+/// straight away, weighted against light sampling ([`emission_found`]), to the direct term of
+/// the path they left.
+pub fn deposit_emission(
+    shared: Res<Shared>,
+    maps: Res<super::Maps>,
+    mut work: ResMut<CameraWork>,
+    mut stats: ResMut<StageStats>,
+) {
     let t = StageClock::start();
     let scene = &*shared.scene;
+    let ctx = Context::new(scene, &maps.0, &shared.job);
     let w = &mut *work;
     let mut n = 0;
     for i in 0..w.paths.len() {
         if w.paths.kind[i] != PathKind::Camera {
+            let (density, hit) = (w.paths.mis[i], w.paths.hits.get(i));
+            let Some(hit) = hit.filter(|_| density > 0.0 && w.paths.depth[i] == 0) else { continue };
+            let found = emission_found(&ctx, &hit, w.paths.rays.direction(i), density);
+            if found != Vec3::ZERO {
+                n += 1;
+                let term = Term::Direct.seen(w.paths.through_specular[i]);
+                w.terms[w.paths.sample[i] as usize].add(term, w.paths.beta[i] * found);
+            }
             continue;
         }
         let emission = match w.paths.hits.get(i) {

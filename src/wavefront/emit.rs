@@ -79,6 +79,7 @@ pub fn emit_camera_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut s
             beta: Vec3::ONE,
             term: Term::Emitted,
             through_specular: false,
+            mis: 0.0,
         });
     }
     stats.record("emit_camera_rays", w.count, t);

@@ -10,7 +10,7 @@
 //!   triangle test returned them, so surface points match the reference engine's bit for bit);
 //! - photons: path index 8, bounce 4, power 12, emitted power 4, specular-only flag 1 → 73 B a lane with ray and hit;
 //! - camera-pass paths: sample 4, kind 1, sampler key 8, bounce base 1, depth 4, term 1,
-//!   throughput 12, through-specular flag 1 → 76 B a lane with ray and hit;
+//!   throughput 12, through-specular flag 1, MIS density 4 → 80 B a lane with ray and hit;
 //! - shadow rays: sample 4, term 1, t_max 4, contribution 12, plus the ray.
 
 use crate::film::Term;
@@ -341,8 +341,14 @@ soa_queue! {
         beta: Vec3,
         /// Film term the segment's findings go to (gather, glossy).
         term: Term,
-        /// True once a camera path went through a mirror or glass.
+        /// True once a camera path went through a mirror or glass (for a gather or glossy
+        /// ray: once the camera path it left had, so the emission it finds goes where that
+        /// path's direct light went).
         through_specular: bool,
+        /// A gather or glossy ray's density toward its direction at its origin (rays × pdf),
+        /// which weighs the emission it hits straight away against light sampling
+        /// (`transport::mis`); 0 where it adds none.
+        mis: f32,
     }
 }
 

@@ -11,6 +11,7 @@ use crate::film::Term;
 use crate::rng::{Domain, Sampler};
 use crate::transport::direct::{direct_light_rays, ShadowRay};
 use crate::transport::gather::{gather_rays, glossy_ray};
+use crate::transport::mis::Strategies;
 use crate::transport::photon::{scatter_photon, PathEnd, PhotonRay, Scattered};
 use crate::transport::specular::continue_chain;
 use crate::transport::{streams, Context};
@@ -139,8 +140,14 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
                 };
                 let (beta, sample) = (w.paths.beta[i], w.paths.sample[i]);
                 let delta_only = !bsdf.is_delta() && bsdf.photon_specular();
+                // Only a camera path's own non-specular hit sends the rays its light samples are
+                // weighed against (as in the reference).
+                let mis = match w.paths.kind[i] {
+                    PathKind::Camera if !delta_only => Strategies::at_camera_hit(&ctx, bsdf),
+                    _ => Strategies::LightOnly,
+                };
                 let wo = -w.paths.rays.direction(i);
-                direct_light_rays(&ctx, &sp, bsdf, wo, &stream, delta_only, |ray: ShadowRay| {
+                direct_light_rays(&ctx, &sp, bsdf, wo, &stream, delta_only, &mis, |ray: ShadowRay| {
                     part.push(ShadowLane {
                         origin: ray.origin,
                         dir: ray.direction,
@@ -161,8 +168,14 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
 
 /// Diffuse camera lanes spawn `gather_rays` cosine-weighted rays, each weighted beta·kd/N;
 /// near-landed gather lanes spawn their secondary gather's one ray, weighted beta·kd.
-pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+pub fn spawn_gather_rays(
+    shared: Res<Shared>,
+    maps: Res<Maps>,
+    mut work: ResMut<CameraWork>,
+    mut stats: ResMut<StageStats>,
+) {
     let t = StageClock::start();
+    let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
     let scene = &*shared.scene;
     let n = shared.job.settings.gather_rays;
     // Chunks append straight to the next queue (disjoint fields of the work resource).
@@ -192,14 +205,21 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
                     continue;
                 }
                 let s = Sampler::from_key(w.key[i]);
-                let (gs, rays, kind, term) = match w.kind[i] {
+                let (gs, rays, kind, term, mis) = match w.kind[i] {
                     PathKind::Camera => (
                         s.fork(streams::gather(w.depth[i])),
                         n,
                         PathKind::Gather,
                         Term::Indirect.seen(w.through_specular[i]),
+                        Strategies::at_camera_hit(&ctx, &bsdf),
                     ),
-                    _ => (s.fork(streams::SECONDARY_GATHER), 1, PathKind::SecondaryGather, w.term[i]),
+                    _ => (
+                        s.fork(streams::SECONDARY_GATHER),
+                        1,
+                        PathKind::SecondaryGather,
+                        w.term[i],
+                        Strategies::LightOnly,
+                    ),
                 };
                 let wo = -w.rays.direction(i);
                 let weight = w.beta[i] * kd / rays as f32;
@@ -220,7 +240,8 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
                         depth: 0,
                         beta: weight,
                         term,
-                        through_specular: false,
+                        through_specular: w.through_specular[i],
+                        mis: mis.gather_density(&sp, wo, dir),
                     });
                 });
             }
@@ -232,8 +253,14 @@ pub fn spawn_gather_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
 }
 
 /// Diffuse camera lanes on glossy materials spawn one ray from the glossy lobe.
-pub fn spawn_glossy_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
+pub fn spawn_glossy_rays(
+    shared: Res<Shared>,
+    maps: Res<Maps>,
+    mut work: ResMut<CameraWork>,
+    mut stats: ResMut<StageStats>,
+) {
     let t = StageClock::start();
+    let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
     let scene = &*shared.scene;
     let w = &*work;
     let mut segments = Vec::new();
@@ -250,7 +277,9 @@ pub fn spawn_glossy_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
             continue;
         }
         let gls = Sampler::from_key(w.paths.key[i]).fork(streams::glossy(w.paths.depth[i]));
-        let Some(ray) = glossy_ray(&sp, bsdf, -w.paths.rays.direction(i), &gls) else { continue };
+        let wo = -w.paths.rays.direction(i);
+        let Some(ray) = glossy_ray(&sp, bsdf, wo, &gls) else { continue };
+        let mis = Strategies::at_camera_hit(&ctx, bsdf);
         segments.push(Segment {
             origin: ray.origin,
             dir: ray.dir,
@@ -261,7 +290,8 @@ pub fn spawn_glossy_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
             depth: 0,
             beta: w.paths.beta[i] * ray.weight,
             term: Term::Specular,
-            through_specular: false,
+            through_specular: w.paths.through_specular[i],
+            mis: mis.glossy_density(&sp, bsdf, wo, ray.dir),
         });
     }
     let count = segments.len();
@@ -307,6 +337,7 @@ fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32], cuts: &m
                     beta: w.paths.beta[i] * next.weight,
                     term: w.paths.term[i],
                     through_specular: w.paths.kind[i] == PathKind::Camera,
+                    mis: 0.0,
                 })
             }) {
                 part.0.push(s);

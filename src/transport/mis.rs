@@ -1,0 +1,170 @@
+//! Multiple importance sampling of direct light (Veach 1997, ch. 9). An emissive triangle
+//! lights a non-specular point by two kinds of sample: light sampling's shadow rays
+//! ([`super::direct`]) and the rays the BSDF sends out anyway — at the photon mapper's camera
+//! hit the final-gather rays over the diffuse base and the glossy ray over the lobe, in the path
+//! tracer the next bounce. Each kind weighs what it finds by the power heuristic against the
+//! other kinds' densities for the same direction, so every emitter is counted once in
+//! expectation, and a sample one kind draws badly (a light point across a crease of the
+//! emitter, its d² near zero; a light point in a near-mirror lobe's peak) is carried by the
+//! kind that draws it well: a weighted light sample is at most f·L·cos / (2·p_bsdf), bounded
+//! where the BSDF's own sampling is.
+//!
+//! The weights come from densities (samples × pdf per steradian): light sampling's is
+//! `light_samples × pmf(light) × d² / (A·cos θ_light)` ([`light_density`]); a BSDF kind's is
+//! given by [`Strategies`]. Only emissive triangles whose surface ends a camera-side chain
+//! (neither mirror, glass nor what photons pass as specular) are weighed: those are the ones a
+//! BSDF ray can find. The environment and the sun stay with light sampling alone.
+//!
+//! Reads the scene's lights and the BSDF's pdfs; writes weights and weighted emission. Every
+//! engine weighs through these functions, so their images agree.
+
+use super::Context;
+use crate::geometry::Hit;
+use crate::material::Bsdf;
+use crate::scene::{Scene, SurfacePoint};
+use glam::Vec3;
+use std::f32::consts::FRAC_1_PI;
+
+/// The BSDF samples that can find an emitter at a point, besides light sampling.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Strategies {
+    /// None: light sampling carries all direct light, unweighted (a secondary vertex of the
+    /// photon mapper, whose rays read the maps instead; or MIS turned off).
+    LightOnly,
+    /// The photon mapper's camera hit: `gather` cosine-weighted final-gather rays over the
+    /// diffuse base ([`Bsdf::eval_base`]) and, with `glossy`, the glossy ray over the lobe
+    /// ([`Bsdf::eval_lobe`]).
+    Split {
+        /// Final-gather rays (0 where none are sent).
+        gather: u32,
+        /// A glossy ray is sent.
+        glossy: bool,
+    },
+    /// The path tracer: one sample of the whole BSDF ([`Bsdf::pdf`]).
+    Whole,
+}
+
+impl Strategies {
+    /// What a photon-mapping camera path sends at its non-specular hit on `bsdf`: final-gather
+    /// rays when final gathering is on and the surface has a diffuse part, the glossy ray on a
+    /// glossy material; light sampling alone when `mis = false`.
+    #[must_use]
+    pub fn at_camera_hit(ctx: &Context, bsdf: &Bsdf) -> Self {
+        if !ctx.settings.mis {
+            return Strategies::LightOnly;
+        }
+        let gather =
+            if ctx.effects.final_gather.on && bsdf.diffuse() != Vec3::ZERO { ctx.settings.gather_rays } else { 0 };
+        Strategies::Split { gather, glossy: bsdf.has_glossy_lobe() }
+    }
+
+    /// Density of the final-gather rays toward `wi` (rays × pdf); 0 without them.
+    #[must_use]
+    pub fn gather_density(&self, sp: &SurfacePoint, wo: Vec3, wi: Vec3) -> f32 {
+        match *self {
+            Strategies::Split { gather, .. } if gather > 0 => gather as f32 * gather_pdf(sp, wo, wi),
+            _ => 0.0,
+        }
+    }
+
+    /// Density of the glossy ray toward `wi`; 0 without it.
+    #[must_use]
+    pub fn glossy_density(&self, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, wi: Vec3) -> f32 {
+        match *self {
+            Strategies::Split { glossy: true, .. } => bsdf.glossy_pdf(&sp.frame, wo, wi),
+            _ => 0.0,
+        }
+    }
+
+    /// f(wo, wi) for a light sample of density `light` toward `wi`, each part weighted against
+    /// the BSDF kind that samples it.
+    #[must_use]
+    pub fn weighted_f(&self, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, wi: Vec3, light: f32) -> Vec3 {
+        let frame = &sp.frame;
+        match *self {
+            Strategies::LightOnly => bsdf.eval(frame, wo, wi),
+            Strategies::Split { .. } => {
+                let base = bsdf.eval_base(frame, wo, wi) * power_heuristic(light, self.gather_density(sp, wo, wi));
+                let lobe =
+                    bsdf.eval_lobe(frame, wo, wi) * power_heuristic(light, self.glossy_density(sp, bsdf, wo, wi));
+                base + lobe
+            }
+            Strategies::Whole => bsdf.eval(frame, wo, wi) * power_heuristic(light, bsdf.pdf(frame, wo, wi)),
+        }
+    }
+}
+
+/// The pdf of a final-gather ray toward `wi` ([`super::gather::gather_rays`]): cos θ/π about
+/// the shading normal on `wo`'s side; 0 below the geometric surface, where no ray is sent.
+#[must_use]
+#[inline]
+pub fn gather_pdf(sp: &SurfacePoint, wo: Vec3, wi: Vec3) -> f32 {
+    let (ng, ns) = sp.frame.oriented(wo);
+    if wi.dot(ng) <= 0.0 {
+        return 0.0;
+    }
+    wi.dot(ns).max(0.0) * FRAC_1_PI
+}
+
+/// The power heuristic (β = 2) weight of a sample drawn with density `f` against another kind
+/// of density `g`: f²/(f² + g²), computed as 1/(1 + (g/f)²) so that huge densities (a light
+/// seen edge-on) give 0 or 1, not ∞/∞.
+#[must_use]
+#[inline]
+pub fn power_heuristic(f: f32, g: f32) -> f32 {
+    if !(f > 0.0) {
+        return 0.0;
+    }
+    let r = g / f;
+    let w = 1.0 / (1.0 + r * r);
+    if w.is_nan() {
+        0.0
+    } else {
+        w
+    }
+}
+
+/// The light of emissive triangle `tri` if its emission is weighed by MIS: its index in the
+/// scene's area-light distribution, for an emitter whose surface ends camera-side chains (a
+/// BSDF ray that hits it stops there and can count it).
+#[must_use]
+#[inline]
+pub fn weighed_light(scene: &Scene, tri: u32) -> Option<usize> {
+    let bsdf = &scene.materials[scene.material[tri as usize] as usize].bsdf;
+    if bsdf.is_delta() || bsdf.photon_specular() {
+        return None;
+    }
+    scene.area_light_of(tri)
+}
+
+/// Light sampling's density toward a point of emissive triangle `tri` (light `light`, see
+/// [`weighed_light`]) at `distance` along unit `wi`: `light_samples` × the light's pick
+/// probability × the solid-angle pdf d²/(A·|cos θ_light|) of a uniform point on it.
+#[must_use]
+#[inline]
+pub fn light_density(scene: &Scene, light_samples: u32, light: usize, tri: u32, distance: f32, wi: Vec3) -> f32 {
+    let Some(dist) = &scene.area_power else { return 0.0 };
+    let t = tri as usize;
+    let cos = wi.dot(scene.ng[t]).abs();
+    let pmf = dist.pmf(light) as f32;
+    light_samples as f32 * pmf * (distance * distance) / (scene.area[t] * cos)
+}
+
+/// Emission a BSDF-sampled ray finds at its first hit `hit` (no mirror or glass before it),
+/// arriving along unit `d`, weighted against light sampling; `density` is the BSDF kind's
+/// density for `d` at the ray's origin. Zero from a back face, a non-emitter, an emitter that
+/// light sampling does not weigh, or with no density.
+#[must_use]
+pub fn emission_found(ctx: &Context, hit: &Hit, d: Vec3, density: f32) -> Vec3 {
+    if !(density > 0.0) {
+        return Vec3::ZERO;
+    }
+    let scene = ctx.scene;
+    let Some(light) = weighed_light(scene, hit.tri) else { return Vec3::ZERO };
+    let e = super::specular::emission_toward(scene, hit, -d);
+    if e == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let p_light = light_density(scene, ctx.settings.light_samples, light, hit.tri, hit.t, d);
+    e * power_heuristic(density, p_light)
+}
