@@ -288,7 +288,8 @@ fn light_samples_weighed_against_gather_and_glossy_rays_keep_the_direct_light() 
     let point = floor_point;
     let n = 16;
     // One camera sample's direct light at `sp` on `bsdf` seen from `wo` with MIS: the weighed light
-    // sample, the gather rays' emission (weight kd/n each) and the glossy ray's.
+    // sample, the gather rays' emission (each weighted by its gather weight over n: kd/n, or the
+    // rough plastic's base seen through its coat) and the glossy ray's.
     let mis_sample = |sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, i: u64| {
         let s = Sampler::new(9, Domain::Camera, i);
         let mis = Strategies::Split { gather: n, glossy: bsdf.has_glossy_lobe() };
@@ -296,7 +297,8 @@ fn light_samples_weighed_against_gather_and_glossy_rays_keep_the_direct_light() 
         gather_rays(sp, wo, n, &s.fork(2), |_, o, d| {
             if let Some(hit) = scene.intersect(o, d, f32::INFINITY) {
                 let e = emission_found(&ctx, &hit, d, mis.gather_density(sp, wo, d));
-                value += bsdf.diffuse().x / n as f32 * e.x;
+                let w = if bsdf.gather_varies() { bsdf.gather_weight(&sp.frame, wo, d) } else { bsdf.diffuse() };
+                value += w.x / n as f32 * e.x;
             }
         });
         if let Some(ray) = glossy_ray(sp, bsdf, wo, &s.fork(3)) {
@@ -316,22 +318,27 @@ fn light_samples_weighed_against_gather_and_glossy_rays_keep_the_direct_light() 
         assert!((mean - want).abs() < 4.0 * se + 1e-5 * want, "at {p}: {mean} vs {want} (se {se})");
     }
     // The glossy point: its mirror direction toward the light's centre.
-    let glossy = Bsdf::Glossy { kd: Vec3::splat(0.3), ks: Vec3::splat(0.7), exponent: 30.0 };
     let sp = point(Vec3::new(0.6, 0.0, 0.2));
     let to_light = (Vec3::new(0.0, 1.0, 0.0) - sp.p).normalize();
     let wo = Vec3::new(-to_light.x, to_light.y, -to_light.z);
-    let with: Vec<f32> = (0..2048).map(|i| mis_sample(&sp, &glossy, wo, i)).collect();
-    let without: Vec<f32> = (0..2048)
-        .map(|i| {
-            let s = Sampler::new(9, Domain::Camera, i);
-            direct_light(&ctx, &sp, &glossy, wo, &s.fork(1), &mut Default::default()).x
-        })
-        .collect();
-    let (a, sa) = mean_and_se(&with);
-    let (b, sb) = mean_and_se(&without);
-    println!("glossy: MIS {a:.4} ± {sa:.4}, light samples alone {b:.4} ± {sb:.4}");
-    assert!((a - b).abs() < 4.0 * (sa * sa + sb * sb).sqrt(), "glossy: MIS {a} ± {sa} against {b} ± {sb}");
-    assert!(sa < sb, "glossy: MIS is noisier ({sa}) than light samples alone ({sb})");
+    for (name, bsdf) in [
+        ("phong", Bsdf::Glossy { kd: Vec3::splat(0.3), ks: Vec3::splat(0.7), exponent: 30.0 }),
+        ("rough plastic", Bsdf::RoughPlastic { kd: Vec3::splat(0.5), ior: 1.5, alpha: 0.05 }),
+        ("rough conductor", Bsdf::RoughConductor { ks: Vec3::splat(0.9), alpha: 0.4 }),
+    ] {
+        let with: Vec<f32> = (0..4096).map(|i| mis_sample(&sp, &bsdf, wo, i)).collect();
+        let without: Vec<f32> = (0..4096)
+            .map(|i| {
+                let s = Sampler::new(9, Domain::Camera, i);
+                direct_light(&ctx, &sp, &bsdf, wo, &s.fork(1), &mut Default::default()).x
+            })
+            .collect();
+        let (a, sa) = mean_and_se(&with);
+        let (b, sb) = mean_and_se(&without);
+        println!("{name}: MIS {a:.4} ± {sa:.4}, light samples alone {b:.4} ± {sb:.4}");
+        assert!((a - b).abs() < 4.0 * (sa * sa + sb * sb).sqrt(), "{name}: MIS {a} ± {sa} against {b} ± {sb}");
+        assert!(sa < sb, "{name}: MIS is noisier ({sa}) than light samples alone ({sb})");
+    }
 }
 
 #[test]
