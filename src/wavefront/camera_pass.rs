@@ -15,11 +15,10 @@
 
 use super::queues::{Classified, PathQueue, ShadowQueue};
 use super::resources::{CameraWork, Maps};
-use super::schedule::CameraPass;
+use super::schedule::{camera_schedules, CameraPass};
 use super::{new_world, IdleWorlds, StageStats};
 use crate::film::{PixelMean, Terms};
 use crate::job::Job;
-use crate::parallel::map_chunks;
 use crate::progress::Progress;
 use crate::scene::camera::CameraRays;
 use crate::scene::Scene;
@@ -68,7 +67,7 @@ pub struct CameraPassOut {
 
 /// A world for one worker: the shared resources, the maps and an empty tile.
 fn worker_world(scene: &Arc<Scene>, job: &Job, maps: &Arc<PhotonMaps>, camera: &CameraRays) -> World {
-    let mut world = new_world(scene, job);
+    let mut world = new_world(scene, job, camera_schedules());
     world.insert_resource(Maps(Arc::clone(maps)));
     world.insert_resource(CameraWork {
         camera: *camera,
@@ -109,36 +108,29 @@ pub fn camera_pass(
     // Inside a tile everything runs on its worker's thread.
     let worker_job = Job { threads: 1, ..job.clone() };
     let idle = IdleWorlds::default();
-    let tiles = map_chunks(
+    let tiles = idle.run_units(
         pixels.div_ceil(tile_pixels),
-        1,
         job.threads,
-        |k| {
-            let first = k.start * tile_pixels;
+        || worker_world(scene, &worker_job, maps, camera),
+        |k, world| {
+            let first = k * tile_pixels;
             let count = tile_pixels.min(pixels - first);
-            let film = idle.with(
-                || worker_world(scene, &worker_job, maps, camera),
-                |world| {
-                    // One wave of the tile's samples, or, for a pixel of more samples than a
-                    // tile holds, waves of `tile` samples each, the pixel's mean carried from
-                    // one to the next in sample order (the same sums, so the same image).
-                    let samples = count * spp;
-                    world.resource_mut::<CameraWork>().film.clear();
-                    for start in (0..samples).step_by(tile.max(1)) {
-                        {
-                            let mut w = world.resource_mut::<CameraWork>();
-                            w.first_sample = (first * spp + start) as u64;
-                            w.count = tile.max(1).min(samples - start);
-                        }
-                        world.run_schedule(CameraPass);
-                    }
-                    std::mem::take(&mut world.resource_mut::<CameraWork>().film)
-                },
-            );
+            // One wave of the tile's samples, or, for a pixel of more samples than a tile
+            // holds, waves of `tile` samples each, the pixel's mean carried from one to the
+            // next in sample order (the same sums, so the same image).
+            let samples = count * spp;
+            world.resource_mut::<CameraWork>().film.clear();
+            for start in (0..samples).step_by(tile.max(1)) {
+                {
+                    let mut w = world.resource_mut::<CameraWork>();
+                    w.first_sample = (first * spp + start) as u64;
+                    w.count = tile.max(1).min(samples - start);
+                }
+                world.run_schedule(CameraPass);
+            }
             progress.advance(count as u64);
-            film
+            std::mem::take(&mut world.resource_mut::<CameraWork>().film)
         },
-        |_| {},
     );
     let (worlds, stages) = idle.finish();
     let mut out = CameraPassOut {

@@ -12,12 +12,16 @@ use bevy_ecs::prelude::*;
 
 /// Fills `out` from `hits`, lanes in order. With `paths` (the camera pass), lanes at surfaces
 /// that photons pass on as specular (frosted glass, smooth rough metal) join the mirror lanes
-/// and continue, as the reference's camera and gather paths do; photons at them deposit nothing
-/// and scatter (`deposit_photon`).
+/// and continue, as the reference's camera and gather paths do, and escaped lanes are not
+/// listed (the camera pass reads the hits for what escaped); photons at them deposit nothing
+/// and scatter (`deposit_photon`), and escaped photons are listed for the leak count.
 pub fn classify(scene: &Scene, hits: &HitColumns, paths: bool, out: &mut Classified) {
     out.clear();
     for (i, &tri) in hits.tri.iter().enumerate() {
         let list = if tri == HitColumns::MISS {
+            if paths {
+                continue;
+            }
             &mut out.escaped
         } else {
             let bsdf = &scene.materials[scene.material[tri as usize] as usize].bsdf;

@@ -1,9 +1,10 @@
 //! Deposit: photons that reached a diffuse surface are stored (keyed by path and bounce, so the
-//! map comes out in the reference engine's order), each worker into its own range; camera rays that reached an emitter add its
-//! radiance. Reads the diffuse lane list and hits; writes deposits, survivors, or the wave's terms.
+//! map comes out in the reference engine's order); camera rays that reached an emitter add its
+//! radiance, gather and glossy rays its MIS-weighted share. Reads the diffuse lane list and hits;
+//! writes deposits, survivors, or the wave's terms.
 
 use super::queues::PathKind;
-use super::{par_columns, CameraWork, PhotonWork, Shared, StageClock, StageStats, CHUNK};
+use super::{CameraWork, PhotonWork, Shared, StageClock, StageStats};
 use crate::film::Term;
 use crate::photon_map::Photon;
 use crate::rng::Domain;
@@ -14,16 +15,6 @@ use crate::transport::Context;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 
-/// One worker's deposits: its own range of stored photons and surviving lanes, appended in
-/// chunk order (no atomics, no shared writes).
-#[derive(Default)]
-pub struct DepositPart {
-    /// (path, bounce, photon).
-    pub deposits: Vec<(u64, u32, Photon)>,
-    /// Lanes whose path goes on.
-    pub survivors: Vec<u32>,
-}
-
 /// Stores photons at diffuse hits; lanes whose path goes on become survivors.
 pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
     let t = StageClock::start();
@@ -33,35 +24,24 @@ pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
     let (queue, lanes) = (&w.queue, &w.classified.diffuse);
     let (deposits, survivors) = (&mut w.deposits, &mut w.survivors);
     survivors.clear();
-    par_columns(
-        lanes.len(),
-        CHUNK,
-        shared.job.threads,
-        |r, part: &mut DepositPart| {
-            let mut out = Vec::new();
-            for &lane in &lanes[r] {
-                let i = lane as usize;
-                let Some(hit) = queue.hits.get(i) else { continue };
-                let sp = scene.surface(&hit);
-                let photon = PhotonRay {
-                    origin: queue.rays.origin(i),
-                    dir: queue.rays.direction(i),
-                    power: queue.power[i],
-                    emitted: queue.emitted[i],
-                    specular_only: queue.specular_only[i],
-                };
-                out.clear();
-                if deposit_photon(domain, &sp, &scene.bsdf(&sp), &photon, queue.bounce[i], &mut out) {
-                    part.survivors.push(lane);
-                }
-                part.deposits.extend(out.drain(..).map(|p| (queue.path[i], queue.bounce[i], p)));
-            }
-        },
-        |part| {
-            deposits.append(&mut part.deposits);
-            survivors.append(&mut part.survivors);
-        },
-    );
+    let mut out: Vec<Photon> = Vec::new();
+    for &lane in lanes {
+        let i = lane as usize;
+        let Some(hit) = queue.hits.get(i) else { continue };
+        let sp = scene.surface(&hit);
+        let photon = PhotonRay {
+            origin: queue.rays.origin(i),
+            dir: queue.rays.direction(i),
+            power: queue.power[i],
+            emitted: queue.emitted[i],
+            specular_only: queue.specular_only[i],
+        };
+        out.clear();
+        if deposit_photon(domain, &sp, &scene.bsdf(&sp), &photon, queue.bounce[i], &mut out) {
+            survivors.push(lane);
+        }
+        deposits.extend(out.drain(..).map(|p| (queue.path[i], queue.bounce[i], p)));
+    }
     stats.record("deposit_photons", lanes.len(), t);
 }
 

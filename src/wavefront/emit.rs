@@ -1,8 +1,8 @@
 //! Emit: new lanes. Reads the scene and settings; writes the photon queue (a batch of paths
 //! starting at lights) or the path queue (a wave of camera rays) and the wave's empty terms.
 
-use super::queues::{PathKind, PhotonLane, PhotonQueue, Segment};
-use super::{par_columns, CameraWork, PhotonWork, Shared, StageClock, StageStats, CHUNK};
+use super::queues::{PathKind, PhotonLane, Segment};
+use super::{CameraWork, PhotonWork, Shared, StageClock, StageStats};
 use crate::film::{Term, Terms};
 use crate::rng::Domain;
 use crate::transport::camera::camera_ray;
@@ -22,37 +22,23 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
     w.queue.clear();
     w.counts.clear();
     w.counts.resize(n, PathCounts::default());
-    let (queue, counts) = (&mut w.queue, &mut w.counts);
-    // Each chunk fills its own queue; chunks are appended in lane order.
-    par_columns(
-        n,
-        CHUNK,
-        shared.job.threads,
-        |r, part: &mut (PhotonQueue, Vec<usize>)| {
-            for i in r {
-                let path = first + i as u64;
-                match start_photon(scene, seed, domain, path, shared.job.settings.aim_caustics) {
-                    Start::Photon(p) => part.0.push(PhotonLane {
-                        origin: p.origin,
-                        dir: p.dir,
-                        path,
-                        bounce: 0,
-                        power: p.power,
-                        emitted: p.emitted,
-                        specular_only: true,
-                    }),
-                    Start::Dark => {}
-                    Start::NonFinite => part.1.push(i),
-                }
-            }
-        },
-        |part| {
-            queue.append(&mut part.0);
-            for &i in &part.1 {
-                counts[i].end = PathEnd::EmissionNonFinite;
-            }
-        },
-    );
+    w.queue.reserve(n);
+    for i in 0..n {
+        let path = first + i as u64;
+        match start_photon(scene, seed, domain, path, shared.job.settings.aim_caustics) {
+            Start::Photon(p) => w.queue.push(PhotonLane {
+                origin: p.origin,
+                dir: p.dir,
+                path,
+                bounce: 0,
+                power: p.power,
+                emitted: p.emitted,
+                specular_only: true,
+            }),
+            Start::Dark => {}
+            Start::NonFinite => w.counts[i].end = PathEnd::EmissionNonFinite,
+        }
+    }
     stats.record("emit_photons", n, t);
 }
 

@@ -5,7 +5,7 @@
 //! lane list, hits and maps; writes the wave's terms in lane order.
 
 use super::queues::PathKind;
-use super::{par_lanes, CameraWork, Maps, Shared, StageClock, StageStats, GATHER_CHUNK};
+use super::{chunks, CameraWork, Maps, Shared, StageClock, StageStats, GATHER_CHUNK};
 use crate::code_path::MortonGrid;
 use crate::film::Term;
 use crate::material::Bsdf;
@@ -21,7 +21,7 @@ use glam::Vec3;
 
 /// Runs `estimate(ctx, point, bsdf, wo, kind, pixel, scratch)` at the diffuse hit of every lane
 /// whose kind passes `wanted` (`pixel` is the lane's pixel for camera lanes, `None` for
-/// others), in parallel, and adds `beta × radiance` to the lane's sample in lane order (and
+/// others), in sorted units of lanes, and adds `beta × radiance` to the lane's sample in lane order (and
 /// `beta × bias` to its bias). `own` is the term of camera lanes (routed to specular behind a
 /// mirror or glass); gather and glossy lanes use the term they carry. Returns the number of
 /// estimates.
@@ -42,18 +42,19 @@ fn estimate_at_diffuse_hits(
 ) -> usize {
     let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
     let spp = u64::from(shared.job.settings.spp);
-    let threads = shared.job.threads;
-    let w = &*work;
+    let w = &mut *work;
     let lanes: Vec<u32> = w.classified.diffuse.iter().copied().filter(|&l| wanted(w.paths.kind[l as usize])).collect();
-    // Chunks large enough that a gather ray's point has close neighbours among the chunk's
-    // (16 384 points over a Cornell box lie ~1 cm apart), small enough to stay in cache, and at
-    // least four a thread.
-    let chunk = lanes.len().div_ceil(4 * threads.max(1)).clamp(GATHER_CHUNK, SORTED_CHUNK);
-    let done = par_lanes(lanes.len(), chunk, threads, |r| {
-        let mut scratch = Nearest::default();
-        let mut done: Vec<Lane> = Vec::with_capacity(r.len());
-        // Lookups deferred to the sorted packets, with the index of their lane in `done`.
-        let mut deferred: Vec<(u32, FixedLookup)> = Vec::with_capacity(r.len());
+    // Units large enough that a gather ray's point has close neighbours among the unit's
+    // (16 384 points over a Cornell box lie ~1 cm apart), small enough to stay in cache: a
+    // quarter of the wave's lanes within those bounds.
+    let chunk = lanes.len().div_ceil(4).clamp(GATHER_CHUNK, SORTED_CHUNK);
+    let mut scratch = Nearest::default();
+    let (mut done, mut deferred) = (Vec::<Lane>::new(), Vec::<(u32, FixedLookup)>::new());
+    for r in chunks(lanes.len(), chunk) {
+        // The unit's lanes, and its lookups deferred to the sorted packets with the index of
+        // their lane in `done`.
+        done.clear();
+        deferred.clear();
         let mut packet = Packet::default();
         for j in r {
             let i = lanes[j] as usize;
@@ -94,14 +95,13 @@ fn estimate_at_diffuse_hits(
             packet.add(&ctx, q, slot as usize, &mut done);
         }
         packet.run(&ctx, &mut done);
-        done
-    });
-    for lane in done {
-        let t = &mut work.terms[lane.sample as usize];
-        t.add(lane.term, lane.beta * lane.radiance);
-        t.bias += lane.beta * lane.bias;
+        for lane in &done {
+            let t = &mut w.terms[lane.sample as usize];
+            t.add(lane.term, lane.beta * lane.radiance);
+            t.bias += lane.beta * lane.bias;
+        }
     }
-    work.numerics.photons_filtered += ctx.filtered();
+    w.numerics.photons_filtered += ctx.filtered();
     lanes.len()
 }
 

@@ -6,7 +6,7 @@
 
 use super::queues::PathKind;
 use super::queues::{HitColumns, RayColumns};
-use super::{par_lanes, par_pieces, CameraWork, PhotonWork, Shared, StageClock, StageStats, CHUNK};
+use super::{chunks, CameraWork, PhotonWork, Shared, StageClock, StageStats, CHUNK};
 use crate::geometry::RayQuery;
 use crate::job::Job;
 use crate::rng::Domain;
@@ -16,20 +16,21 @@ use crate::transport::camera::camera_ray;
 use crate::traversal_choice::{Queue, TRIAL_CHUNKS};
 use bevy_ecs::prelude::*;
 
-/// Fills `hits` with the closest hits of `rays` (of `queue`), each chunk writing its own lanes
-/// in place (per-chunk columns appended afterwards cost `intersect_paths` ~6 % of its samples:
-/// the copy and fresh pages for every bounce).
+/// Fills `hits` with the closest hits of `rays` (of `queue`), [`CHUNK`] lanes a traversal call,
+/// written in place (the columns keep their allocation from bounce to bounce).
 fn closest_hits(shared: &Shared, queue: Queue, rays: &RayColumns, hits: &mut HitColumns) {
     let scene = &*shared.scene;
-    let n = rays.len();
-    par_pieces(n, CHUNK, shared.job.threads, hits.pieces(n, CHUNK), |r, piece| {
-        let queries: Vec<RayQuery> =
-            r.map(|i| RayQuery::new(rays.origin(i), rays.direction(i), f32::INFINITY)).collect();
-        let job = &shared.job;
+    let job = &shared.job;
+    hits.clear();
+    hits.reserve(rays.len());
+    let mut queries = Vec::with_capacity(CHUNK);
+    for r in chunks(rays.len(), CHUNK) {
+        queries.clear();
+        queries.extend(r.map(|i| RayQuery::new(rays.origin(i), rays.direction(i), f32::INFINITY)));
         let found =
             job.traversal.closest(queue, job.settings.code_path, scene.bvh(), scene.columns(), &queries, scene.bounds);
-        piece.write(&found);
-    });
+        hits.extend(&found);
+    }
 }
 
 /// Chooses the camera queue's kernel before the first camera pass
@@ -103,26 +104,21 @@ pub fn trace_shadow_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut 
     let w = &mut *work;
     let q = &w.shadows;
     let n = q.len();
-    let blocked = par_lanes(n, CHUNK, shared.job.threads, |r| {
-        let queries: Vec<RayQuery> =
-            r.map(|i| RayQuery::new(q.rays.origin(i), q.rays.direction(i), q.t_max[i])).collect();
+    let job = &shared.job;
+    let (mut queries, mut blocked) = (Vec::with_capacity(CHUNK), Vec::with_capacity(CHUNK));
+    for r in chunks(n, CHUNK) {
+        queries.clear();
+        queries.extend(r.clone().map(|i| RayQuery::new(q.rays.origin(i), q.rays.direction(i), q.t_max[i])));
         // Shadow rays are queued in camera-lane order, from neighbouring hits toward the same
         // lights: already coherent, and sorting them cost more than it saved (BENCHMARKS.md).
-        let mut blocked = vec![false; queries.len()];
-        let job = &shared.job;
-        job.traversal.occluded(
-            Queue::Shadows,
-            job.settings.code_path,
-            scene.bvh(),
-            scene.columns(),
-            &queries,
-            &mut blocked,
-        );
-        blocked
-    });
-    for (i, b) in blocked.into_iter().enumerate() {
-        if !b {
-            w.terms[q.sample[i] as usize].add(q.term[i], q.contribution[i]);
+        blocked.clear();
+        blocked.resize(queries.len(), false);
+        let code_path = job.settings.code_path;
+        job.traversal.occluded(Queue::Shadows, code_path, scene.bvh(), scene.columns(), &queries, &mut blocked);
+        for (i, &b) in r.zip(&blocked) {
+            if !b {
+                w.terms[q.sample[i] as usize].add(q.term[i], q.contribution[i]);
+            }
         }
     }
     w.rays.shadow += n as u64;

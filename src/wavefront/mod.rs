@@ -2,19 +2,21 @@
 //! flow through bevy_ecs systems, one stage per file:
 //!
 //! ```text
-//! photon pass (per wave):   emit ─► [ intersect ─► classify ─► deposit ─► shade ]* until no photon is left
-//! camera pass (per tile):   emit ─► [ intersect ─► classify ─► deposit ─► gather ─► shade ]* until no ray is left ─► resolve
+//! photon pass (per piece):  emit ─► [ intersect ─► classify ─► deposit ─► shade ]* until no photon is left
+//! camera pass (per wave):   emit ─► [ intersect ─► classify ─► deposit ─► gather ─► shade ]* until no ray is left ─► resolve
 //! ```
 //!
 //! The bracketed loop is a sub-schedule run by an exclusive system until its queues are empty,
 //! as physics engines run substeps ([`schedule`]). The systems call the transport core
 //! ([`crate::transport`]) per lane with the same random streams as the oracle, so for the same
-//! seed the two agree per pixel up to the order of floating-point additions. The photon pass's
-//! waves are shared by all threads: within a system, lanes are processed in fixed chunks on the
-//! persistent worker pool ([`crate::parallel`]) and results are reduced in lane order. The
-//! camera pass runs per worker ([`camera_pass`]): each worker takes tiles of samples through the
-//! whole camera schedule on its own world. Either way the image is bit-identical at any thread
-//! count.
+//! seed the two agree per pixel up to the order of floating-point additions.
+//!
+//! Parallelism is outside the schedules: each worker takes a unit of work — a *piece* of a
+//! photon wave ([`photon_pass`]: up to 2 048 consecutive paths) or a *tile* of the image
+//! ([`camera_pass`]: whole pixels, its samples run as one or more *waves* of at most a tile's
+//! samples in flight) — through the whole schedule on its own world, and every system is a plain
+//! loop over its queue on that worker's thread, pushing into the next queue in lane order. The
+//! image is bit-identical at any thread count.
 //!
 //! Systems are gated on the [`Effects`](crate::effects::Effects) plan with run conditions: a
 //! scene without mirrors or glass never runs the caustic systems, one without glass never runs
@@ -52,15 +54,13 @@ use bevy_ecs::prelude::*;
 use camera_pass::camera_pass;
 use photon_pass::photon_pass;
 pub use resources::{CameraWork, Maps, PhotonWork, Shared};
-pub use schedule::{schedules, CameraBounce, CameraPass, PhotonBounce, PhotonPass};
+pub use schedule::{camera_schedules, photon_schedules, CameraBounce, CameraPass, PhotonBounce, PhotonPass};
 use std::sync::Arc;
 use std::time::Instant;
 
-/// The stages, in order.
+/// The stages of a bounce, in order (emit runs before the bounce loop, in the pass's schedule).
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Stage {
-    /// New rays and photons.
-    Emit,
     /// Closest hits (and shadow rays' any-hits).
     Intersect,
     /// Split hits into diffuse, mirror, glass, escaped.
@@ -73,74 +73,16 @@ pub enum Stage {
     Shade,
 }
 
-/// Lanes per work chunk for cheap kernels (traversal, scattering).
+/// Lanes per traversal call: the unit the traversal kernels are timed and chosen on
+/// ([`crate::traversal_choice`]) and the packets' sorting unit.
 pub const CHUNK: usize = 1024;
-/// Lanes per work chunk for density estimates.
+/// Fewest lanes in one sorted unit of density estimates ([`gather`]).
 pub const GATHER_CHUNK: usize = 256;
 
-/// Runs `f` over `0..n` in chunks on `threads` threads; each chunk fills its own `T` (a queue
-/// or columns) and the chunks are appended in lane order with `append` (column copies, so the
-/// sequential part stays small).
-pub fn par_columns<T: Send + Default>(
-    n: usize,
-    chunk: usize,
-    threads: usize,
-    f: impl Fn(std::ops::Range<usize>, &mut T) + Sync,
-    mut append: impl FnMut(&mut T),
-) {
-    for mut part in map_chunks(
-        n,
-        chunk,
-        threads,
-        |r| {
-            let mut t = T::default();
-            f(r, &mut t);
-            t
-        },
-        |_| {},
-    ) {
-        append(&mut part);
-    }
-}
-
-/// Runs `f` over `0..n` in chunks on `threads` threads, chunk `c` with `pieces[c]` (lanes
-/// `c·chunk..` of some columns, split as [`queues::HitColumns::pieces`] splits them): each chunk
-/// writes its own lanes in place, so nothing is appended or copied afterwards.
-///
-/// # Panics
-/// If there are fewer pieces than chunks.
-pub fn par_pieces<P: Send>(
-    n: usize,
-    chunk: usize,
-    threads: usize,
-    pieces: Vec<P>,
-    f: impl Fn(std::ops::Range<usize>, &mut P) + Sync,
-) {
+/// The ranges of `0..n` in order, each `chunk` long but the last.
+pub fn chunks(n: usize, chunk: usize) -> impl Iterator<Item = std::ops::Range<usize>> {
     let chunk = chunk.max(1);
-    assert!(pieces.len() >= n.div_ceil(chunk), "a piece for every chunk");
-    let slots: Vec<std::sync::Mutex<Option<P>>> = pieces.into_iter().map(|p| std::sync::Mutex::new(Some(p))).collect();
-    map_chunks(
-        n,
-        chunk,
-        threads,
-        |r| {
-            let piece = slots[r.start / chunk].lock().unwrap_or_else(std::sync::PoisonError::into_inner).take();
-            f(r, &mut piece.expect("each chunk runs once"));
-        },
-        |_| {},
-    );
-}
-
-/// Runs `f` over `0..n` in chunks on `threads` threads; results in lane order, read from each
-/// chunk's own vector (collecting them into one new vector cost `gather_global` 7 % of its
-/// samples, most of them fresh pages for ~10⁶ lanes every bounce).
-pub fn par_lanes<T: Send>(
-    n: usize,
-    chunk: usize,
-    threads: usize,
-    f: impl Fn(std::ops::Range<usize>) -> Vec<T> + Sync,
-) -> std::iter::Flatten<std::vec::IntoIter<Vec<T>>> {
-    map_chunks(n, chunk, threads, f, |_| {}).into_iter().flatten()
+    (0..n).step_by(chunk).map(move |s| s..(s + chunk).min(n))
 }
 
 /// The worlds of a pass's workers: a tile or piece takes an idle one (or builds one) and puts it
@@ -160,6 +102,19 @@ impl IdleWorlds {
         r
     }
 
+    /// Runs `unit(k, world)` for every unit of work `k` in `0..units` (a piece or a tile) on
+    /// `threads` workers, each on an idle world (or a new one from `make`); the results in unit
+    /// order. The one worker loop of both passes.
+    pub fn run_units<T: Send>(
+        &self,
+        units: usize,
+        threads: usize,
+        make: impl Fn() -> World + Sync,
+        unit: impl Fn(usize, &mut World) -> T + Sync,
+    ) -> Vec<T> {
+        map_chunks(units, 1, threads, |k| self.with(&make, |world| unit(k.start, world)), |_| {})
+    }
+
     /// The worlds, and their stage counts and times summed (sums of counts and times: they do
     /// not depend on which worker took which tile).
     #[must_use]
@@ -173,14 +128,14 @@ impl IdleWorlds {
     }
 }
 
-/// A world holding the shared resources and the schedules of both passes.
-fn new_world(scene: &Arc<Scene>, job: &Job) -> World {
+/// A worker's world: the shared resources, empty maps and stage counts, and `schedules` (one
+/// pass's).
+fn new_world(scene: &Arc<Scene>, job: &Job, schedules: [Schedule; 2]) -> World {
     let mut world = World::new();
     world.insert_resource(Shared { scene: scene.clone(), job: job.clone() });
     world.insert_resource(Maps::default());
-    world.insert_resource(PhotonWork::default());
     world.insert_resource(StageStats::default());
-    for s in schedules() {
+    for s in schedules {
         world.add_schedule(s);
     }
     world

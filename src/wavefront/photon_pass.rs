@@ -11,10 +11,9 @@
 //! reference engine's order, whoever traced which piece.
 
 use super::resources::PhotonWork;
-use super::schedule::PhotonPass;
+use super::schedule::{photon_schedules, PhotonPass};
 use super::{new_world, IdleWorlds, StageStats};
 use crate::job::Job;
-use crate::parallel::map_chunks;
 use crate::photon_map::Photon;
 use crate::progress::Progress;
 use crate::rng::Domain;
@@ -57,32 +56,30 @@ fn trace_wave(
 ) -> (Vec<(u64, u32, Photon)>, Vec<PathCounts>) {
     let worker_job = Job { threads: 1, ..job.clone() };
     let piece = piece_for(paths, job.threads);
-    let pieces = map_chunks(
+    let pieces = idle.run_units(
         paths.div_ceil(piece),
-        1,
         job.threads,
-        |k| {
-            let start = k.start * piece;
-            idle.with(
-                || new_world(scene, &worker_job),
-                |world| {
-                    {
-                        // The queues keep their allocations from piece to piece (emit clears them).
-                        let mut w = world.resource_mut::<PhotonWork>();
-                        w.domain = Some(domain);
-                        w.first_path = first + start as u64;
-                        w.paths = piece.min(paths - start);
-                        w.deposits.clear();
-                    }
-                    world.run_schedule(PhotonPass);
-                    let mut w = world.resource_mut::<PhotonWork>();
-                    let mut deposits = std::mem::take(&mut w.deposits);
-                    deposits.sort_by_key(|(path, bounce, _)| (*path, *bounce));
-                    (deposits, std::mem::take(&mut w.counts))
-                },
-            )
+        || {
+            let mut world = new_world(scene, &worker_job, photon_schedules());
+            world.insert_resource(PhotonWork::default());
+            world
         },
-        |_| {},
+        |k, world| {
+            let start = k * piece;
+            {
+                // The queues keep their allocations from piece to piece (emit clears them).
+                let mut w = world.resource_mut::<PhotonWork>();
+                w.domain = Some(domain);
+                w.first_path = first + start as u64;
+                w.paths = piece.min(paths - start);
+                w.deposits.clear();
+            }
+            world.run_schedule(PhotonPass);
+            let mut w = world.resource_mut::<PhotonWork>();
+            let mut deposits = std::mem::take(&mut w.deposits);
+            deposits.sort_by_key(|(path, bounce, _)| (*path, *bounce));
+            (deposits, std::mem::take(&mut w.counts))
+        },
     );
     let mut deposits = Vec::with_capacity(pieces.iter().map(|p| p.0.len()).sum());
     let mut counts = Vec::with_capacity(paths);

@@ -119,24 +119,25 @@ impl HitColumns {
         self.b2.clear();
     }
 
-    /// Resizes every column to `n` lanes (new lanes escaped) and splits them into pieces of
-    /// `chunk` lanes, in lane order: each piece can be written by its own thread.
-    pub fn pieces(&mut self, n: usize, chunk: usize) -> Vec<HitPiece<'_>> {
-        let chunk = chunk.max(1);
-        let e = Self::ESCAPED;
-        self.tri.resize(n, e.tri);
-        self.t.resize(n, e.t);
-        for (c, b) in [&mut self.b0, &mut self.b1, &mut self.b2].into_iter().zip(e.b) {
-            c.resize(n, b);
+    /// Reserves room for `n` more lanes.
+    pub fn reserve(&mut self, n: usize) {
+        self.tri.reserve(n);
+        self.t.reserve(n);
+        for c in [&mut self.b0, &mut self.b1, &mut self.b2] {
+            c.reserve(n);
         }
-        let mut b0 = self.b0.chunks_mut(chunk);
-        let mut b1 = self.b1.chunks_mut(chunk);
-        let mut b2 = self.b2.chunks_mut(chunk);
-        self.tri
-            .chunks_mut(chunk)
-            .zip(self.t.chunks_mut(chunk))
-            .filter_map(|(tri, t)| Some(HitPiece { tri, t, b0: b0.next()?, b1: b1.next()?, b2: b2.next()? }))
-            .collect()
+    }
+
+    /// Appends `hits`, one per lane in order (`None`: escaped).
+    pub fn extend(&mut self, hits: &[Option<Hit>]) {
+        for h in hits {
+            let h = h.unwrap_or(Self::ESCAPED);
+            self.tri.push(h.tri);
+            self.t.push(h.t);
+            self.b0.push(h.b[0]);
+            self.b1.push(h.b[1]);
+            self.b2.push(h.b[2]);
+        }
     }
 
     /// The hit of lane `i`, if any.
@@ -151,40 +152,6 @@ impl HitColumns {
     }
 }
 
-/// A run of lanes of [`HitColumns`], borrowed column by column for one thread to write.
-pub struct HitPiece<'a> {
-    tri: &'a mut [u32],
-    t: &'a mut [f32],
-    b0: &'a mut [f32],
-    b1: &'a mut [f32],
-    b2: &'a mut [f32],
-}
-
-impl HitPiece<'_> {
-    /// Lanes in the piece.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.tri.len()
-    }
-    /// True if the piece holds no lane.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.tri.is_empty()
-    }
-    /// Writes `hits`, one per lane of the piece, in order (`None`: escaped).
-    pub fn write(&mut self, hits: &[Option<Hit>]) {
-        debug_assert_eq!(hits.len(), self.len(), "one hit per lane");
-        let n = self.len().min(hits.len());
-        let (tri, t) = (&mut self.tri[..n], &mut self.t[..n]);
-        let (b0, b1, b2) = (&mut self.b0[..n], &mut self.b1[..n], &mut self.b2[..n]);
-        for (k, h) in hits[..n].iter().enumerate() {
-            let h = h.unwrap_or(HitColumns::ESCAPED);
-            (tri[k], t[k]) = (h.tri, h.t);
-            (b0[k], b1[k], b2[k]) = (h.b[0], h.b[1], h.b[2]);
-        }
-    }
-}
-
 /// Lanes of the last intersected queue, split by what happens next.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Classified {
@@ -194,7 +161,7 @@ pub struct Classified {
     pub mirror: Vec<u32>,
     /// Lanes that hit glass.
     pub glass: Vec<u32>,
-    /// Lanes that hit nothing.
+    /// Lanes that hit nothing (listed for photons only: their leak count).
     pub escaped: Vec<u32>,
 }
 
@@ -371,7 +338,6 @@ soa_queue! {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::wavefront::par_pieces;
 
     /// A hit whose fields all say which lane it belongs to.
     fn hit(lane: usize) -> Option<Hit> {
@@ -380,31 +346,26 @@ mod tests {
     }
 
     #[test]
-    fn pieces_written_by_two_threads_fill_every_lane_in_order() {
-        // 2 500 lanes in chunks of 1 024: the last piece is short. The columns start longer than
-        // the queue (a bigger bounce before), so they must shrink, and every lane is rewritten.
-        let (n, chunk) = (2_500, 1_024);
+    fn hits_written_in_chunks_fill_every_lane_in_order() {
+        // 2 500 lanes in chunks of 1 024 (the last one short), after a longer bounce: the
+        // columns are cleared and every lane written again.
         let mut hits = HitColumns::default();
-        hits.pieces(4_000, chunk);
-        let pieces = hits.pieces(n, chunk);
-        assert_eq!(pieces.iter().map(HitPiece::len).collect::<Vec<_>>(), [1_024, 1_024, 452]);
-        par_pieces(n, chunk, 2, pieces, |r, piece| {
-            assert_eq!(r.len(), piece.len());
-            piece.write(&r.map(hit).collect::<Vec<_>>());
-        });
-        assert_eq!(hits.tri.len(), n);
-        for lane in 0..n {
+        hits.extend(&(0..4_000).map(hit).collect::<Vec<_>>());
+        hits.clear();
+        for r in crate::wavefront::chunks(2_500, 1_024) {
+            hits.extend(&r.map(hit).collect::<Vec<_>>());
+        }
+        assert_eq!(hits.tri.len(), 2_500);
+        for lane in 0..2_500 {
             assert_eq!(hits.get(lane), hit(lane), "lane {lane}");
         }
         assert_eq!((hits.t[3], hits.b0[3]), (f32::INFINITY, 0.0), "a miss reads as escaped");
     }
 
     #[test]
-    fn no_lanes_no_pieces() {
-        let mut hits = HitColumns::default();
-        hits.pieces(10, 4);
-        assert!(hits.pieces(0, 4).is_empty());
-        par_pieces(0, 4, 2, hits.pieces(0, 4), |_, _: &mut HitPiece| panic!("no chunk to run"));
-        assert!(hits.tri.is_empty() && hits.b2.is_empty());
+    fn chunks_cover_every_lane_once() {
+        let ranges: Vec<_> = crate::wavefront::chunks(2_500, 1_024).collect();
+        assert_eq!(ranges, [0..1_024, 1_024..2_048, 2_048..2_500]);
+        assert_eq!(crate::wavefront::chunks(0, 4).count(), 0);
     }
 }

@@ -51,13 +51,6 @@ pub struct PhotonWork {
     pub counts: Vec<PathCounts>,
 }
 
-impl PhotonWork {
-    /// The counts of path `path` of this wave.
-    pub fn count(&mut self, path: u64) -> &mut PathCounts {
-        &mut self.counts[(path - self.first_path) as usize]
-    }
-}
-
 /// Camera-pass state of one worker: its tile of samples (a wave) and the counts of every tile
 /// it has rendered.
 #[derive(Resource)]

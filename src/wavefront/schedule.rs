@@ -1,13 +1,13 @@
-//! The recipe: the four schedules (photon wave and bounce, camera wave and bounce), the order
-//! of their systems, their run conditions from the effects plan, and the loops that run a
-//! bounce schedule until its queues are empty.
+//! The recipe: the four schedules (a photon piece and its bounce, a camera wave and its bounce),
+//! the order of their systems, their run conditions from the effects plan, and the loops that
+//! run a bounce schedule until its queues are empty.
 
 use super::resources::{CameraWork, PhotonWork, Shared};
 use super::{classify, deposit, emit, gather, intersect, shade, Stage};
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{ExecutorKind, ScheduleLabel};
 
-/// One wave of the photon pass (up to `MAX_BATCHES_PER_WAVE` batches of paths): emit, then the
+/// One piece of a photon wave (consecutive paths, [`super::photon_pass`]): emit, then the
 /// bounce loop.
 #[derive(ScheduleLabel, Clone, Debug, PartialEq, Eq, Hash)]
 pub struct PhotonPass;
@@ -64,29 +64,46 @@ fn run_camera_bounces(world: &mut World) {
     }
 }
 
-/// The recipe: every schedule and the order of its systems, top to bottom.
-#[must_use]
-pub fn schedules() -> [Schedule; 4] {
-    let stages =
-        || (Stage::Emit, Stage::Intersect, Stage::Classify, Stage::Deposit, Stage::Gather, Stage::Shade).chain();
+/// The stages of a bounce, in order.
+const STAGES: (Stage, Stage, Stage, Stage, Stage) =
+    (Stage::Intersect, Stage::Classify, Stage::Deposit, Stage::Gather, Stage::Shade);
 
+/// The systems of a schedule run one after another in the recipe's order, on the worker's
+/// thread (the workers are the parallelism: [`super::IdleWorlds::run_units`]).
+fn single_threaded<const N: usize>(mut schedules: [Schedule; N]) -> [Schedule; N] {
+    for s in &mut schedules {
+        s.set_executor_kind(ExecutorKind::SingleThreaded);
+    }
+    schedules
+}
+
+/// The photon pass's recipe, [`PhotonPass`] and [`PhotonBounce`]: the order of their systems,
+/// top to bottom.
+#[must_use]
+pub fn photon_schedules() -> [Schedule; 2] {
     let mut photon_pass = Schedule::new(PhotonPass);
     photon_pass.add_systems((emit::emit_photons, run_photon_bounces).chain());
 
     let mut photon_bounce = Schedule::new(PhotonBounce);
-    photon_bounce.configure_sets(stages());
+    photon_bounce.configure_sets(STAGES.chain());
     photon_bounce.add_systems((
         intersect::intersect_photons.in_set(Stage::Intersect),
         classify::classify_photons.in_set(Stage::Classify),
         deposit::deposit_photons.in_set(Stage::Deposit),
         (shade::scatter_photons, shade::refract_photons.run_if(refraction_on)).chain().in_set(Stage::Shade),
     ));
+    single_threaded([photon_pass, photon_bounce])
+}
 
+/// The camera pass's recipe, [`CameraPass`] and [`CameraBounce`]: the order of their systems,
+/// top to bottom.
+#[must_use]
+pub fn camera_schedules() -> [Schedule; 2] {
     let mut camera_pass = Schedule::new(CameraPass);
     camera_pass.add_systems((emit::emit_camera_rays, run_camera_bounces, shade::resolve_wave).chain());
 
     let mut camera_bounce = Schedule::new(CameraBounce);
-    camera_bounce.configure_sets(stages());
+    camera_bounce.configure_sets(STAGES.chain());
     camera_bounce.add_systems((
         (intersect::trace_shadow_rays, intersect::intersect_paths).chain().in_set(Stage::Intersect),
         (classify::classify_paths, classify::mark_near_gathers.run_if(final_gather_on)).chain().in_set(Stage::Classify),
@@ -105,11 +122,5 @@ pub fn schedules() -> [Schedule; 4] {
             .in_set(Stage::Shade),
     ));
 
-    let mut all = [photon_pass, photon_bounce, camera_pass, camera_bounce];
-    for s in &mut all {
-        // Parallelism is inside the systems (fixed chunks, ordered reduction); the systems
-        // themselves run one after another in the recipe's order.
-        s.set_executor_kind(ExecutorKind::SingleThreaded);
-    }
-    all
+    single_threaded([camera_pass, camera_bounce])
 }

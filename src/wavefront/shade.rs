@@ -5,8 +5,8 @@
 //! `resolve_wave` turns the tile's samples into pixels. Reads classified lanes and hits; writes
 //! the next queues, the shadow queue and the film.
 
-use super::queues::{PathKind, PathQueue, PhotonLane, PhotonQueue, Segment, ShadowLane, ShadowQueue};
-use super::{par_columns, par_lanes, CameraWork, Maps, PhotonWork, Shared, StageClock, StageStats, CHUNK};
+use super::queues::{PathKind, PhotonLane, Segment, ShadowLane};
+use super::{CameraWork, Maps, PhotonWork, Shared, StageClock, StageStats};
 use crate::film::Term;
 use crate::rng::{Domain, Sampler};
 use crate::transport::direct::{direct_light_rays, ShadowRay};
@@ -17,32 +17,28 @@ use crate::transport::specular::continue_chain;
 use crate::transport::{streams, Context};
 use bevy_ecs::prelude::*;
 
-/// Scatters the photon lanes `lanes` into `next`, counting per path what the bounce clamped,
-/// dropped or cut.
-fn scatter_lanes(shared: &Shared, work: &mut PhotonWork, lanes: &[u32], next: &mut PhotonQueue) {
+/// Scatters the photon lanes `lanes` into the next queue, counting per path what the bounce
+/// clamped, dropped or cut.
+fn scatter_lanes(shared: &Shared, work: &mut PhotonWork, lanes: &[u32]) {
     let scene = &*shared.scene;
     let domain = work.domain.unwrap_or(Domain::GlobalPhoton);
-    let q = &work.queue;
-    let results = par_lanes(lanes.len(), CHUNK, shared.job.threads, |r| {
-        r.filter_map(|j| {
-            let i = lanes[j] as usize;
-            let sp = scene.surface(&q.hits.get(i)?);
-            let bsdf = scene.bsdf(&sp);
-            let photon = PhotonRay {
-                origin: q.rays.origin(i),
-                dir: q.rays.direction(i),
-                power: q.power[i],
-                emitted: q.emitted[i],
-                specular_only: q.specular_only[i],
-            };
-            let s = Sampler::new(shared.job.pass.seed, domain, q.path[i]);
-            Some((i, scatter_photon(&s, &sp, &bsdf, &photon, q.bounce[i])))
-        })
-        .collect()
-    });
-    for (i, r) in results {
-        let (path, bounce) = (work.queue.path[i], work.queue.bounce[i]);
-        let counts = work.count(path);
+    let PhotonWork { queue: q, next, counts: path_counts, first_path, .. } = work;
+    for &lane in lanes {
+        let i = lane as usize;
+        let Some(hit) = q.hits.get(i) else { continue };
+        let sp = scene.surface(&hit);
+        let bsdf = scene.bsdf(&sp);
+        let photon = PhotonRay {
+            origin: q.rays.origin(i),
+            dir: q.rays.direction(i),
+            power: q.power[i],
+            emitted: q.emitted[i],
+            specular_only: q.specular_only[i],
+        };
+        let s = Sampler::new(shared.job.pass.seed, domain, q.path[i]);
+        let r = scatter_photon(&s, &sp, &bsdf, &photon, q.bounce[i]);
+        let (path, bounce) = (q.path[i], q.bounce[i]);
+        let counts = &mut path_counts[(path - *first_path) as usize];
         let p = match r {
             Scattered::Continue(p) => p,
             Scattered::Capped(p) => {
@@ -80,20 +76,17 @@ fn scatter_lanes(shared: &Shared, work: &mut PhotonWork, lanes: &[u32], next: &m
 pub fn scatter_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
     let t = StageClock::start();
     let lanes: Vec<u32> = work.classified.mirror.iter().chain(&work.survivors).copied().collect();
-    let mut next = std::mem::take(&mut work.next);
-    scatter_lanes(&shared, &mut work, &lanes, &mut next);
-    work.next = next;
+    scatter_lanes(&shared, &mut work, &lanes);
     stats.record("scatter_photons", lanes.len(), t);
 }
 
 /// Photons at glass reflect or refract into the next queue (only in scenes with glass).
 pub fn refract_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
     let t = StageClock::start();
-    let lanes = work.classified.glass.clone();
-    let mut next = std::mem::take(&mut work.next);
-    scatter_lanes(&shared, &mut work, &lanes, &mut next);
-    work.next = next;
+    let lanes = std::mem::take(&mut work.classified.glass);
+    scatter_lanes(&shared, &mut work, &lanes);
     stats.record("refract_photons", lanes.len(), t);
+    work.classified.glass = lanes;
 }
 
 /// Diffuse lanes of camera, glossy and near-landed gather rays queue their shadow rays (direct
@@ -101,68 +94,59 @@ pub fn refract_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
 pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = StageClock::start();
     let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
-    let w = &*work;
+    let CameraWork { paths, classified, shadows, .. } = &mut *work;
     let scene = &*shared.scene;
+    let before = shadows.len();
     // Camera lanes at surfaces passed by sampling (frosted glass, smooth rough metal) take the
     // delta lights' direct light there; lanes merged in order.
     let passed = |l: &u32| {
         let i = *l as usize;
-        w.paths.kind[i] == PathKind::Camera
-            && w.paths.hits.get(i).is_some_and(|h| {
+        paths.kind[i] == PathKind::Camera
+            && paths.hits.get(i).is_some_and(|h| {
                 let b = &scene.materials[scene.material[h.tri as usize] as usize].bsdf;
                 !b.is_delta() && b.photon_specular()
             })
     };
     let mut lanes: Vec<u32> =
-        w.classified.diffuse.iter().copied().filter(|&l| !w.paths.kind[l as usize].reads_maps()).collect();
+        classified.diffuse.iter().copied().filter(|&l| !paths.kind[l as usize].reads_maps()).collect();
     if !scene.delta_lights.is_empty() {
-        lanes.extend(w.classified.mirror.iter().copied().filter(passed));
+        lanes.extend(classified.mirror.iter().copied().filter(passed));
         lanes.sort_unstable();
     }
-    let mut queued = ShadowQueue::default();
-    par_columns(
-        lanes.len(),
-        CHUNK,
-        shared.job.threads,
-        |r, part: &mut ShadowQueue| {
-            for j in r {
-                let i = lanes[j] as usize;
-                let Some(hit) = w.paths.hits.get(i) else { continue };
-                let sp = ctx.scene.surface(&hit);
-                let bsdf = &ctx.scene.bsdf(&sp);
-                let s = Sampler::from_key(w.paths.key[i]);
-                let (stream, term) = match w.paths.kind[i] {
-                    PathKind::Camera => {
-                        (s.fork(streams::light(w.paths.depth[i])), Term::Direct.seen(w.paths.through_specular[i]))
-                    }
-                    PathKind::NearGather => (s.fork(streams::SECONDARY_LIGHT), w.paths.term[i]),
-                    _ => (s.fork(streams::GLOSSY_HIT_LIGHT), w.paths.term[i]),
-                };
-                let (beta, sample) = (w.paths.beta[i], w.paths.sample[i]);
-                let delta_only = !bsdf.is_delta() && bsdf.photon_specular();
-                // Only a camera path's own non-specular hit sends the rays its light samples are
-                // weighed against (as in the reference).
-                let mis = match w.paths.kind[i] {
-                    PathKind::Camera if !delta_only => Strategies::at_camera_hit(&ctx, bsdf),
-                    _ => Strategies::LightOnly,
-                };
-                let wo = -w.paths.rays.direction(i);
-                direct_light_rays(&ctx, &sp, bsdf, wo, &stream, delta_only, &mis, |ray: ShadowRay| {
-                    part.push(ShadowLane {
-                        origin: ray.origin,
-                        dir: ray.direction,
-                        t_max: ray.t_max,
-                        sample,
-                        term,
-                        contribution: ray.contribution * beta,
-                    });
-                });
+    for &lane in &lanes {
+        let i = lane as usize;
+        let Some(hit) = paths.hits.get(i) else { continue };
+        let sp = ctx.scene.surface(&hit);
+        let bsdf = &ctx.scene.bsdf(&sp);
+        let s = Sampler::from_key(paths.key[i]);
+        let (stream, term) = match paths.kind[i] {
+            PathKind::Camera => {
+                (s.fork(streams::light(paths.depth[i])), Term::Direct.seen(paths.through_specular[i]))
             }
-        },
-        |part| queued.append(part),
-    );
-    let n = queued.len();
-    work.shadows.append(&mut queued);
+            PathKind::NearGather => (s.fork(streams::SECONDARY_LIGHT), paths.term[i]),
+            _ => (s.fork(streams::GLOSSY_HIT_LIGHT), paths.term[i]),
+        };
+        let (beta, sample) = (paths.beta[i], paths.sample[i]);
+        let delta_only = !bsdf.is_delta() && bsdf.photon_specular();
+        // Only a camera path's own non-specular hit sends the rays its light samples are
+        // weighed against (as in the reference).
+        let mis = match paths.kind[i] {
+            PathKind::Camera if !delta_only => Strategies::at_camera_hit(&ctx, bsdf),
+            _ => Strategies::LightOnly,
+        };
+        let wo = -paths.rays.direction(i);
+        direct_light_rays(&ctx, &sp, bsdf, wo, &stream, delta_only, &mis, |ray: ShadowRay| {
+            shadows.push(ShadowLane {
+                origin: ray.origin,
+                dir: ray.direction,
+                t_max: ray.t_max,
+                sample,
+                term,
+                contribution: ray.contribution * beta,
+            });
+        });
+    }
+    let n = shadows.len() - before;
     stats.record("shade_direct", n, t);
 }
 
@@ -178,7 +162,7 @@ pub fn spawn_gather_rays(
     let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
     let scene = &*shared.scene;
     let n = shared.job.settings.gather_rays;
-    // Chunks append straight to the next queue (disjoint fields of the work resource).
+    // Rays go straight into the next queue (disjoint fields of the work resource).
     let CameraWork { paths, classified, next, .. } = &mut *work;
     let w = &*paths;
     let lanes: Vec<u32> = classified
@@ -189,65 +173,56 @@ pub fn spawn_gather_rays(
         .collect();
     let before = next.len();
     next.reserve(lanes.len() * n as usize);
-    par_columns(
-        lanes.len(),
-        CHUNK,
-        shared.job.threads,
-        |r, out: &mut PathQueue| {
-            out.reserve(r.len() * n as usize);
-            for j in r {
-                let i = lanes[j] as usize;
-                let Some(hit) = w.hits.get(i) else { continue };
-                let sp = scene.surface(&hit);
-                let bsdf = scene.bsdf(&sp);
-                let kd = bsdf.diffuse();
-                if kd == glam::Vec3::ZERO {
-                    continue;
-                }
-                let s = Sampler::from_key(w.key[i]);
-                let (gs, rays, kind, term, mis) = match w.kind[i] {
-                    PathKind::Camera => (
-                        s.fork(streams::gather(w.depth[i])),
-                        n,
-                        PathKind::Gather,
-                        Term::Indirect.seen(w.through_specular[i]),
-                        Strategies::at_camera_hit(&ctx, &bsdf),
-                    ),
-                    _ => (
-                        s.fork(streams::SECONDARY_GATHER),
-                        1,
-                        PathKind::SecondaryGather,
-                        w.term[i],
-                        Strategies::LightOnly,
-                    ),
-                };
-                let wo = -w.rays.direction(i);
-                let weight = w.beta[i] * kd / rays as f32;
-                gather_rays(&sp, wo, rays, &gs, |g, origin, dir| {
-                    // A rough plastic weighs each ray by its base's share (as the reference).
-                    let weight = if bsdf.gather_varies() {
-                        w.beta[i] * bsdf.gather_weight(&sp.frame, wo, dir) / rays as f32
-                    } else {
-                        weight
-                    };
-                    out.push(Segment {
-                        origin,
-                        dir,
-                        sample: w.sample[i],
-                        kind,
-                        key: gs.fork(streams::gather_ray(g)).key(),
-                        base: streams::GATHER_CHAIN_BOUNCE as u8,
-                        depth: 0,
-                        beta: weight,
-                        term,
-                        through_specular: w.through_specular[i],
-                        mis: mis.gather_density(&sp, wo, dir),
-                    });
-                });
-            }
-        },
-        |part| next.append(part),
-    );
+    for &lane in &lanes {
+        let i = lane as usize;
+        let Some(hit) = w.hits.get(i) else { continue };
+        let sp = scene.surface(&hit);
+        let bsdf = scene.bsdf(&sp);
+        let kd = bsdf.diffuse();
+        if kd == glam::Vec3::ZERO {
+            continue;
+        }
+        let s = Sampler::from_key(w.key[i]);
+        let (gs, rays, kind, term, mis) = match w.kind[i] {
+            PathKind::Camera => (
+                s.fork(streams::gather(w.depth[i])),
+                n,
+                PathKind::Gather,
+                Term::Indirect.seen(w.through_specular[i]),
+                Strategies::at_camera_hit(&ctx, &bsdf),
+            ),
+            _ => (
+                s.fork(streams::SECONDARY_GATHER),
+                1,
+                PathKind::SecondaryGather,
+                w.term[i],
+                Strategies::LightOnly,
+            ),
+        };
+        let wo = -w.rays.direction(i);
+        let weight = w.beta[i] * kd / rays as f32;
+        gather_rays(&sp, wo, rays, &gs, |g, origin, dir| {
+            // A rough plastic weighs each ray by its base's share (as the reference).
+            let weight = if bsdf.gather_varies() {
+                w.beta[i] * bsdf.gather_weight(&sp.frame, wo, dir) / rays as f32
+            } else {
+                weight
+            };
+            next.push(Segment {
+                origin,
+                dir,
+                sample: w.sample[i],
+                kind,
+                key: gs.fork(streams::gather_ray(g)).key(),
+                base: streams::GATHER_CHAIN_BOUNCE as u8,
+                depth: 0,
+                beta: weight,
+                term,
+                through_specular: w.through_specular[i],
+                mis: mis.gather_density(&sp, wo, dir),
+            });
+        });
+    }
     let count = next.len() - before;
     stats.record("spawn_gather_rays", count, t);
 }
@@ -262,115 +237,92 @@ pub fn spawn_glossy_rays(
     let t = StageClock::start();
     let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
     let scene = &*shared.scene;
-    let w = &*work;
-    let mut segments = Vec::new();
-    for &l in &w.classified.diffuse {
+    let CameraWork { paths, classified, next, .. } = &mut *work;
+    let before = next.len();
+    for &l in &classified.diffuse {
         let i = l as usize;
-        if w.paths.kind[i] != PathKind::Camera {
+        if paths.kind[i] != PathKind::Camera {
             continue;
         }
-        let Some(hit) = w.paths.hits.get(i) else { continue };
+        let Some(hit) = paths.hits.get(i) else { continue };
         let sp = scene.surface(&hit);
         let bsdf = &scene.bsdf(&sp);
         // Only glossy materials have the lobe (glossy_ray says so too, after the stream's fork).
         if !bsdf.has_glossy_lobe() {
             continue;
         }
-        let gls = Sampler::from_key(w.paths.key[i]).fork(streams::glossy(w.paths.depth[i]));
-        let wo = -w.paths.rays.direction(i);
+        let gls = Sampler::from_key(paths.key[i]).fork(streams::glossy(paths.depth[i]));
+        let wo = -paths.rays.direction(i);
         let Some(ray) = glossy_ray(&sp, bsdf, wo, &gls) else { continue };
         let mis = Strategies::at_camera_hit(&ctx, bsdf);
-        segments.push(Segment {
+        next.push(Segment {
             origin: ray.origin,
             dir: ray.dir,
-            sample: w.paths.sample[i],
+            sample: paths.sample[i],
             kind: PathKind::Glossy,
             key: gls.key(),
             base: streams::GLOSSY_CHAIN_BOUNCE as u8,
             depth: 0,
-            beta: w.paths.beta[i] * ray.weight,
+            beta: paths.beta[i] * ray.weight,
             term: Term::Specular,
-            through_specular: w.paths.through_specular[i],
+            through_specular: paths.through_specular[i],
             mis: mis.glossy_density(&sp, bsdf, wo, ray.dir),
         });
     }
-    let count = segments.len();
-    for s in segments {
-        work.next.push(s);
-    }
+    let count = next.len() - before;
     stats.record("spawn_glossy_rays", count, t);
 }
 
-/// Continues the lanes `lanes` (at mirrors or glass) by sampling the delta BSDF with the
-/// random numbers of bounce `base + depth` ([`continue_chain`]'s roulette included); chains
-/// stop after `max_depth` bounces, and those cut there are counted in `cuts`.
-fn continue_specular(shared: &Shared, work: &CameraWork, lanes: &[u32], cuts: &mut u64) -> PathQueue {
+/// Continues the lanes at mirrors (or, with `glass`, at glass) into the next queue by sampling
+/// the delta BSDF with the random numbers of bounce `base + depth` ([`continue_chain`]'s roulette
+/// included); chains stop after `max_depth` bounces, counted in the numerics. Returns the lanes
+/// it looked at.
+fn continue_specular(shared: &Shared, work: &mut CameraWork, glass: bool) -> usize {
     let scene = &*shared.scene;
     let max_depth = shared.job.settings.max_depth;
-    let w = work;
-    let mut out = PathQueue::default();
-    par_columns(
-        lanes.len(),
-        CHUNK,
-        shared.job.threads,
-        |r, part: &mut (PathQueue, u64)| {
-            part.0.reserve(r.len());
-            for s in r.filter_map(|j| {
-                let i = lanes[j] as usize;
-                let sp = scene.surface(&w.paths.hits.get(i)?);
-                if w.paths.depth[i] >= max_depth {
-                    part.1 += 1;
-                    return None;
-                }
-                let bsdf = &scene.bsdf(&sp);
-                let s = Sampler::from_key(w.paths.key[i]);
-                let (depth, bounce) = (w.paths.depth[i], u32::from(w.paths.base[i]) + w.paths.depth[i]);
-                let next = continue_chain(&sp, bsdf, -w.paths.rays.direction(i), &s, bounce, depth)?;
-                Some(Segment {
-                    origin: next.origin,
-                    dir: next.dir,
-                    sample: w.paths.sample[i],
-                    kind: w.paths.kind[i],
-                    key: w.paths.key[i],
-                    base: w.paths.base[i],
-                    depth: w.paths.depth[i] + 1,
-                    beta: w.paths.beta[i] * next.weight,
-                    term: w.paths.term[i],
-                    through_specular: w.paths.kind[i] == PathKind::Camera,
-                    mis: 0.0,
-                })
-            }) {
-                part.0.push(s);
-            }
-        },
-        |part| {
-            out.append(&mut part.0);
-            *cuts += part.1;
-        },
-    );
-    out
+    let CameraWork { paths, classified, next, numerics, .. } = work;
+    let lanes = if glass { &classified.glass } else { &classified.mirror };
+    for &lane in lanes {
+        let i = lane as usize;
+        let Some(hit) = paths.hits.get(i) else { continue };
+        let sp = scene.surface(&hit);
+        if paths.depth[i] >= max_depth {
+            numerics.camera_depth_cut += 1;
+            continue;
+        }
+        let bsdf = &scene.bsdf(&sp);
+        let s = Sampler::from_key(paths.key[i]);
+        let (depth, bounce) = (paths.depth[i], u32::from(paths.base[i]) + paths.depth[i]);
+        let Some(bounced) = continue_chain(&sp, bsdf, -paths.rays.direction(i), &s, bounce, depth) else { continue };
+        next.push(Segment {
+            origin: bounced.origin,
+            dir: bounced.dir,
+            sample: paths.sample[i],
+            kind: paths.kind[i],
+            key: paths.key[i],
+            base: paths.base[i],
+            depth: paths.depth[i] + 1,
+            beta: paths.beta[i] * bounced.weight,
+            term: paths.term[i],
+            through_specular: paths.kind[i] == PathKind::Camera,
+            mis: 0.0,
+        });
+    }
+    lanes.len()
 }
 
 /// Lanes at mirrors continue.
 pub fn reflect_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = StageClock::start();
-    let lanes = work.classified.mirror.clone();
-    let mut cuts = 0;
-    let mut segments = continue_specular(&shared, &work, &lanes, &mut cuts);
-    work.numerics.camera_depth_cut += cuts;
-    work.next.append(&mut segments);
-    stats.record("reflect_paths", lanes.len(), t);
+    let n = continue_specular(&shared, &mut work, false);
+    stats.record("reflect_paths", n, t);
 }
 
 /// Lanes at glass reflect or refract (only in scenes with glass).
 pub fn refract_paths(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut stats: ResMut<StageStats>) {
     let t = StageClock::start();
-    let lanes = work.classified.glass.clone();
-    let mut cuts = 0;
-    let mut segments = continue_specular(&shared, &work, &lanes, &mut cuts);
-    work.numerics.camera_depth_cut += cuts;
-    work.next.append(&mut segments);
-    stats.record("refract_paths", lanes.len(), t);
+    let n = continue_specular(&shared, &mut work, true);
+    stats.record("refract_paths", n, t);
 }
 
 /// Averages each pixel's samples (dropping non-finite ones, as the reference does) into the
