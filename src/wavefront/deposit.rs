@@ -9,7 +9,7 @@ use crate::film::Term;
 use crate::photon_map::Photon;
 use crate::rng::Domain;
 use crate::transport::mis::emission_found;
-use crate::transport::photon::{deposit_photon, PhotonRay};
+use crate::transport::photon::deposit_photon;
 use crate::transport::specular::emission_toward;
 use crate::transport::Context;
 use bevy_ecs::prelude::*;
@@ -29,13 +29,7 @@ pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
         let i = lane as usize;
         let Some(hit) = queue.hits.get(i) else { continue };
         let sp = scene.surface(&hit);
-        let photon = PhotonRay {
-            origin: queue.rays.origin(i),
-            dir: queue.rays.direction(i),
-            power: queue.power[i],
-            emitted: queue.emitted[i],
-            specular_only: queue.specular_only[i],
-        };
+        let photon = queue.photon(i);
         out.clear();
         if deposit_photon(domain, &sp, &scene.bsdf(&sp), &photon, queue.bounce[i], &mut out) {
             survivors.push(lane);

@@ -264,6 +264,21 @@ soa_queue! {
     }
 }
 
+impl PhotonQueue {
+    /// Lane `i` as the transport core's photon ray.
+    #[must_use]
+    #[inline]
+    pub fn photon(&self, i: usize) -> crate::transport::photon::PhotonRay {
+        crate::transport::photon::PhotonRay {
+            origin: self.rays.origin(i),
+            dir: self.rays.direction(i),
+            power: self.power[i],
+            emitted: self.emitted[i],
+            specular_only: self.specular_only[i],
+        }
+    }
+}
+
 /// What a camera-pass path segment is for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]

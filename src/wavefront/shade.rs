@@ -12,7 +12,7 @@ use crate::rng::{Domain, Sampler};
 use crate::transport::direct::{direct_light_rays, ShadowRay};
 use crate::transport::gather::{gather_rays, glossy_ray};
 use crate::transport::mis::Strategies;
-use crate::transport::photon::{scatter_photon, PathEnd, PhotonRay, Scattered};
+use crate::transport::photon::{scatter_photon, PathEnd, Scattered};
 use crate::transport::specular::continue_chain;
 use crate::transport::{streams, Context};
 use bevy_ecs::prelude::*;
@@ -28,13 +28,7 @@ fn scatter_lanes(shared: &Shared, work: &mut PhotonWork, lanes: &[u32]) {
         let Some(hit) = q.hits.get(i) else { continue };
         let sp = scene.surface(&hit);
         let bsdf = scene.bsdf(&sp);
-        let photon = PhotonRay {
-            origin: q.rays.origin(i),
-            dir: q.rays.direction(i),
-            power: q.power[i],
-            emitted: q.emitted[i],
-            specular_only: q.specular_only[i],
-        };
+        let photon = q.photon(i);
         let s = Sampler::new(shared.job.pass.seed, domain, q.path[i]);
         let r = scatter_photon(&s, &sp, &bsdf, &photon, q.bounce[i]);
         let (path, bounce) = (q.path[i], q.bounce[i]);
@@ -120,9 +114,7 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
         let bsdf = &ctx.scene.bsdf(&sp);
         let s = Sampler::from_key(paths.key[i]);
         let (stream, term) = match paths.kind[i] {
-            PathKind::Camera => {
-                (s.fork(streams::light(paths.depth[i])), Term::Direct.seen(paths.through_specular[i]))
-            }
+            PathKind::Camera => (s.fork(streams::light(paths.depth[i])), Term::Direct.seen(paths.through_specular[i])),
             PathKind::NearGather => (s.fork(streams::SECONDARY_LIGHT), paths.term[i]),
             _ => (s.fork(streams::GLOSSY_HIT_LIGHT), paths.term[i]),
         };
@@ -191,13 +183,7 @@ pub fn spawn_gather_rays(
                 Term::Indirect.seen(w.through_specular[i]),
                 Strategies::at_camera_hit(&ctx, &bsdf),
             ),
-            _ => (
-                s.fork(streams::SECONDARY_GATHER),
-                1,
-                PathKind::SecondaryGather,
-                w.term[i],
-                Strategies::LightOnly,
-            ),
+            _ => (s.fork(streams::SECONDARY_GATHER), 1, PathKind::SecondaryGather, w.term[i], Strategies::LightOnly),
         };
         let wo = -w.rays.direction(i);
         let weight = w.beta[i] * kd / rays as f32;
