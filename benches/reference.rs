@@ -5,11 +5,11 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec3;
 use photonwave::code_path::CodePath;
+use photonwave::formats::load_scene;
 use photonwave::photon_map::{Filter, Lookup, Nearest, Reflectance};
 use photonwave::reference::build_maps;
 use photonwave::rng::{Domain, Sampler};
 use photonwave::sampling::uniform_sphere;
-use photonwave::scene::file::load_scene;
 use photonwave::settings::Settings;
 use std::hint::black_box;
 use std::path::PathBuf;

@@ -9,10 +9,10 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use glam::Vec3;
 use photonwave::bench::RaySets;
 use photonwave::code_path::CodePath;
+use photonwave::formats::load_scene;
 use photonwave::geometry::packet::{closest_packets, occluded_packets};
 use photonwave::photon_map::{Filter, Lookup, Nearest, Reflectance};
 use photonwave::reference::build_maps;
-use photonwave::scene::file::load_scene;
 use photonwave::settings::Settings;
 use std::hint::black_box;
 use std::path::PathBuf;

@@ -3,12 +3,12 @@
 //! property fails; bad input that is refused with an error is not a failure.
 
 use crate::engine::{render, Engine};
+use crate::formats::load_scene;
 use crate::geometry::bvh::TriangleColumns;
 use crate::geometry::packet::closest_packets;
 use crate::geometry::traverse::closest_rays;
 use crate::geometry::{in_range, Bvh, RayQuery};
 use crate::progress::NoProgress;
-use crate::scene::file::load_scene;
 use crate::settings::Settings;
 use glam::Vec3;
 use std::path::Path;
@@ -44,7 +44,7 @@ pub fn mesh_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), String> {
     let headlight = |_: (Vec3, Vec3), _: Option<crate::scene::Camera>| {
         vec![crate::scene::Light::Point { position: Vec3::new(0.0, 0.0, 10.0), intensity: Vec3::ONE }]
     };
-    let loaded = match crate::scene::file::load_scene_lit(&path, &headlight) {
+    let loaded = match crate::formats::load_scene_lit(&path, &headlight) {
         Err(e) => {
             let msg = e.to_string();
             return if msg.is_empty() || msg.len() > 2000 { Err(format!("unhelpful error: {msg:?}")) } else { Ok(()) };
@@ -63,7 +63,7 @@ pub fn mesh_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), String> {
     };
     let camera = loaded
         .camera
-        .unwrap_or_else(|| crate::scene::file::fitted_camera(&loaded.scene, crate::scene::camera::DEFAULT_FOV, 1.0));
+        .unwrap_or_else(|| crate::scene::camera::fitted_camera(&loaded.scene, crate::scene::camera::DEFAULT_FOV, 1.0));
     let Ok(rays) = camera.prepare(s.width, s.height) else { return Ok(()) };
     renders_finite(loaded.scene, &rays, &s).map_err(|e| format!("{name}, {e}"))
 }

@@ -27,8 +27,10 @@
 //! - [`material`]: BSDFs (Lambert, glossy Phong, mirror, glass, the rough ones) and their textures;
 //! - [`photon_map`]: the 20-byte photon, the 8-wide photon tree, k-NN and fixed-radius density estimates;
 //! - [`settings`]: the user's knobs, their layering and validation;
-//! - [`scene`]: OBJ/MTL and TOML loading, image files, lights (area, point, spot, directional,
-//!   sun, environment), caustic targets, the camera;
+//! - [`scene`]: the scene model — triangles in BVH order, materials, lights (area, point, spot,
+//!   directional, sun, environment), the camera, caustic targets, open edges;
+//! - [`formats`]: every file reader, chosen from one table of extensions — the TOML scene file,
+//!   Mitsuba XML, OBJ/MTL, PLY, glTF, images, built-in shapes — into the scene model;
 //! - [`plan`] and [`effects`]: the effects plan — which terms and machinery a scene needs, and why;
 //! - [`stats`]: plain records of what a render did (rays, times, maps, numerics);
 //! - [`film`]: the five [`film::Term`]s per pixel, EXR and PNG output;
@@ -40,8 +42,9 @@
 //!
 //! **Physics** — written once:
 //! - [`transport`]: every vertex both engines and the path tracer share — camera samples,
-//!   photon emission (caustic photons aimed at specular objects), deposit and scattering, direct light, gather and glossy rays, the
-//!   specular continuation, density estimates, the random-stream layout;
+//!   photon emission (caustic photons aimed at specular objects), deposit and scattering, direct
+//!   light and its multiple importance sampling, gather and glossy rays, the specular
+//!   continuation, density estimates, the random-stream layout;
 //!
 //! **Engines** — loops over the transport core:
 //! - [`reference`]: the scalar oracle, one ray at a time, that every fast path is tested against;
@@ -71,6 +74,7 @@ pub mod engine;
 pub mod error;
 pub mod files;
 pub mod film;
+pub mod formats;
 pub mod fuzzing;
 pub mod geometry;
 pub mod job;

@@ -6,11 +6,11 @@ mod common;
 
 use common::*;
 use glam::Vec3;
+use photonwave::formats::load_scene;
 use photonwave::photon_map::Photon;
 use photonwave::progress::NoProgress;
 use photonwave::reference::photons::trace_photons;
 use photonwave::rng::Domain;
-use photonwave::scene::file::load_scene;
 use photonwave::scene::Scene;
 use photonwave::settings::Settings;
 

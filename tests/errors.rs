@@ -3,7 +3,7 @@
 mod common;
 
 use common::*;
-use photonwave::scene::file::load_scene;
+use photonwave::formats::load_scene;
 use std::path::Path;
 use std::process::Command;
 

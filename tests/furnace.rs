@@ -30,8 +30,8 @@ mod common;
 
 use glam::{DVec3, Vec3};
 use photonwave::engine::{render, Engine};
+use photonwave::formats::load_scene;
 use photonwave::progress::NoProgress;
-use photonwave::scene::file::load_scene;
 use photonwave::scene::Scene;
 use photonwave::settings::Settings;
 use std::path::PathBuf;
@@ -39,7 +39,7 @@ use std::sync::Arc;
 
 const SIZE: usize = 24;
 
-fn hard(name: &str) -> photonwave::scene::file::LoadedScene {
+fn hard(name: &str) -> photonwave::formats::LoadedScene {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/hard").join(name);
     load_scene(&path).unwrap_or_else(|e| panic!("{name}: {e}"))
 }

@@ -4,8 +4,8 @@ mod common;
 
 use glam::Vec3;
 use photonwave::engine::{render, Engine};
+use photonwave::formats::{load_scene, LoadedScene};
 use photonwave::progress::NoProgress;
-use photonwave::scene::file::{load_scene, LoadedScene};
 use photonwave::settings::Settings;
 use std::path::PathBuf;
 use std::sync::Arc;

@@ -5,8 +5,8 @@
 mod common;
 
 use common::*;
+use photonwave::formats::load_scene;
 use photonwave::material::Material;
-use photonwave::scene::file::load_scene;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -373,7 +373,7 @@ fn bare_meshes_can_be_lit_and_framed() {
         assert!(mean > 0.05, "{light}: mean {mean}");
     }
     // A quarter as wide as high: the bounding sphere fits the horizontal field of view.
-    let c = photonwave::scene::file::fitted_camera_to((glam::Vec3::splat(-1.0), glam::Vec3::ONE), 40.0, 0.25);
+    let c = photonwave::scene::camera::fitted_camera_to((glam::Vec3::splat(-1.0), glam::Vec3::ONE), 40.0, 0.25);
     let half_h = ((20f32).to_radians().tan() * 0.25).atan();
     let r = 3f32.sqrt();
     assert!(r / (c.eye - c.target).length() <= half_h.sin() + 1e-6, "{c:?}");

@@ -8,9 +8,9 @@ mod common;
 use common::{bundled, scratch_dir};
 use glam::{Vec2, Vec3};
 use photonwave::engine::{render, Engine};
+use photonwave::formats::{load_scene, LoadedScene};
 use photonwave::material::Bsdf;
 use photonwave::progress::NoProgress;
-use photonwave::scene::file::{load_scene, LoadedScene};
 use photonwave::scene::Light;
 use photonwave::settings::Settings;
 use serde_json::{json, Value};
@@ -305,7 +305,7 @@ fn ply_meshes_in_every_encoding() {
         "property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n",
     )
         + "0 0 0 0 0 1 0.25 0.5\n1 0 0 0 0.6 0.8 0.75 0\n1 1 0 0.6 0 0.8 1 1\n0 1 0 0 0 2 0 0.125\n4 0 1 2 3\n";
-    let mesh = photonwave::scene::ply::load_ply(&write(&d, "c.ply", &columns), 0, &mut vec![], &mut vec![]).unwrap();
+    let mesh = photonwave::formats::ply::load_ply(&write(&d, "c.ply", &columns), 0, &mut vec![], &mut vec![]).unwrap();
     let uv = [[0.25, 0.5], [0.75, 0.0], [1.0, 1.0], [0.0, 0.125]].map(Vec2::from_array);
     assert_eq!(mesh.texcoords, uv);
     let normals = [[0.0, 0.0, 1.0], [0.0, 0.6, 0.8], [0.6, 0.0, 0.8], [0.0, 0.0, 2.0]].map(Vec3::from_array);
@@ -318,7 +318,7 @@ property float nx\nproperty float ny\nproperty float nz\nproperty float u\nprope
 element vertex 1\nproperty float x\nproperty float y\nproperty float z\n\
 element face 1\nproperty list uchar int vertex_indices\nend_header\n\
 0 0 0 0 0 1 0.5 0.5\n1 0 0 0 0 1 0.25 0.25\n0.75 1 0\n3 0 1 2\n";
-    let mesh = photonwave::scene::ply::load_ply(&write(&d, "l.ply", lacking), 0, &mut vec![], &mut vec![]).unwrap();
+    let mesh = photonwave::formats::ply::load_ply(&write(&d, "l.ply", lacking), 0, &mut vec![], &mut vec![]).unwrap();
     assert_eq!(mesh.texcoords, [Vec2::splat(0.5), Vec2::splat(0.25), Vec2::ZERO]);
     assert_eq!(mesh.normals, [Vec3::Z, Vec3::Z, Vec3::ZERO]);
     let toml = "[[mesh]]\nfile = \"q.ply\"\nmaterial = \"grey\"\n[materials.grey]\ntype = \"lambert\"\nkd = [0.5, 0.5, 0.5]\n[[light]]\ntype = \"point\"\nposition = [0, 0, 1]\nintensity = [1, 1, 1]\n";

@@ -216,7 +216,7 @@ fn a_point_light_in_smooth_rough_metal_matches_the_path_tracer() {
     let toml = "[[mesh]]\nfile = \"m.obj\"\n[camera]\neye = [0, 0.6, 1.6]\ntarget = [0, 0.1, 0]\nfov = 45\n\
                 [[light]]\ntype = \"point\"\nposition = [0, 0.5, -0.6]\nintensity = [0.3, 0.3, 0.3]\n";
     std::fs::write(dir.join("m.toml"), toml).unwrap();
-    let loaded = photonwave::scene::file::load_scene(&dir.join("m.toml")).unwrap();
+    let loaded = photonwave::formats::load_scene(&dir.join("m.toml")).unwrap();
     let cam = loaded.camera.unwrap().prepare(24, 24).unwrap();
     let s = photonwave::settings::Settings { width: 24, height: 24, spp: 16, ..Default::default() };
     let pm = photonwave::reference::render(&loaded.scene, &cam, &s, &photonwave::progress::NoProgress).unwrap().0;

@@ -10,8 +10,8 @@ mod common;
 
 use glam::Vec3;
 use photonwave::engine::{render, Engine};
+use photonwave::formats::{load_scene, LoadedScene};
 use photonwave::progress::NoProgress;
-use photonwave::scene::file::{load_scene, LoadedScene};
 use photonwave::settings::Settings;
 use photonwave::transport::PhotonMaps;
 use std::path::PathBuf;

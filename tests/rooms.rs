@@ -17,9 +17,9 @@ mod common;
 
 use glam::Vec3;
 use photonwave::engine::{render, Engine};
+use photonwave::formats::{load_scene, LoadedScene};
 use photonwave::photon_map::{Filter, Kernel, Lookup, Nearest, OFF_PLANE};
 use photonwave::progress::NoProgress;
-use photonwave::scene::file::{load_scene, LoadedScene};
 use photonwave::scene::Scene;
 use photonwave::settings::Settings;
 use std::path::PathBuf;

@@ -5,8 +5,8 @@ mod common;
 
 use common::*;
 use photonwave::film::Film;
+use photonwave::formats::LoadedScene;
 use photonwave::progress::NoProgress;
-use photonwave::scene::file::LoadedScene;
 use photonwave::settings::Settings;
 use photonwave::stats::RenderStats;
 use std::sync::Arc;
@@ -77,7 +77,7 @@ fn wavefront_matches_reference_per_pixel_on_every_bundled_scene() {
             [(true, true, on), (true, false, on), (false, true, on), (true, false, 0.0)]
         {
             let s = Settings { final_gather, precompute_irradiance, secondary_gather, ..small() };
-            let loaded = || photonwave::scene::file::load_scene(&bundled(scene)).unwrap();
+            let loaded = || photonwave::formats::load_scene(&bundled(scene)).unwrap();
             let reference = render(&loaded(), &s);
             let (wave, _, _) = wavefront(loaded(), &s);
             let d = max_rel_diff(&reference, &wave);

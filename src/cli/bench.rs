@@ -4,7 +4,8 @@
 use super::parse_vec3;
 use glam::Vec3;
 use photonwave::error::{Error, Result};
-use photonwave::scene::file::{fitted_camera, load_scene_lit};
+use photonwave::formats::load_scene_lit;
+use photonwave::scene::camera::fitted_camera;
 use photonwave::scene::Light;
 use std::path::PathBuf;
 
@@ -51,7 +52,7 @@ pub struct BenchArgs {
 /// Runs `bench`.
 pub fn run(args: BenchArgs) -> Result<()> {
     use photonwave::bench;
-    use photonwave::scene::generated;
+    use photonwave::formats::generated;
     if args.reps == 0 || args.reps > 1000 {
         return Err(Error::Setting { field: "--reps".into(), message: format!("{} is not in 1..=1000", args.reps) });
     }

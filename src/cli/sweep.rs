@@ -6,8 +6,9 @@ use super::parse_duration;
 use photonwave::engine::Engine;
 use photonwave::error::{Error, Result};
 use photonwave::files::{check_outputs, Output};
+use photonwave::formats::load_scene;
 use photonwave::job::Job;
-use photonwave::scene::file::{fitted_camera, load_scene};
+use photonwave::scene::camera::fitted_camera;
 use photonwave::settings::{Overrides, Preset};
 use std::path::PathBuf;
 

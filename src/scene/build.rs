@@ -2,8 +2,8 @@
 //! checked and stored as columns in BVH order, light triangles and their power distribution
 //! (textured emitters by their texture's mean over each triangle), the environment, the BVH.
 //!
-//! Reads [`MeshInput`]s (from [`super::obj`] and [`super::file`]), [`Material`]s and [`Light`]s;
-//! writes the [`Scene`] the engines trace.
+//! Reads [`MeshInput`]s (from the readers of [`crate::formats`], or made in code),
+//! [`Material`]s and [`Light`]s; writes the [`Scene`] the engines trace.
 
 use super::*;
 
@@ -27,14 +27,13 @@ impl Scene {
         mut warnings: Vec<String>,
     ) -> Result<Scene> {
         for m in &meshes {
-            // `load_obj` names the line; this catches meshes made in code.
-            if let Some(k) = m.positions.iter().position(|p| !in_range(*p)) {
+            // The readers name the line or the `[[mesh]]` entry; this catches meshes made in code.
+            if let Some((k, p)) = super::first_out_of_range(&m.positions) {
                 return Err(Error::scene(format!(
-                    "{}: vertex {} lies at {}, outside ±{MAX_COORDINATE:e}, the range in which photonwave's \
-                     f32 geometry stays watertight (docs/src/bad-input.md, \"Limits\")",
+                    "{}, vertex {}: {}",
                     m.source,
                     k + 1,
-                    m.positions[k]
+                    super::out_of_range_message(p)
                 )));
             }
         }

@@ -1,11 +1,12 @@
 //! A pinhole camera: eye, target, up and vertical field of view.
 
+use super::Scene;
 use crate::error::{Error, Result};
 use crate::geometry::{in_range, MAX_COORDINATE};
 use glam::Vec3;
 
 /// The vertical field of view, in degrees, of a camera that names none: a `[camera]` without
-/// `fov`, a scene with no camera (framed by [`super::file::fitted_camera`]).
+/// `fov`, a scene with no camera (framed by [`fitted_camera`]).
 pub const DEFAULT_FOV: f32 = 40.0;
 
 /// Where the camera is and where it looks.
@@ -80,4 +81,22 @@ impl CameraRays {
         let sy = 1.0 - 2.0 * y / self.height;
         (self.eye, (self.forward + self.right * sx + self.up * sy).normalize())
     }
+}
+
+/// A camera that frames the bounding sphere of the scene's triangles from +z, looking down −z, for an image of
+/// `aspect` = width / height: the sphere fits the narrower of the two fields of view.
+#[must_use]
+pub fn fitted_camera(scene: &Scene, fov_deg: f32, aspect: f32) -> Camera {
+    fitted_camera_to(scene.mesh_bounds(), fov_deg, aspect)
+}
+
+/// [`fitted_camera`] for a bounding box (lo, hi).
+#[must_use]
+pub fn fitted_camera_to((lo, hi): (Vec3, Vec3), fov_deg: f32, aspect: f32) -> Camera {
+    let c = (lo + hi) * 0.5;
+    let r = ((hi - lo) * 0.5).length().max(f32::MIN_POSITIVE);
+    let half_v = fov_deg.to_radians() * 0.5;
+    let half = if aspect >= 1.0 { half_v } else { (half_v.tan() * aspect).atan() };
+    let dist = r / half.sin() * 1.05;
+    Camera { eye: c + Vec3::Z * dist, target: c, up: Vec3::Y, fov_deg }
 }

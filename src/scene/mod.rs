@@ -1,26 +1,15 @@
-//! The scene: triangles as columns in BVH order, materials, lights and their power
-//! distributions, and the BVH. Built from OBJ/MTL (through tobj) and the TOML scene file.
+//! The scene model, in memory: triangles as columns in BVH order, materials, lights and their
+//! power distributions, the environment, the camera, the BVH — and what is derived from them
+//! once (open edges, caustic targets, checks). Built from [`MeshInput`]s by [`Scene::build`]
+//! (`build.rs`); the file readers that make them are [`crate::formats`]'s.
 
 mod build;
 pub mod camera;
 mod checks;
 pub mod environment;
-pub mod file;
-mod file_materials;
-mod file_meshes;
-pub mod generated;
-mod gltf;
-pub mod image;
 pub mod light;
-pub mod mitsuba;
-pub mod mtl;
-pub mod obj;
 pub mod open_edges;
-pub mod ply;
-pub mod shapes;
 pub mod targets;
-pub mod transform;
-pub mod validate;
 
 use crate::error::{Error, Result};
 use crate::geometry::bvh::TriangleColumns;
@@ -72,6 +61,23 @@ pub struct SurfacePoint {
     /// The triangle is flat-shaded (its vertex normals are its geometric normal): its photons
     /// lie in its plane ([`crate::photon_map::Filter::flat`]).
     pub flat: bool,
+}
+
+/// The first of `positions` outside ±[`MAX_COORDINATE`], with its index.
+#[must_use]
+pub fn first_out_of_range(positions: &[Vec3]) -> Option<(usize, Vec3)> {
+    positions.iter().position(|p| !in_range(*p)).map(|k| (k, positions[k]))
+}
+
+/// What every reader says of a vertex at `p` outside ±[`MAX_COORDINATE`] (after its mesh's
+/// transform), after naming where it is.
+#[must_use]
+pub fn out_of_range_message(p: Vec3) -> String {
+    format!(
+        "the vertex lies at {p} (after the mesh's transform), outside ±{MAX_COORDINATE:e}, the range in which \
+         photonwave's f32 geometry stays watertight; scale the scene down (`scale` in a scene file; \
+         docs/src/bad-input.md, \"Limits\")"
+    )
 }
 
 /// An assembled, validated scene.

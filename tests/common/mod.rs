@@ -3,9 +3,9 @@
 
 use glam::Vec3;
 use photonwave::film::Film;
+use photonwave::formats::{load_scene, LoadedScene};
 use photonwave::progress::NoProgress;
 use photonwave::reference;
-use photonwave::scene::file::{load_scene, LoadedScene};
 use photonwave::settings::Settings;
 use std::path::PathBuf;
 

@@ -5,7 +5,7 @@
 //! shapes, and `point`, `spot`, `directional`, `envmap` and `constant` emitters.
 //!
 //! Writes the meshes, materials (into the [`MaterialTable`]), lights, environment, camera and
-//! image size of a [`super::file::LoadedScene`]. Everything not understood is warned of with its
+//! image size of a [`crate::formats::LoadedScene`]. Everything not understood is warned of with its
 //! line (`integrator`, `sampler`, `medium`, `sun`, …); what cannot be rendered honestly (a
 //! metal without data, a shape file that cannot be read) is an error naming file and line.
 //!
@@ -16,16 +16,17 @@
 mod bsdfs;
 mod props;
 
-use super::camera::Camera;
-use super::environment::Environment;
-use super::light::Light;
-use super::obj::{load_obj, MaterialTable, ObjMaterials};
-use super::ply::load_ply;
-use super::shapes::shape;
-use super::transform::Transform;
-use super::MeshInput;
 use crate::error::{Error, Result};
 use crate::files::{read_text, MAX_SCENE_FILE};
+use crate::formats::materials::MaterialTable;
+use crate::formats::obj::{load_obj, ObjMaterials};
+use crate::formats::ply::load_ply;
+use crate::formats::shapes::shape;
+use crate::formats::transform::Transform;
+use crate::scene::camera::Camera;
+use crate::scene::environment::Environment;
+use crate::scene::light::Light;
+use crate::scene::MeshInput;
 use crate::settings::MAX_IMAGE_SIDE;
 use crate::texture::{Encoding, Texture};
 use bsdfs::UvMap;

@@ -1,21 +1,23 @@
 //! The TOML scene file's `[[mesh]]` entries: a mesh file (OBJ with its MTL files, PLY, glTF) or a
-//! built-in shape ([`super::shapes`]), placed by a transform (a `matrix`, or `scale`, `rotate`
+//! built-in shape ([`crate::formats::shapes`]), placed by a transform (a `matrix`, or `scale`, `rotate`
 //! and `translate` applied in that order) and optionally made of one material of the file's
 //! `[materials]` (`material = "NAME"`, replacing whatever the mesh file says).
 //!
 //! Reads the entry; writes [`MeshInput`]s into the scene's list and materials into its
 //! [`MaterialTable`], and the lights and cameras a glTF file brings into [`Brought`].
 
-use super::camera::Camera;
-use super::file_materials::finite3;
-use super::gltf::load_gltf;
-use super::light::Light;
-use super::obj::{load_obj, MaterialTable, ObjMaterials};
-use super::ply::load_ply;
-use super::shapes::shape;
-use super::transform::Transform;
-use super::MeshInput;
+use super::materials::finite3;
 use crate::error::{Error, Result};
+use crate::formats::gltf::load_gltf;
+use crate::formats::materials::MaterialTable;
+use crate::formats::obj::{load_obj, ObjMaterials};
+use crate::formats::ply::load_ply;
+use crate::formats::shapes::shape;
+use crate::formats::transform::Transform;
+use crate::formats::Format;
+use crate::scene::camera::Camera;
+use crate::scene::light::Light;
+use crate::scene::MeshInput;
 use glam::{Affine3A, Quat, Vec3};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -23,7 +25,7 @@ use std::path::{Path, PathBuf};
 /// A `[[mesh]]` table.
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
-pub(super) struct MeshEntry {
+pub(in crate::formats) struct MeshEntry {
     /// An OBJ, PLY, glTF or GLB file, relative to the scene file.
     #[serde(default)]
     file: Option<PathBuf>,
@@ -32,7 +34,7 @@ pub(super) struct MeshEntry {
     shape: Option<String>,
     /// A `[materials.NAME]` every face of the mesh is made of.
     #[serde(default)]
-    pub(super) material: Option<String>,
+    pub(in crate::formats) material: Option<String>,
     /// A number (uniform) or three (per axis).
     #[serde(default)]
     scale: Option<Scale>,
@@ -55,19 +57,16 @@ enum Scale {
 
 /// What mesh files bring besides their triangles: a glTF file's lights and cameras.
 #[derive(Default)]
-pub(super) struct Brought {
+pub(in crate::formats) struct Brought {
     /// Lights, in world space.
     pub lights: Vec<Light>,
     /// Cameras with their names, in world space.
     pub cameras: Vec<(String, Camera)>,
 }
 
-/// The mesh formats a `[[mesh]]` file may be, by extension.
-const FORMATS: &str = "`.obj`, `.ply`, `.gltf` or `.glb`";
-
 impl MeshEntry {
     /// An entry for the file `file` alone, untransformed.
-    pub(super) fn of_file(file: PathBuf) -> MeshEntry {
+    pub(in crate::formats) fn of_file(file: PathBuf) -> MeshEntry {
         MeshEntry {
             file: Some(file),
             shape: None,
@@ -80,7 +79,7 @@ impl MeshEntry {
     }
 
     /// The transform this entry gives its mesh; `i` is its index in the file.
-    pub(super) fn transform(&self, i: usize) -> Result<Transform> {
+    pub(in crate::formats) fn transform(&self, i: usize) -> Result<Transform> {
         let field = |name: &str| format!("mesh[{i}].{name}");
         if let Some(rows) = &self.matrix {
             if self.scale.is_some() || self.rotate.is_some() || self.translate.is_some() {
@@ -120,7 +119,7 @@ impl MeshEntry {
     /// Loads this entry's mesh (relative to `dir`), of material `material` when the entry names
     /// one; materials read go into `table`, every file read into `inputs`.
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn load(
+    pub(in crate::formats) fn load(
         &self,
         i: usize,
         dir: &Path,
@@ -153,21 +152,21 @@ impl MeshEntry {
             }
             (Some(file), None) => {
                 let path = dir.join(file);
-                let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-                match ext.as_str() {
-                    // A file without an extension is read as OBJ, as before other formats.
-                    "obj" | "" => {
+                // A file without an extension is read as OBJ, as before other formats.
+                let format = if path.extension().is_none() { Some(Format::Obj) } else { Format::of(&path) };
+                match format {
+                    Some(Format::Obj) => {
                         let from = material.map_or(ObjMaterials::Mtl, ObjMaterials::All);
                         load_obj(&path, &transform, from, table, warnings, inputs)?
                     }
-                    "ply" => {
+                    Some(Format::Ply) => {
                         let what = format!("{}, a PLY file, which has no materials", file.display());
                         let m = fallback(&what, table, warnings);
                         let mut mesh = load_ply(&path, m, warnings, inputs)?;
                         transform.apply(&mut mesh);
                         mesh
                     }
-                    "gltf" | "glb" => {
+                    Some(Format::Gltf) => {
                         let model = load_gltf(&path, &transform, table, warnings, inputs)?;
                         brought.lights.extend(model.lights);
                         brought.cameras.extend(model.cameras);
@@ -176,7 +175,7 @@ impl MeshEntry {
                     _ => {
                         return Err(Error::setting(
                             format!("mesh[{i}].file"),
-                            format!("{}: not a mesh format photonwave reads ({FORMATS})", file.display()),
+                            format!("{}: not a mesh format photonwave reads ({})", file.display(), Format::MESH_NAMES),
                         ))
                     }
                 }
@@ -185,15 +184,9 @@ impl MeshEntry {
         if let Some(m) = material {
             mesh.material.fill(m);
         }
-        if mesh.positions.iter().any(|p| !crate::geometry::in_range(*p)) {
-            return Err(Error::setting(
-                format!("mesh[{i}]"),
-                format!(
-                    "a vertex lies outside ±{:e} once transformed, the range in which photonwave's f32 geometry stays \
-                     watertight; scale the scene down",
-                    crate::geometry::MAX_COORDINATE
-                ),
-            ));
+        if let Some((k, p)) = crate::scene::first_out_of_range(&mesh.positions) {
+            let at = format!("mesh[{i}] ({}, vertex {})", mesh.source, k + 1);
+            return Err(Error::setting(at, crate::scene::out_of_range_message(p)));
         }
         Ok(mesh)
     }

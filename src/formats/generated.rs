@@ -1,10 +1,10 @@
 //! Scenes generated in code, so that benchmarks need no download: a finely tessellated displaced
 //! sphere inside a closed, lit box.
 
-use super::file::LoadedScene;
-use super::{Camera, MeshInput, Scene};
+use super::LoadedScene;
 use crate::error::Result;
 use crate::material::{Bsdf, Material};
+use crate::scene::{Camera, MeshInput, Scene};
 use crate::settings::Settings;
 use glam::Vec3;
 use std::f32::consts::PI;

@@ -13,7 +13,7 @@
 //!
 //! Colours take three numbers, one (grey), or `xyz X [Y Z]` (CIE XYZ, converted to linear sRGB).
 //! `map_Kd` and `map_Ks` name textures that replace `Kd` and `Ks` ([`MapStatement`]; read by
-//! [`super::obj`]). Statements the spec defines but photonwave does not simulate (the other
+//! [`super`]). Statements the spec defines but photonwave does not simulate (the other
 //! texture maps, texture options, `d`/`Tr` transparency, a coloured `Tf`, `sharpness`, `Km`, the
 //! PBR keys, spectral colours) are read, checked where they hold numbers, and reported in one warning per
 //! material (`Ka` is read and not reported: ambient light has no place in global illumination). Anything else is

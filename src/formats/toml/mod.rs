@@ -38,20 +38,23 @@
 //! spp = 16
 //! ```
 
-use super::camera::{Camera, DEFAULT_FOV};
-use super::environment::Environment;
-use super::file_materials::{colour, finite3, MaterialEntry};
-use super::file_meshes::{Brought, MeshEntry};
+pub mod materials;
+pub mod meshes;
+
 use super::image::load_texture;
-use super::light::Light;
-use super::mitsuba::load_mitsuba;
-use super::obj::MaterialTable;
-use super::{bounds_of, MeshInput, Scene};
+use super::materials::MaterialTable;
+use super::{AddedLights, LoadedScene};
 use crate::error::{Error, Result};
 use crate::files::{read_text, MAX_SCENE_FILE};
+use crate::scene::camera::{Camera, DEFAULT_FOV};
+use crate::scene::environment::Environment;
+use crate::scene::light::Light;
+use crate::scene::{bounds_of, MeshInput, Scene};
 use crate::settings::Settings;
 use crate::texture::Encoding;
 use glam::Vec3;
+use materials::{colour, finite3, MaterialEntry};
+use meshes::{Brought, MeshEntry};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -139,37 +142,6 @@ enum LightEntry {
         #[serde(default = "sun_angle")]
         angle: f32,
     },
-}
-
-/// A loaded scene with what its file said about the camera and settings.
-pub struct LoadedScene {
-    /// The assembled scene.
-    pub scene: Scene,
-    /// Camera from the file, if it had one: the TOML `[camera]`, else the first a glTF file
-    /// brings; in the scene's frame ([`Scene::to_frame`]).
-    pub camera: Option<Camera>,
-    /// The named cameras mesh files bring (glTF), for `--camera NAME`; in the scene's frame.
-    pub cameras: Vec<(String, Camera)>,
-    /// Settings from the file's `[render]` table (defaults otherwise).
-    pub settings: Settings,
-    /// Every file read: the scene file, its OBJ and MTL files (outputs must not overwrite them).
-    pub inputs: Vec<PathBuf>,
-}
-
-impl LoadedScene {
-    /// The loaded scene with its file's cameras (given in the file's coordinates) moved into the
-    /// scene's frame.
-    fn framed(
-        scene: Scene,
-        camera: Option<Camera>,
-        cameras: Vec<(String, Camera)>,
-        settings: Settings,
-        inputs: Vec<PathBuf>,
-    ) -> LoadedScene {
-        let camera = camera.map(|c| scene.camera_to_frame(c));
-        let cameras = cameras.into_iter().map(|(name, c)| (name, scene.camera_to_frame(c))).collect();
-        LoadedScene { scene, camera, cameras, settings, inputs }
-    }
 }
 
 impl LightEntry {
@@ -262,50 +234,9 @@ impl EnvironmentEntry {
     }
 }
 
-/// The extensions of mesh files that load as scenes by themselves.
-const MESH_FORMATS: [&str; 4] = ["obj", "ply", "gltf", "glb"];
-
-/// Loads a scene: a `.toml` scene file, a Mitsuba scene file (`.xml`), or a bare mesh file (OBJ
-/// with its MTL files, PLY, glTF or GLB).
-pub fn load_scene(path: &Path) -> Result<LoadedScene> {
-    load_scene_lit(path, &|_, _| Vec::new())
-}
-
-/// Lights added to a scene once its meshes' bounds and its file's camera are known (the CLI's
-/// `--light` presets, for meshes that bring no light of their own).
-pub type AddedLights<'a> = &'a dyn Fn((Vec3, Vec3), Option<Camera>) -> Vec<Light>;
-
-/// Loads a scene as [`load_scene`] does, with the lights `added` gives it besides its own.
-pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
+/// Loads the TOML scene file at `path`, with the lights `added` gives it besides its own.
+pub fn load(path: &Path, added: AddedLights) -> Result<LoadedScene> {
     let bounds = |meshes: &[MeshInput]| bounds_of(meshes.iter().flat_map(|m| m.positions.iter()));
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    if ext == "xml" {
-        let (mut table, mut warnings, mut inputs) = (MaterialTable::default(), Vec::new(), Vec::new());
-        let m = load_mitsuba(path, &mut table, &mut warnings, &mut inputs)?;
-        let mut lights = m.lights;
-        lights.extend(added(bounds(&m.meshes), m.camera));
-        let scene = Scene::build_lit(m.meshes, table.materials, lights, m.environment, warnings)?;
-        let mut settings = Settings::default();
-        if let Some((width, height)) = m.size {
-            (settings.width, settings.height) = (width, height);
-        }
-        return Ok(LoadedScene::framed(scene, m.camera, Vec::new(), settings, inputs));
-    }
-    if MESH_FORMATS.contains(&ext.as_str()) {
-        // A bare mesh file: its own camera and lights if it brings them, `added` besides.
-        let (mut table, mut warnings, mut inputs, mut brought) =
-            (MaterialTable::default(), Vec::new(), Vec::new(), Brought::default());
-        let dir = path.parent().unwrap_or(Path::new("."));
-        let name = PathBuf::from(path.file_name().unwrap_or_default());
-        let meshes =
-            vec![MeshEntry::of_file(name).load(0, dir, None, &mut table, &mut warnings, &mut inputs, &mut brought)?];
-        let camera = brought.cameras.first().map(|c| c.1);
-        let mut lights = brought.lights;
-        lights.extend(added(bounds(&meshes), camera));
-        let scene = Scene::build(meshes, table.materials, lights, warnings)?;
-        let (settings, cameras) = (Settings::default(), brought.cameras);
-        return Ok(LoadedScene::framed(scene, camera, cameras, settings, inputs));
-    }
     let text = read_text(path, "a scene file", MAX_SCENE_FILE)?;
     let mut inputs = vec![path.to_path_buf()];
     let file: SceneFile = toml::from_str(&text).map_err(|e| {
@@ -366,22 +297,4 @@ pub fn load_scene_lit(path: &Path, added: AddedLights) -> Result<LoadedScene> {
     let environment = file.environment.as_ref().map(|e| e.to_environment(dir, &mut inputs)).transpose()?;
     let scene = Scene::build_lit(meshes, table.materials, lights, environment, warnings)?;
     Ok(LoadedScene::framed(scene, camera, brought.cameras, settings, inputs))
-}
-
-/// A camera that frames the bounding sphere of the scene's triangles from +z, looking down −z, for an image of
-/// `aspect` = width / height: the sphere fits the narrower of the two fields of view.
-#[must_use]
-pub fn fitted_camera(scene: &Scene, fov_deg: f32, aspect: f32) -> Camera {
-    fitted_camera_to(scene.mesh_bounds(), fov_deg, aspect)
-}
-
-/// [`fitted_camera`] for a bounding box (lo, hi).
-#[must_use]
-pub fn fitted_camera_to((lo, hi): (Vec3, Vec3), fov_deg: f32, aspect: f32) -> Camera {
-    let c = (lo + hi) * 0.5;
-    let r = ((hi - lo) * 0.5).length().max(f32::MIN_POSITIVE);
-    let half_v = fov_deg.to_radians() * 0.5;
-    let half = if aspect >= 1.0 { half_v } else { (half_v.tan() * aspect).atan() };
-    let dist = r / half.sin() * 1.05;
-    Camera { eye: c + Vec3::Z * dist, target: c, up: Vec3::Y, fov_deg }
 }

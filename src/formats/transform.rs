@@ -3,8 +3,8 @@
 //! winding reversed where the transform mirrors (so that the front face, the one that emits,
 //! stays on the same side of the surface).
 
-use super::MeshInput;
 use crate::error::{Error, Result};
+use crate::scene::MeshInput;
 use glam::{Affine3A, Mat3, Mat4, Quat, Vec3};
 
 /// An affine transform of object space into world space.

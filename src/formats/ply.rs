@@ -11,8 +11,8 @@
 //! here names the file and the header line, the ASCII line, or the element and its index, and
 //! no input panics (the `mesh_files` fuzz target).
 
-use super::MeshInput;
 use crate::error::{Error, Result};
+use crate::scene::MeshInput;
 use glam::{Vec2, Vec3};
 use std::path::Path;
 

@@ -16,13 +16,13 @@
 mod accessor;
 mod materials;
 
-use super::camera::Camera;
-use super::light::Light;
-use super::obj::MaterialTable;
-use super::transform::Transform;
-use super::MeshInput;
 use crate::error::{Error, Result};
 use crate::files::{read_input, MAX_MESH_FILE};
+use crate::formats::materials::MaterialTable;
+use crate::formats::transform::Transform;
+use crate::scene::camera::Camera;
+use crate::scene::light::Light;
+use crate::scene::MeshInput;
 use crate::texture::{Encoding, Texture};
 use accessor::{read_f32, read_indices};
 use glam::{Affine3A, Mat4, Vec2, Vec3};
@@ -181,7 +181,7 @@ impl Sources<'_> {
                 (bytes, self.path.to_path_buf())
             }
         };
-        let texture = Arc::new(super::image::texture_from_bytes(&origin, &bytes, encoding, &label)?);
+        let texture = Arc::new(crate::formats::image::texture_from_bytes(&origin, &bytes, encoding, &label)?);
         self.images.insert((index, encoding), texture.clone());
         Ok(texture)
     }

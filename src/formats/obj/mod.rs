@@ -1,4 +1,4 @@
-//! OBJ input through tobj, with materials from the MTL files it names ([`super::mtl`]).
+//! OBJ input through tobj, with materials from the MTL files it names ([`mtl`]).
 //!
 //! The text is read by [`crate::files::read_text`] (regular files only, bounded size, no
 //! byte-order mark, any line ends), checked line by line ([`check_obj`]) and handed to tobj.
@@ -6,71 +6,25 @@
 //! whole when such a file exists). Materials are kept per MTL file: two files may each define
 //! `floor`, and each mesh gets its own file's.
 
-use super::image::load_texture;
-use super::mtl::{material_from_mtl, parse_mtl, MtlMaterial};
-use super::transform::Transform;
-use super::validate::{check_obj, MtlLib};
-use super::MeshInput;
+pub mod mtl;
+pub mod validate;
+
 use crate::error::{Error, Result};
 use crate::files::{read_text, MAX_MATERIAL_FILE, MAX_MESH_FILE};
-use crate::geometry::{in_range, MAX_COORDINATE};
-use crate::material::{Bsdf, Maps, Material};
+use crate::formats::materials::MaterialTable;
+use crate::formats::transform::Transform;
+use crate::geometry::in_range;
+use crate::material::{Bsdf, Maps};
+use crate::scene::{first_out_of_range, out_of_range_message, MeshInput};
 use crate::texture::{Encoding, Texture};
 use glam::{Vec2, Vec3};
+use mtl::{material_from_mtl, parse_mtl, MtlMaterial};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-
-/// Materials of all loaded files, kept apart per MTL file.
-#[derive(Default, Debug)]
-pub struct MaterialTable {
-    /// The table.
-    pub materials: Vec<Material>,
-    /// (MTL file, name) → index.
-    by_key: HashMap<(PathBuf, String), u32>,
-    /// Textures read so far, by file and encoding (a file named twice is read once).
-    textures: HashMap<(PathBuf, Encoding), Arc<Texture>>,
-}
+use validate::{check_obj, MtlLib};
 
 impl MaterialTable {
-    /// Adds the material `m` of the file `source`, or replaces the one of that name from that
-    /// file; returns its index. When another file defines a different material of the same
-    /// name, `warnings` says that each mesh keeps its own file's.
-    pub fn insert(&mut self, source: &Path, m: Material, warnings: &mut Vec<String>) -> u32 {
-        let key = (source.to_path_buf(), m.name.clone());
-        if let Some(&i) = self.by_key.get(&key) {
-            self.materials[i as usize] = m;
-            return i;
-        }
-        let clash = self
-            .by_key
-            .iter()
-            .find(|((file, name), &i)| name == &m.name && file != source && self.materials[i as usize] != m);
-        if let Some(((file, _), _)) = clash {
-            warnings.push(format!(
-                "material `{}` is defined differently in {} and {}: each mesh uses its own MTL file's                  (a [materials.{}] override in the scene file replaces both)",
-                m.name,
-                file.display(),
-                source.display(),
-                m.name
-            ));
-        }
-        let i = self.materials.len() as u32;
-        self.by_key.insert(key, i);
-        self.materials.push(m);
-        i
-    }
-
-    /// Replaces every material called `name`, from any file, by `m`; returns how many there were.
-    pub fn replace_named(&mut self, name: &str, m: &Material) -> usize {
-        let mut n = 0;
-        for slot in self.materials.iter_mut().filter(|x| x.name == name) {
-            *slot = m.clone();
-            n += 1;
-        }
-        n
-    }
-
     /// The textures the MTL material `m` of the file `mtl_path` names, read (or taken from those
     /// read before); each file read is added to `inputs`. An image that cannot be read is an
     /// error naming it and the MTL statement.
@@ -95,38 +49,7 @@ impl MaterialTable {
             metallic: load("map_Pm", Encoding::Linear)?,
         })
     }
-
-    /// The image at `path` decoded with `encoding`, read once per scene (`what` names its use in
-    /// messages); the file is added to `inputs` when read.
-    pub fn texture(
-        &mut self,
-        path: &Path,
-        encoding: Encoding,
-        what: &str,
-        inputs: &mut Vec<PathBuf>,
-    ) -> Result<Arc<Texture>> {
-        let key = (path.to_path_buf(), encoding);
-        if let Some(t) = self.textures.get(&key) {
-            return Ok(t.clone());
-        }
-        let texture = Arc::new(load_texture(path, encoding, what)?);
-        inputs.push(path.to_path_buf());
-        self.textures.insert(key, texture.clone());
-        Ok(texture)
-    }
-
-    /// Index of the grey Lambertian used for faces without a material.
-    pub fn default_material(&mut self) -> u32 {
-        let grey = Material::new(DEFAULT_MATERIAL, Bsdf::Lambert { kd: Vec3::splat(0.8) }, Vec3::ZERO);
-        match self.by_key.get(&(PathBuf::new(), DEFAULT_MATERIAL.to_string())) {
-            Some(&i) => i,
-            None => self.insert(Path::new(""), grey, &mut Vec::new()),
-        }
-    }
 }
-
-/// Name of the material given to faces with no `usemtl` (or an unknown one).
-pub const DEFAULT_MATERIAL: &str = "(default grey)";
 
 /// The files an `mtllib` statement names: its whole text when a file of that name exists
 /// (names with spaces), else each word.
@@ -159,7 +82,7 @@ fn named_by(e: Error, obj: &Path, line: usize) -> Error {
     }
 }
 
-/// The error for the first `v` statement of `text` that lies outside ±[`MAX_COORDINATE`] once
+/// The error for the first `v` statement of `text` that lies outside ±[`crate::geometry::MAX_COORDINATE`] once
 /// transformed (tobj reorders vertices, so the file is read again for its line).
 fn out_of_range(path: &Path, text: &str, transform: &Transform) -> Error {
     let first = text.lines().enumerate().find_map(|(i, line)| {
@@ -172,15 +95,7 @@ fn out_of_range(path: &Path, text: &str, transform: &Transform) -> Error {
         (!in_range(p)).then_some((i + 1, p))
     });
     let (line, p) = first.unwrap_or((0, Vec3::splat(f32::INFINITY)));
-    Error::parse(
-        path,
-        line,
-        format!(
-            "the vertex lies at {p} (after the mesh's transform), outside ±{MAX_COORDINATE:e}, the range in \
-             which photonwave's f32 geometry stays watertight; scale the scene down (`scale` in the scene \
-             file; docs/src/bad-input.md, \"Limits\")"
-        ),
-    )
+    Error::parse(path, line, out_of_range_message(p))
 }
 
 /// The name tobj is given for the one material library photonwave hands it (all of the OBJ's
@@ -308,7 +223,7 @@ pub fn load_obj(
         mesh.texcoords.clear();
     }
     transform.apply(&mut mesh);
-    if mesh.positions.iter().any(|p| !in_range(*p)) {
+    if first_out_of_range(&mesh.positions).is_some() {
         return Err(out_of_range(path, &text, transform));
     }
     if mesh.zero_normals > 0 {

@@ -5,8 +5,8 @@
 //!
 //! Writes [`MeshInput`]s; the front (emitting) face of each is the one its normal points out of.
 
-use super::MeshInput;
 use crate::error::{Error, Result};
+use crate::scene::MeshInput;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
