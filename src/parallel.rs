@@ -14,9 +14,11 @@ use std::time::Instant;
 use rayon_core::{ThreadPool, ThreadPoolBuilder};
 
 /// A persistent pool of `threads` workers, built on first use and kept for the process. Spawning
-/// and joining two OS threads costs ~100 µs on this machine, and the wavefront engine shares
-/// work ~3 000 times per render (every stage of every bounce), so fresh threads per call cost ~9 %
-/// of a two-thread render (BENCHMARKS.md). `None` if the OS refuses the threads.
+/// and joining two OS threads costs ~100 µs on this machine; when the wavefront engine still
+/// shared work ~3 000 times per render (every stage of every bounce), fresh threads per call cost
+/// ~9 % of a two-thread render (BENCHMARKS.md). Its passes now meet the pool once per pass and
+/// photon wave, the reference engine once per row range and photon batch. `None` if the OS
+/// refuses the threads.
 fn pool(threads: usize) -> Option<Arc<ThreadPool>> {
     /// Pools built so far, by worker count.
     type Pools = Mutex<Vec<(usize, Arc<ThreadPool>)>>;

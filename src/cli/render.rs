@@ -253,62 +253,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
     // Validated and planned once, for the whole render.
     let job = Job::new(&scene, &settings)?;
     let settings = &job.settings;
-    let file_camera = match &args.camera {
-        None => loaded.camera,
-        Some(name) => Some(loaded.cameras.iter().find(|c| &c.0 == name).map(|c| c.1).ok_or_else(|| {
-            let names: Vec<&str> = loaded.cameras.iter().map(|c| c.0.as_str()).collect();
-            photonwave::error::Error::setting(
-                "--camera",
-                if names.is_empty() {
-                    format!("`{name}`: the scene's models name no cameras")
-                } else {
-                    format!("`{name}` is not a camera of the scene (its cameras: {})", names.join(", "))
-                },
-            )
-        })?),
-    };
+    let file_camera = named_camera(&args, loaded.camera, &loaded.cameras)?;
     let aspect = settings.width as f32 / settings.height as f32;
     let camera = view(&args, file_camera, scene.mesh_bounds(), aspect, &|p| scene.to_frame(p));
     let rays = camera.prepare(settings.width, settings.height)?;
     let load_s = t0.elapsed().as_secs_f64();
 
-    for w in &scene.warnings {
-        say.warn(w);
-    }
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    if job.threads > 2 * cores {
-        say.warn(format!(
-            "{} threads on {cores} cores: threads beyond the cores only add switching (measured 20× slower \
-             at 1024 on 2 cores); 0 uses every core",
-            job.threads
-        ));
-    }
-    say.info(format!(
-        "scene: {} triangles, {} materials, lights: {} ({} emissive triangles), total power {} W\n",
-        scene.triangle_count(),
-        scene.materials.len(),
-        scene.lights.len(),
-        scene.area_lights.len(),
-        significant(scene.total_power().element_sum() / 3.0)
-    ));
-    if scene.origin != Vec3::ZERO {
-        let o = scene.origin;
-        say.info(format!(
-            "frame: the scene lies {} units from the origin, far for its size; it is rendered moved to its centre \
-             ({}, {}, {}), where f32 holds its detail (the camera and lights move with it)\n",
-            significant(o.length()),
-            significant(o.x),
-            significant(o.y),
-            significant(o.z)
-        ));
-    }
-    if args.engine == Engine::Path {
-        say.info(
-            "plan: path tracing with next-event estimation — every term sampled from the camera; no photon maps\n",
-        );
-    } else {
-        say.info(job.plan.describe());
-    }
+    describe(say, &scene, &job, args.engine);
     let bars = Bars::new(args.quiet);
     let budget = args.time.map(|limit| Budget { limit, start: t0 });
     let flags = PassFlags {
@@ -379,6 +330,79 @@ pub fn run(args: RenderArgs) -> Result<()> {
         };
         say.info(format!("wrote {}{part}\n", args.output.display()));
     }
+    write_png_and_stats(&args, &film, &stats, say)?;
+    if let Some(sig) = signal {
+        std::process::exit(128 + sig);
+    }
+    Ok(())
+}
+
+/// The camera `--camera NAME` picks from the scene's named cameras, or the file's own.
+fn named_camera(args: &RenderArgs, file: Option<Camera>, cameras: &[(String, Camera)]) -> Result<Option<Camera>> {
+    let Some(name) = &args.camera else { return Ok(file) };
+    let found = cameras.iter().find(|c| &c.0 == name).map(|c| c.1);
+    Ok(Some(found.ok_or_else(|| {
+        let names: Vec<&str> = cameras.iter().map(|c| c.0.as_str()).collect();
+        photonwave::error::Error::setting(
+            "--camera",
+            if names.is_empty() {
+                format!("`{name}`: the scene's models name no cameras")
+            } else {
+                format!("`{name}` is not a camera of the scene (its cameras: {})", names.join(", "))
+            },
+        )
+    })?))
+}
+
+/// What the render is about to do, before it does it: the scene's warnings, too many threads,
+/// the scene in numbers, its frame when it was moved, and the plan.
+fn describe(say: Say, scene: &photonwave::scene::Scene, job: &Job, engine: Engine) {
+    for w in &scene.warnings {
+        say.warn(w);
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if job.threads > 2 * cores {
+        say.warn(format!(
+            "{} threads on {cores} cores: threads beyond the cores only add switching (measured 20× slower \
+             at 1024 on 2 cores); 0 uses every core",
+            job.threads
+        ));
+    }
+    say.info(format!(
+        "scene: {} triangles, {} materials, lights: {} ({} emissive triangles), total power {} W\n",
+        scene.triangle_count(),
+        scene.materials.len(),
+        scene.lights.len(),
+        scene.area_lights.len(),
+        significant(scene.total_power().element_sum() / 3.0)
+    ));
+    if scene.origin != Vec3::ZERO {
+        let o = scene.origin;
+        say.info(format!(
+            "frame: the scene lies {} units from the origin, far for its size; it is rendered moved to its centre \
+             ({}, {}, {}), where f32 holds its detail (the camera and lights move with it)\n",
+            significant(o.length()),
+            significant(o.x),
+            significant(o.y),
+            significant(o.z)
+        ));
+    }
+    if engine == Engine::Path {
+        say.info(
+            "plan: path tracing with next-event estimation — every term sampled from the camera; no photon maps\n",
+        );
+    } else {
+        say.info(job.plan.describe());
+    }
+}
+
+/// Writes the `--png` preview and the `--stats` JSON, and prints the summary.
+fn write_png_and_stats(
+    args: &RenderArgs,
+    film: &photonwave::film::Film,
+    stats: &photonwave::stats::RenderStats,
+    say: Say,
+) -> Result<()> {
     if let Some(p) = &args.png {
         film.write_png(p)?;
         say.info(format!("wrote {}\n", p.display()));
@@ -391,9 +415,6 @@ pub fn run(args: RenderArgs) -> Result<()> {
         let json = serde_json::to_string_pretty(&stats).map_err(|e| Error::output(p, e))?;
         photonwave::files::write_bytes(p, json.as_bytes())?;
         say.info(format!("wrote {}\n", p.display()));
-    }
-    if let Some(sig) = signal {
-        std::process::exit(128 + sig);
     }
     Ok(())
 }

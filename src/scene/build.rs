@@ -37,94 +37,16 @@ impl Scene {
                 )));
             }
         }
-        let origin = frame_origin(&meshes);
-        if origin != Vec3::ZERO {
-            for p in meshes.iter_mut().flat_map(|m| m.positions.iter_mut()) {
-                *p = relative_to(*p, origin);
-            }
-            for l in &mut extra_lights {
-                if let Light::Point { position, .. } | Light::Spot { position, .. } = l {
-                    *position = relative_to(*position, origin);
-                }
-            }
-        }
+        let origin = move_to_frame(&mut meshes, &mut extra_lights);
         if environment.is_some() {
             extra_lights.push(Light::Environment);
         }
-        let (mut p0, mut p1, mut p2, mut vn, mut mat) = (vec![], vec![], vec![], vec![], vec![]);
-        let textured = materials.iter().any(|m| !m.maps.is_empty());
-        let mut uv: Vec<[Vec2; 3]> = vec![];
-        let mut untextured_uses: Vec<String> = vec![];
-        // Degenerate triangles skipped, per mesh (named in the warning).
-        let mut dropped_in: Vec<(&str, usize)> = vec![];
         let zero_normals = meshes.iter().map(|m| m.zero_normals).sum();
-        // Emissive area per material, to refuse lights whose every triangle is degenerate.
-        let mut emitter_area = vec![0.0f64; materials.len()];
-        let mut emitter_seen = vec![false; materials.len()];
-        for m in &meshes {
-            for (t, tri) in m.triangles.iter().enumerate() {
-                let v = tri.map(|i| m.positions[i as usize]);
-                let material = m.material[t];
-                let emissive = materials[material as usize].emission != Vec3::ZERO;
-                let (gn, area) = normal_and_area(v[0], v[1], v[2]);
-                if emissive {
-                    emitter_seen[material as usize] = true;
-                }
-                // Also what the intersection test takes as degenerate (its f32 cross product
-                // underflows): such a triangle could never be hit, nor lit if it emitted.
-                if !(area > 0.0) || is_degenerate(v[0], v[1], v[2]) {
-                    match dropped_in.last_mut() {
-                        Some((source, n)) if *source == m.source.as_str() => *n += 1,
-                        _ => dropped_in.push((&m.source, 1)),
-                    }
-                    continue;
-                }
-                if emissive {
-                    emitter_area[material as usize] += f64::from(area);
-                }
-                p0.push(v[0]);
-                p1.push(v[1]);
-                p2.push(v[2]);
-                vn.push(if m.normals.is_empty() {
-                    [gn; 3]
-                } else {
-                    tri.map(|i| m.normals[i as usize].try_normalize().unwrap_or(gn))
-                });
-                mat.push(material);
-                if textured {
-                    if m.texcoords.is_empty() {
-                        let name = &materials[material as usize];
-                        if !name.maps.is_empty() && !untextured_uses.iter().any(|u| u.starts_with(&m.source)) {
-                            untextured_uses.push(format!(
-                                "{}: material `{}` has a texture but the mesh has no texture coordinates (`vt`); it \
-                                 reads the texture at (0, 0) everywhere",
-                                m.source, name.name
-                            ));
-                        }
-                        uv.push([Vec2::ZERO; 3]);
-                    } else {
-                        uv.push(tri.map(|i| m.texcoords[i as usize]));
-                    }
-                }
-            }
-        }
-        warnings.extend(untextured_uses);
-        for (i, seen) in emitter_seen.iter().enumerate() {
-            if *seen && emitter_area[i] <= 0.0 {
-                return Err(Error::scene(format!(
-                    "emitter material `{}` has zero area: every triangle using it is degenerate",
-                    materials[i].name
-                )));
-            }
-        }
-        let dropped: usize = dropped_in.iter().map(|(_, n)| n).sum();
-        for (source, n) in &dropped_in {
-            warnings.push(format!("{source}: {n} degenerate (zero-area) triangles were skipped"));
-        }
-        if p0.is_empty() {
+        let t = Triangles::gather(&meshes, &materials, &mut warnings)?;
+        if t.p0.is_empty() {
             let directional = extra_lights.iter().any(Light::is_distant);
-            let why = if dropped > 0 {
-                format!(" (all {dropped} of its triangles have zero area)")
+            let why = if t.dropped > 0 {
+                format!(" (all {} of its triangles have zero area)", t.dropped)
             } else if directional {
                 ": a directional light needs geometry to light (add a [[mesh]])".into()
             } else {
@@ -132,43 +54,22 @@ impl Scene {
             };
             return Err(Error::scene(format!("the scene has no triangles{why}")));
         }
-        for (i, l) in extra_lights.iter().enumerate() {
-            if let Light::Point { position, .. } | Light::Spot { position, .. } = *l {
-                if !in_range(position) {
-                    return Err(Error::setting(
-                        format!("light[{i}].position"),
-                        format!("{position} is outside ±{MAX_COORDINATE:e}, the range photonwave supports"),
-                    ));
-                }
-            }
-        }
+        check_light_positions(&extra_lights)?;
 
-        let (mut lo, mut hi) = bounds_of(p0.iter().chain(&p1).chain(&p2));
+        let (mut lo, mut hi) = bounds_of(t.p0.iter().chain(&t.p1).chain(&t.p2));
         let size = (hi - lo).length().max(f32::MIN_POSITIVE);
-        if let Some(w) = checks::coincident_dielectrics(&p0, &p1, &p2, &mat, &materials, size) {
+        if let Some(w) = checks::coincident_dielectrics(&t.p0, &t.p1, &t.p2, &t.mat, &materials, size) {
             warnings.push(w);
         }
-        let (bvh, order) = Bvh::build(&p0, &p1, &p2);
+        let (bvh, order) = Bvh::build(&t.p0, &t.p1, &t.p2);
         let pick = |v: &Vec<Vec3>| order.iter().map(|&i| v[i as usize]).collect::<Vec<_>>();
-        let (p0, p1, p2) = (pick(&p0), pick(&p1), pick(&p2));
-        let vn: Vec<[Vec3; 3]> = order.iter().map(|&i| vn[i as usize]).collect();
-        let material: Vec<u32> = order.iter().map(|&i| mat[i as usize]).collect();
-        let uv: Vec<[Vec2; 3]> = if textured { order.iter().map(|&i| uv[i as usize]).collect() } else { vec![] };
+        let (p0, p1, p2) = (pick(&t.p0), pick(&t.p1), pick(&t.p2));
+        let vn: Vec<[Vec3; 3]> = order.iter().map(|&i| t.vn[i as usize]).collect();
+        let material: Vec<u32> = order.iter().map(|&i| t.mat[i as usize]).collect();
+        let uv: Vec<[Vec2; 3]> = if t.textured { order.iter().map(|&i| t.uv[i as usize]).collect() } else { vec![] };
         let (ng, area): (Vec<Vec3>, Vec<f32>) = (0..p0.len()).map(|i| normal_and_area(p0[i], p1[i], p2[i])).unzip();
 
-        let mut lights: Vec<Light> = (0..p0.len())
-            .filter(|&i| materials[material[i] as usize].emission != Vec3::ZERO)
-            .map(|i| {
-                let m = &materials[material[i] as usize];
-                // A textured emitter's radiance here only weighs its pick (its power): the
-                // samples read the texture where they land (`Scene::sample_incident`, …).
-                let radiance = match (&m.maps.ke, uv.get(i)) {
-                    (Some(t), Some(tri_uv)) => m.emission * textured_mean(t, tri_uv),
-                    _ => m.emission,
-                };
-                Light::Area { tri: i as u32, radiance }
-            })
-            .collect();
+        let mut lights = area_lights(&material, &materials, &uv);
         for l in &extra_lights {
             if let Light::Point { position, .. } | Light::Spot { position, .. } = *l {
                 lo = lo.min(position);
@@ -202,7 +103,7 @@ impl Scene {
             suns: vec![],
             bounds: (lo, hi),
             origin,
-            dropped_degenerate: dropped,
+            dropped_degenerate: t.dropped,
             zero_normals,
             encloses_lights: false,
             warnings,
@@ -211,24 +112,41 @@ impl Scene {
             open_edges: open_edges::OpenEdges::default(),
             caustic_targets: Vec::new(),
         };
-        let mut used = vec![false; scene.materials.len()];
-        for &m in &scene.material {
+        scene.find_kinds();
+        scene.distribute_lights()?;
+        let edges = scene.edge_uses();
+        scene.encloses_lights = scene.find_enclosure(&edges);
+        scene.open_edges = scene.find_open_edges(scene.diagonal().max(f32::MIN_POSITIVE), &edges);
+        scene.caustic_targets = scene.find_caustic_targets(&edges);
+        Ok(scene)
+    }
+
+    /// Which kinds of material the scene's triangles use: (any passed as specular by photons,
+    /// any glass, any non-delta).
+    fn find_kinds(&mut self) {
+        let mut used = vec![false; self.materials.len()];
+        for &m in &self.material {
             used[m as usize] = true;
         }
-        for (m, _) in scene.materials.iter().zip(&used).filter(|(_, u)| **u) {
-            scene.kinds.0 |= m.bsdf.photon_specular();
-            scene.kinds.1 |= matches!(m.bsdf, Bsdf::Glass { .. });
-            scene.kinds.2 |= !m.bsdf.is_delta();
+        for (m, _) in self.materials.iter().zip(&used).filter(|(_, u)| **u) {
+            self.kinds.0 |= m.bsdf.photon_specular();
+            self.kinds.1 |= matches!(m.bsdf, Bsdf::Glass { .. });
+            self.kinds.2 |= !m.bsdf.is_delta();
         }
-        let powers: Vec<f64> =
-            scene.lights.iter().map(|l| scene.light_power_of(l).element_sum() as f64 / 3.0).collect();
+    }
+
+    /// The lights' power distributions: every light by power (photons), the area lights, sun and
+    /// environment by power (direct light), the delta lights and suns listed. A light whose
+    /// power overflows f32, or a scene whose every light is dark, is an error.
+    fn distribute_lights(&mut self) -> Result<()> {
+        let powers: Vec<f64> = self.lights.iter().map(|l| self.light_power_of(l).element_sum() as f64 / 3.0).collect();
         if let Some(i) = powers.iter().position(|p| !p.is_finite()) {
-            let what = match &scene.lights[i] {
+            let what = match &self.lights[i] {
                 Light::Area { tri, .. } => {
-                    format!("emitter material `{}`", scene.materials[scene.material[*tri as usize] as usize].name)
+                    format!("emitter material `{}`", self.materials[self.material[*tri as usize] as usize].name)
                 }
                 _ => {
-                    let k = scene.lights[..i].iter().filter(|l| !matches!(l, Light::Area { .. })).count();
+                    let k = self.lights[..i].iter().filter(|l| !matches!(l, Light::Area { .. })).count();
                     format!("setting `light[{k}]`")
                 }
             };
@@ -236,19 +154,158 @@ impl Scene {
                 "{what}: its power overflows f32 (emission times area or intensity times solid angle is above 3.4e38 W); scale it down"
             )));
         }
-        scene.light_power = Distribution1D::try_new(&powers)
+        self.light_power = Distribution1D::try_new(&powers)
             .ok_or_else(|| Error::scene("every light has zero power: check `Ke` and light intensities"))?;
-        scene.area_lights = (0..scene.lights.len() as u32).filter(|&i| !scene.lights[i as usize].is_delta()).collect();
-        scene.delta_lights = (0..scene.lights.len() as u32).filter(|&i| scene.lights[i as usize].is_delta()).collect();
-        scene.suns =
-            (0..scene.lights.len() as u32).filter(|&i| matches!(scene.lights[i as usize], Light::Sun { .. })).collect();
-        let area_w: Vec<f64> = scene.area_lights.iter().map(|&i| powers[i as usize]).collect();
-        scene.area_power = Distribution1D::try_new(&area_w);
-        let edges = scene.edge_uses();
-        scene.encloses_lights = scene.find_enclosure(&edges);
-        scene.open_edges = scene.find_open_edges(scene.diagonal().max(f32::MIN_POSITIVE), &edges);
-        scene.caustic_targets = scene.find_caustic_targets(&edges);
-        Ok(scene)
+        let lights = 0..self.lights.len() as u32;
+        self.area_lights = lights.clone().filter(|&i| !self.lights[i as usize].is_delta()).collect();
+        self.delta_lights = lights.clone().filter(|&i| self.lights[i as usize].is_delta()).collect();
+        self.suns = lights.filter(|&i| matches!(self.lights[i as usize], Light::Sun { .. })).collect();
+        let area_w: Vec<f64> = self.area_lights.iter().map(|&i| powers[i as usize]).collect();
+        self.area_power = Distribution1D::try_new(&area_w);
+        Ok(())
+    }
+}
+
+/// Moves the meshes and the point and spot lights into the scene's frame ([`frame_origin`]);
+/// returns its origin (zero: nothing moved).
+fn move_to_frame(meshes: &mut [MeshInput], lights: &mut [Light]) -> Vec3 {
+    let origin = frame_origin(meshes);
+    if origin != Vec3::ZERO {
+        for p in meshes.iter_mut().flat_map(|m| m.positions.iter_mut()) {
+            *p = relative_to(*p, origin);
+        }
+        for l in lights {
+            if let Light::Point { position, .. } | Light::Spot { position, .. } = l {
+                *position = relative_to(*position, origin);
+            }
+        }
+    }
+    origin
+}
+
+/// Point and spot lights must lie within ±[`MAX_COORDINATE`].
+fn check_light_positions(lights: &[Light]) -> Result<()> {
+    for (i, l) in lights.iter().enumerate() {
+        if let Light::Point { position, .. } | Light::Spot { position, .. } = *l {
+            if !in_range(position) {
+                return Err(Error::setting(
+                    format!("light[{i}].position"),
+                    format!("{position} is outside ±{MAX_COORDINATE:e}, the range photonwave supports"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One area light per emissive triangle (`material` per triangle, in BVH order), in triangle
+/// order: the scene's first lights.
+fn area_lights(material: &[u32], materials: &[Material], uv: &[[Vec2; 3]]) -> Vec<Light> {
+    (0..material.len())
+        .filter(|&i| materials[material[i] as usize].emission != Vec3::ZERO)
+        .map(|i| {
+            let m = &materials[material[i] as usize];
+            // A textured emitter's radiance here only weighs its pick (its power): the
+            // samples read the texture where they land (`Scene::sample_incident`, …).
+            let radiance = match (&m.maps.ke, uv.get(i)) {
+                (Some(t), Some(tri_uv)) => m.emission * textured_mean(t, tri_uv),
+                _ => m.emission,
+            };
+            Light::Area { tri: i as u32, radiance }
+        })
+        .collect()
+}
+
+/// The meshes' triangles as columns in input order, degenerate ones skipped: vertices, vertex
+/// normals, materials and (with any textured material) texture coordinates.
+struct Triangles {
+    p0: Vec<Vec3>,
+    p1: Vec<Vec3>,
+    p2: Vec<Vec3>,
+    vn: Vec<[Vec3; 3]>,
+    mat: Vec<u32>,
+    uv: Vec<[Vec2; 3]>,
+    /// Whether any material has a texture (then `uv` has a row per triangle).
+    textured: bool,
+    /// Degenerate triangles skipped.
+    dropped: usize,
+}
+
+impl Triangles {
+    /// Gathers the triangles of `meshes`, warning per mesh of the degenerate ones skipped and of
+    /// textured materials on meshes without texture coordinates; an emitter material whose every
+    /// triangle is degenerate is an error.
+    fn gather(meshes: &[MeshInput], materials: &[Material], warnings: &mut Vec<String>) -> Result<Triangles> {
+        let textured = materials.iter().any(|m| !m.maps.is_empty());
+        let mut t =
+            Triangles { p0: vec![], p1: vec![], p2: vec![], vn: vec![], mat: vec![], uv: vec![], textured, dropped: 0 };
+        let mut untextured_uses: Vec<String> = vec![];
+        // Degenerate triangles skipped, per mesh (named in the warning).
+        let mut dropped_in: Vec<(&str, usize)> = vec![];
+        // Emissive area per material, to refuse lights whose every triangle is degenerate.
+        let mut emitter_area = vec![0.0f64; materials.len()];
+        let mut emitter_seen = vec![false; materials.len()];
+        for m in meshes {
+            for (k, tri) in m.triangles.iter().enumerate() {
+                let v = tri.map(|i| m.positions[i as usize]);
+                let material = m.material[k];
+                let emissive = materials[material as usize].emission != Vec3::ZERO;
+                let (gn, area) = normal_and_area(v[0], v[1], v[2]);
+                if emissive {
+                    emitter_seen[material as usize] = true;
+                }
+                // Also what the intersection test takes as degenerate (its f32 cross product
+                // underflows): such a triangle could never be hit, nor lit if it emitted.
+                if !(area > 0.0) || is_degenerate(v[0], v[1], v[2]) {
+                    match dropped_in.last_mut() {
+                        Some((source, n)) if *source == m.source.as_str() => *n += 1,
+                        _ => dropped_in.push((&m.source, 1)),
+                    }
+                    continue;
+                }
+                if emissive {
+                    emitter_area[material as usize] += f64::from(area);
+                }
+                t.p0.push(v[0]);
+                t.p1.push(v[1]);
+                t.p2.push(v[2]);
+                t.vn.push(if m.normals.is_empty() {
+                    [gn; 3]
+                } else {
+                    tri.map(|i| m.normals[i as usize].try_normalize().unwrap_or(gn))
+                });
+                t.mat.push(material);
+                if textured {
+                    if m.texcoords.is_empty() {
+                        let name = &materials[material as usize];
+                        if !name.maps.is_empty() && !untextured_uses.iter().any(|u| u.starts_with(&m.source)) {
+                            untextured_uses.push(format!(
+                                "{}: material `{}` has a texture but the mesh has no texture coordinates (`vt`); it \
+                                 reads the texture at (0, 0) everywhere",
+                                m.source, name.name
+                            ));
+                        }
+                        t.uv.push([Vec2::ZERO; 3]);
+                    } else {
+                        t.uv.push(tri.map(|i| m.texcoords[i as usize]));
+                    }
+                }
+            }
+        }
+        warnings.extend(untextured_uses);
+        for (i, seen) in emitter_seen.iter().enumerate() {
+            if *seen && emitter_area[i] <= 0.0 {
+                return Err(Error::scene(format!(
+                    "emitter material `{}` has zero area: every triangle using it is degenerate",
+                    materials[i].name
+                )));
+            }
+        }
+        t.dropped = dropped_in.iter().map(|(_, n)| n).sum();
+        for (source, n) in &dropped_in {
+            warnings.push(format!("{source}: {n} degenerate (zero-area) triangles were skipped"));
+        }
+        Ok(t)
     }
 }
 

@@ -32,7 +32,7 @@ pub struct Maps(pub Arc<PhotonMaps>);
 pub struct PhotonWork {
     /// Which map this pass fills.
     pub domain: Option<Domain>,
-    /// Path index of the wave's first photon.
+    /// Path index of the piece's first photon.
     pub first_path: u64,
     /// Paths in this piece of a wave.
     pub paths: usize,
@@ -46,13 +46,13 @@ pub struct PhotonWork {
     pub survivors: Vec<u32>,
     /// Stored photons keyed by (path, bounce), the reference engine's order.
     pub deposits: Vec<(u64, u32, Photon)>,
-    /// What each path of the wave counted (rays, clamped bounces, how it ended), indexed by
+    /// What each path of the piece counted (rays, clamped bounces, how it ended), indexed by
     /// path − `first_path`: the tally sums the kept paths' only.
     pub counts: Vec<PathCounts>,
 }
 
-/// Camera-pass state of one worker: its tile of samples (a wave) and the counts of every tile
-/// it has rendered.
+/// Camera-pass state of one worker: the wave of samples in flight (its tile's, or part of them)
+/// and the counts of every tile it has rendered.
 #[derive(Resource)]
 pub struct CameraWork {
     /// Primary-ray generator.

@@ -187,21 +187,11 @@ impl Sources<'_> {
     }
 }
 
-/// Loads the glTF or GLB file at `path`, placed by `transform`; its materials go into `table`,
-/// every file read into `inputs`.
-pub fn load_gltf(
-    path: &Path,
-    transform: &Transform,
-    table: &mut MaterialTable,
-    warnings: &mut Vec<String>,
-    inputs: &mut Vec<PathBuf>,
-) -> Result<Model> {
-    let data = read_input(path, "a glTF model", MAX_MESH_FILE)?;
-    inputs.push(path.to_path_buf());
-    let (json, bin) = if data.starts_with(b"glTF") { glb_chunks(path, &data)? } else { (&data[..], None) };
-    asset_version(path, json)?;
-    let root: gltf::json::Root =
-        gltf::json::deserialize::from_slice(json).map_err(|e| Error::parse(path, e.line(), format!("glTF: {e}")))?;
+/// What the crate would refuse late or unwrap, checked first: required extensions photonwave
+/// does not read; an image needs a `uri` or a `bufferView` with a `mimeType`; a camera the
+/// projection its `type` names; a POSITION attribute an accessor that exists (gltf-json's
+/// validator indexes it unchecked).
+fn check_root(path: &Path, root: &gltf::json::Root) -> Result<()> {
     for ext in &root.extensions_required {
         if !REQUIRED_READ.contains(&ext.as_str()) {
             return Err(Error::parse(
@@ -255,16 +245,13 @@ pub fn load_gltf(
             }
         }
     }
-    let doc = gltf::Document::from_json(root).map_err(|e| Error::parse(path, 0, format!("glTF: {e}")))?;
-    let ignored: Vec<&str> = doc.extensions_used().filter(|e| !REQUIRED_READ.contains(e)).collect();
-    if !ignored.is_empty() {
-        warnings.push(format!(
-            "{}: the extensions {} are not read; the model renders without them",
-            path.display(),
-            ignored.join(", ")
-        ));
-    }
-    let mut src = Sources { path, doc: &doc, buffers: Vec::new(), images: HashMap::new(), inputs };
+    Ok(())
+}
+
+/// Reads every buffer of `src`'s document into `src.buffers`: the GLB's binary chunk `bin` or
+/// the file or data URI it names; a buffer shorter than declared is an error.
+fn read_buffers(src: &mut Sources, bin: Option<&[u8]>) -> Result<()> {
+    let (path, doc) = (src.path, src.doc);
     for buffer in doc.buffers() {
         let what = format!("buffer {}", buffer.index());
         let bytes = match buffer.source() {
@@ -284,6 +271,63 @@ pub fn load_gltf(
         }
         src.buffers.push(bytes);
     }
+    Ok(())
+}
+
+/// The pinhole camera `camera` of `node`, placed by `world`, with its name (the camera's, else
+/// the node's); an orthographic one is warned of and skipped.
+fn node_camera(
+    node: &gltf::Node,
+    camera: &gltf::Camera,
+    world: &Affine3A,
+    label: &str,
+    path: &Path,
+    warnings: &mut Vec<String>,
+) -> Option<(String, Camera)> {
+    match camera.projection() {
+        gltf::camera::Projection::Perspective(p) => {
+            let name =
+                camera.name().or(node.name()).map_or_else(|| format!("camera {}", camera.index()), str::to_string);
+            let eye = world.transform_point3(Vec3::ZERO);
+            let forward = world.transform_vector3(-Vec3::Z);
+            let up = world.transform_vector3(Vec3::Y);
+            Some((name, Camera { eye, target: eye + forward, up, fov_deg: p.yfov().to_degrees() }))
+        }
+        gltf::camera::Projection::Orthographic(_) => {
+            warnings
+                .push(format!("{}: {label}'s orthographic camera is not read (pinhole cameras only)", path.display()));
+            None
+        }
+    }
+}
+
+/// Loads the glTF or GLB file at `path`, placed by `transform`; its materials go into `table`,
+/// every file read into `inputs`.
+pub fn load_gltf(
+    path: &Path,
+    transform: &Transform,
+    table: &mut MaterialTable,
+    warnings: &mut Vec<String>,
+    inputs: &mut Vec<PathBuf>,
+) -> Result<Model> {
+    let data = read_input(path, "a glTF model", MAX_MESH_FILE)?;
+    inputs.push(path.to_path_buf());
+    let (json, bin) = if data.starts_with(b"glTF") { glb_chunks(path, &data)? } else { (&data[..], None) };
+    asset_version(path, json)?;
+    let root: gltf::json::Root =
+        gltf::json::deserialize::from_slice(json).map_err(|e| Error::parse(path, e.line(), format!("glTF: {e}")))?;
+    check_root(path, &root)?;
+    let doc = gltf::Document::from_json(root).map_err(|e| Error::parse(path, 0, format!("glTF: {e}")))?;
+    let ignored: Vec<&str> = doc.extensions_used().filter(|e| !REQUIRED_READ.contains(e)).collect();
+    if !ignored.is_empty() {
+        warnings.push(format!(
+            "{}: the extensions {} are not read; the model renders without them",
+            path.display(),
+            ignored.join(", ")
+        ));
+    }
+    let mut src = Sources { path, doc: &doc, buffers: Vec::new(), images: HashMap::new(), inputs };
+    read_buffers(&mut src, bin)?;
     let mut ids = Vec::new();
     let mut names = std::collections::HashSet::new();
     for m in doc.materials() {
@@ -332,31 +376,7 @@ pub fn load_gltf(
         stack.extend(children.into_iter().rev().map(|c| (c, world, depth + 1)));
         let label = node.name().map_or_else(|| format!("node {}", node.index()), |n| format!("node `{n}`"));
         if let Some(camera) = node.camera() {
-            match camera.projection() {
-                gltf::camera::Projection::Perspective(p) => {
-                    let name = camera
-                        .name()
-                        .or(node.name())
-                        .map_or_else(|| format!("camera {}", camera.index()), str::to_string);
-                    let eye = world.transform_point3(Vec3::ZERO);
-                    let forward = world.transform_vector3(-Vec3::Z);
-                    model.cameras.push((
-                        name,
-                        Camera {
-                            eye,
-                            target: eye + forward,
-                            up: world.transform_vector3(Vec3::Y),
-                            fov_deg: p.yfov().to_degrees(),
-                        },
-                    ));
-                }
-                gltf::camera::Projection::Orthographic(_) => {
-                    warnings.push(format!(
-                        "{}: {label}'s orthographic camera is not read (pinhole cameras only)",
-                        path.display()
-                    ));
-                }
-            }
+            model.cameras.extend(node_camera(&node, &camera, &world, &label, path, warnings));
         }
         if let Some(light) = node.light() {
             model.lights.extend(punctual(&light, &world, &label, path, warnings));

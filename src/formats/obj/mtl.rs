@@ -72,6 +72,13 @@ impl MtlMaterial {
     pub fn map(&self, key: &str) -> Option<&MapStatement> {
         self.maps.iter().rev().find(|m| m.key == key)
     }
+
+    /// Notes the statement `what` as read but not simulated (once).
+    fn ignore(&mut self, what: &str) {
+        if !self.ignored.iter().any(|s| s == what) {
+            self.ignored.push(what.to_string());
+        }
+    }
 }
 
 /// A colour statement's value: `r g b`, `r` (grey), or `xyz X [Y Z]`. `None` for `spectral`.
@@ -160,127 +167,13 @@ pub fn parse_mtl(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<
         let Some(m) = out.last_mut() else {
             return Err(Error::parse(path, line, format!("`{kw}` before any `newmtl`")));
         };
-        let one = |what: &str| -> Result<f32> {
-            match words.as_slice() {
-                [w] => number(path, line, what, w),
-                _ => Err(Error::parse(path, line, format!("`{what}` needs 1 number, found {}", words.len()))),
-            }
-        };
-        let ignore = |m: &mut MtlMaterial, what: &str| {
-            if !m.ignored.iter().any(|s| s == what) {
-                m.ignored.push(what.to_string());
-            }
-        };
-        if words.first() == Some(&"spectral") {
-            ignore(m, &format!("{kw} spectral"));
-        }
-        match kw {
-            "Kd" => m.kd = colour(path, line, kw, &words)?.or(m.kd),
-            "Ks" => m.ks = colour(path, line, kw, &words)?.or(m.ks),
-            "Ke" => m.ke = colour(path, line, kw, &words)?.or(m.ke),
-            "Ka" => {
-                colour(path, line, kw, &words)?;
-            }
-            "Tf" => {
-                // The transmission filter: clear (1 1 1) is what photonwave's glass does.
-                if colour(path, line, kw, &words)?.is_some_and(|c| c != Vec3::ONE) {
-                    ignore(m, kw);
-                }
-            }
-            "Ns" => {
-                let v = one(kw)?;
-                if v < 0.0 {
-                    return Err(Error::parse(path, line, "`Ns` (Phong exponent) must not be negative"));
-                }
-                m.ns = Some(v);
-            }
-            "Ni" => {
-                let v = one(kw)?;
-                if v <= 0.0 {
-                    return Err(Error::parse(path, line, "`Ni` (index of refraction) must be positive"));
-                }
-                m.ni = Some(v);
-            }
-            "illum" => match words.as_slice() {
-                [w] if w.parse::<u8>().is_ok_and(|v| v <= 10) => m.illum = w.parse().ok(),
-                _ => return Err(Error::parse(path, line, "`illum` needs one integer 0–10 (the MTL spec's models)")),
-            },
-            "d" | "Tr" => {
-                // `d -halo 0.5` is the spec's other form.
-                let v = match words.as_slice() {
-                    ["-halo", w] => number(path, line, kw, w)?,
-                    _ => one(kw)?,
-                };
-                if !(0.0..=1.0).contains(&v) {
-                    return Err(Error::parse(path, line, format!("`{kw}` must be in [0, 1]")));
-                }
-                let opaque = if kw == "d" { v == 1.0 } else { v == 0.0 };
-                if !opaque {
-                    ignore(m, kw);
-                }
-            }
-            "Pr" | "Pm" => {
-                let v = one(kw)?;
-                if !(0.0..=1.0).contains(&v) {
-                    let what = if kw == "Pr" { "roughness" } else { "metallic" };
-                    return Err(Error::parse(path, line, format!("`{kw}` ({what}) must be in [0, 1], found {v}")));
-                }
-                if kw == "Pr" {
-                    m.pr = Some(v);
-                } else {
-                    m.pm = Some(v);
-                }
-            }
-            "sharpness" | "Ps" | "Pc" | "Pcr" | "aniso" | "anisor" => {
-                one(kw)?;
-                ignore(m, kw);
-            }
-            "Km" => {
-                colour(path, line, kw, &words)?;
-                ignore(m, kw);
-            }
-            _ if kw.starts_with("map_") || matches!(kw, "bump" | "disp" | "decal" | "refl" | "norm") => {
-                let Some(file) = texture_file(&words) else {
-                    return Err(Error::parse(path, line, format!("`{kw}` names no image file")));
-                };
-                if matches!(kw, "map_Kd" | "map_Ks" | "map_Pr" | "map_Ke" | "map_Pm") {
-                    if words.first().is_some_and(|w| w.starts_with('-')) {
-                        ignore(m, &format!("{kw} options"));
-                    }
-                    m.maps.push(MapStatement { key: kw.to_string(), file, line });
-                } else {
-                    ignore(m, kw);
-                }
-            }
-            other => return Err(Error::parse(path, line, format!("unknown MTL statement `{other}`"))),
-        }
+        statement(path, line, kw, &words, m)?;
     }
     for m in &mut out {
-        // Without `Pr` > 0 the material is smooth and has no roughness for `map_Pr` to vary.
-        for key in ["map_Pr", "map_Pm"] {
-            if !m.pr.is_some_and(|r| r > 0.0) && m.map(key).is_some() {
-                m.maps.retain(|s| s.key != key);
-                m.ignored.push(format!("{key} without Pr > 0"));
-            }
-        }
-        // A metallic map on a smooth mirror or glass (illum 3–9) has no plastic to mix with.
-        if matches!(m.illum, Some(3..=9)) && m.map("map_Pm").is_some() {
-            m.maps.retain(|s| s.key != "map_Pm");
-            m.ignored.push("map_Pm on a mirror or glass".into());
-        }
+        drop_unusable_maps(m);
     }
     for m in &out {
-        if !m.ignored.is_empty() {
-            warnings.push(format!(
-                "{}:{}: material `{}`: {} not simulated yet (of the texture maps only `map_Kd`, `map_Ks`, \
-                 `map_Ke`, `map_Pr` and `map_Pm` are, without options; transparency and the PBR keys are ignored); it renders with its constant \
-                 colours there",
-                path.display(),
-                m.line,
-                m.name,
-                m.ignored.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", ")
-            ));
-        }
+        warn_ignored(path, m, warnings);
     }
     Ok(out)
 }
@@ -336,6 +229,133 @@ pub fn material_from_mtl(m: &MtlMaterial, file: &Path, warnings: &mut Vec<String
         }
     };
     Material::new(m.name.clone(), bsdf, emission)
+}
+
+/// Statement `kw` with arguments `words` at `line` of `path`, applied to the material `m` it
+/// belongs to (a statement photonwave reads but does not simulate is noted in `m.ignored`).
+fn statement(path: &Path, line: usize, kw: &str, words: &[&str], m: &mut MtlMaterial) -> Result<()> {
+    let one = |what: &str| -> Result<f32> {
+        match words {
+            [w] => number(path, line, what, w),
+            _ => Err(Error::parse(path, line, format!("`{what}` needs 1 number, found {}", words.len()))),
+        }
+    };
+    if words.first() == Some(&"spectral") {
+        m.ignore(&format!("{kw} spectral"));
+    }
+    match kw {
+        "Kd" => m.kd = colour(path, line, kw, words)?.or(m.kd),
+        "Ks" => m.ks = colour(path, line, kw, words)?.or(m.ks),
+        "Ke" => m.ke = colour(path, line, kw, words)?.or(m.ke),
+        "Ka" => {
+            colour(path, line, kw, words)?;
+        }
+        "Tf" => {
+            // The transmission filter: clear (1 1 1) is what photonwave's glass does.
+            if colour(path, line, kw, words)?.is_some_and(|c| c != Vec3::ONE) {
+                m.ignore(kw);
+            }
+        }
+        "Ns" => {
+            let v = one(kw)?;
+            if v < 0.0 {
+                return Err(Error::parse(path, line, "`Ns` (Phong exponent) must not be negative"));
+            }
+            m.ns = Some(v);
+        }
+        "Ni" => {
+            let v = one(kw)?;
+            if v <= 0.0 {
+                return Err(Error::parse(path, line, "`Ni` (index of refraction) must be positive"));
+            }
+            m.ni = Some(v);
+        }
+        "illum" => match words {
+            [w] if w.parse::<u8>().is_ok_and(|v| v <= 10) => m.illum = w.parse().ok(),
+            _ => return Err(Error::parse(path, line, "`illum` needs one integer 0–10 (the MTL spec's models)")),
+        },
+        "d" | "Tr" => {
+            // `d -halo 0.5` is the spec's other form.
+            let v = match words {
+                ["-halo", w] => number(path, line, kw, w)?,
+                _ => one(kw)?,
+            };
+            if !(0.0..=1.0).contains(&v) {
+                return Err(Error::parse(path, line, format!("`{kw}` must be in [0, 1]")));
+            }
+            let opaque = if kw == "d" { v == 1.0 } else { v == 0.0 };
+            if !opaque {
+                m.ignore(kw);
+            }
+        }
+        "Pr" | "Pm" => {
+            let v = one(kw)?;
+            if !(0.0..=1.0).contains(&v) {
+                let what = if kw == "Pr" { "roughness" } else { "metallic" };
+                return Err(Error::parse(path, line, format!("`{kw}` ({what}) must be in [0, 1], found {v}")));
+            }
+            if kw == "Pr" {
+                m.pr = Some(v);
+            } else {
+                m.pm = Some(v);
+            }
+        }
+        "sharpness" | "Ps" | "Pc" | "Pcr" | "aniso" | "anisor" => {
+            one(kw)?;
+            m.ignore(kw);
+        }
+        "Km" => {
+            colour(path, line, kw, words)?;
+            m.ignore(kw);
+        }
+        _ if kw.starts_with("map_") || matches!(kw, "bump" | "disp" | "decal" | "refl" | "norm") => {
+            let Some(file) = texture_file(words) else {
+                return Err(Error::parse(path, line, format!("`{kw}` names no image file")));
+            };
+            if matches!(kw, "map_Kd" | "map_Ks" | "map_Pr" | "map_Ke" | "map_Pm") {
+                if words.first().is_some_and(|w| w.starts_with('-')) {
+                    m.ignore(&format!("{kw} options"));
+                }
+                m.maps.push(MapStatement { key: kw.to_string(), file, line });
+            } else {
+                m.ignore(kw);
+            }
+        }
+        other => return Err(Error::parse(path, line, format!("unknown MTL statement `{other}`"))),
+    }
+    Ok(())
+}
+
+/// Drops the maps a material cannot use: `map_Pr` and `map_Pm` without `Pr` > 0 (a smooth
+/// material has no roughness for them to vary), `map_Pm` on a mirror or glass (illum 3–9: no
+/// plastic to mix with).
+fn drop_unusable_maps(m: &mut MtlMaterial) {
+    for key in ["map_Pr", "map_Pm"] {
+        if !m.pr.is_some_and(|r| r > 0.0) && m.map(key).is_some() {
+            m.maps.retain(|s| s.key != key);
+            m.ignored.push(format!("{key} without Pr > 0"));
+        }
+    }
+    if matches!(m.illum, Some(3..=9)) && m.map("map_Pm").is_some() {
+        m.maps.retain(|s| s.key != "map_Pm");
+        m.ignored.push("map_Pm on a mirror or glass".into());
+    }
+}
+
+/// Warns, naming the material's `newmtl` line, of what `m` states that is not simulated.
+fn warn_ignored(path: &Path, m: &MtlMaterial, warnings: &mut Vec<String>) {
+    if m.ignored.is_empty() {
+        return;
+    }
+    warnings.push(format!(
+        "{}:{}: material `{}`: {} not simulated yet (of the texture maps only `map_Kd`, `map_Ks`, \
+         `map_Ke`, `map_Pr` and `map_Pm` are, without options; transparency and the PBR keys are ignored); it renders with its constant \
+         colours there",
+        path.display(),
+        m.line,
+        m.name,
+        m.ignored.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", ")
+    ));
 }
 
 #[cfg(test)]
