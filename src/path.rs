@@ -91,8 +91,9 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
     // The camera's first hit was a mirror or glass: everything found later is `specular`, as in
     // the photon mapper's layers.
     let mut via_specular = false;
-    let mut last_delta = true; // previous vertex was the camera or a delta bounce
-                               // The density with which the last non-delta bounce picked this ray's direction (0: MIS off).
+    // The previous vertex was the camera or a delta bounce.
+    let mut last_delta = true;
+    // The density with which the last non-delta bounce picked this ray's direction (0: MIS off).
     let mut bsdf_density = 0.0;
     let mis = if ctx.settings.mis { Strategies::Whole } else { Strategies::LightOnly };
     for depth in 0..=ctx.settings.max_depth {
@@ -108,12 +109,14 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
         let bsdf = scene.bsdf(&sp);
         let wo = -d;
         let e = emission_toward(scene, &hit, wo);
-        if last_delta && e != Vec3::ZERO {
-            terms.add(path_term(Term::Emitted, depth, via_specular), beta * e);
-        } else if !last_delta && e != Vec3::ZERO {
-            // Found by the previous bounce's BSDF sample: light sampling's partner there.
-            let found = emission_found(ctx, &hit, d, bsdf_density);
-            terms.add(path_term(Term::Direct, depth - 1, via_specular), beta * found);
+        if e != Vec3::ZERO {
+            if last_delta {
+                terms.add(path_term(Term::Emitted, depth, via_specular), beta * e);
+            } else {
+                // Found by the previous bounce's BSDF sample: light sampling's partner there.
+                let found = emission_found(ctx, &hit, d, bsdf_density);
+                terms.add(path_term(Term::Direct, depth - 1, via_specular), beta * found);
+            }
         }
         if depth == ctx.settings.max_depth {
             break;

@@ -5,9 +5,9 @@
 mod common;
 
 use common::*;
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use photonwave::code_path::CodePath;
-use photonwave::material::{Bsdf, Material, SurfaceFrame};
+use photonwave::material::{Bsdf, Material};
 use photonwave::photon_map::{Filter, Lookup, Nearest, Photon, PhotonMap, Reflectance};
 use photonwave::progress::NoProgress;
 use photonwave::reference::photons::trace_photons;
@@ -228,19 +228,6 @@ fn quad_light(le: f32) -> (Scene, [Vec3; 4]) {
     };
     let light = Material::new("light", Bsdf::Lambert { kd: Vec3::ZERO }, Vec3::splat(le));
     (Scene::build(vec![mesh], vec![light], vec![], vec![]).unwrap(), corners)
-}
-
-/// A point of a floor facing +y at `p` (material and triangle 0).
-fn floor_point(p: Vec3) -> SurfacePoint {
-    SurfacePoint {
-        p,
-        p_error: Vec3::ZERO,
-        frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y },
-        material: 0,
-        tri: 0,
-        uv: Vec2::ZERO,
-        flat: true,
-    }
 }
 
 #[test]

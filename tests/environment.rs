@@ -6,15 +6,15 @@
 mod common;
 
 use common::*;
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use photonwave::code_path::CodePath;
 use photonwave::formats::load_scene;
-use photonwave::material::{Bsdf, Material, SurfaceFrame};
+use photonwave::material::{Bsdf, Material};
 use photonwave::photon_map::{Filter, Lookup, Nearest, PhotonMap, Reflectance};
 use photonwave::progress::NoProgress;
 use photonwave::reference::photons::trace_photons;
 use photonwave::rng::{Domain, Sampler};
-use photonwave::scene::{Environment, Light, MeshInput, Scene, SurfacePoint};
+use photonwave::scene::{Environment, Light, MeshInput, Scene};
 use photonwave::settings::{Kernel, Settings};
 use photonwave::transport::direct::direct_light;
 use photonwave::transport::{Context, PhotonMaps};
@@ -43,18 +43,6 @@ fn white() -> Material {
     Material::new("white", Bsdf::Lambert { kd: Vec3::splat(KD) }, Vec3::ZERO)
 }
 
-fn top(p: Vec3) -> SurfacePoint {
-    SurfacePoint {
-        p,
-        p_error: Vec3::ZERO,
-        frame: SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y },
-        material: 0,
-        tri: 0,
-        uv: Vec2::ZERO,
-        flat: true,
-    }
-}
-
 /// Light sampling at the floor's centre, `n` independent estimates of the red channel: (mean,
 /// standard error).
 fn sampled_direct(scene: &Scene, n: u64) -> (f64, f64) {
@@ -65,7 +53,7 @@ fn sampled_direct(scene: &Scene, n: u64) -> (f64, f64) {
     let values: Vec<f32> = (0..n)
         .map(|i| {
             let s = Sampler::new(7, Domain::Camera, i);
-            direct_light(&ctx, &top(Vec3::ZERO), &white().bsdf, Vec3::Y, &s, &mut Default::default()).x
+            direct_light(&ctx, &floor_point(Vec3::ZERO), &white().bsdf, Vec3::Y, &s, &mut Default::default()).x
         })
         .collect();
     mean_and_se(&values)
@@ -88,7 +76,7 @@ fn photon_estimate(scene: &Scene) -> f32 {
     let mut sum = 0.0;
     for i in 0..8 {
         for j in 0..8 {
-            let sp = top(Vec3::new(-4.0 + i as f32, 0.0, -4.0 + j as f32));
+            let sp = floor_point(Vec3::new(-4.0 + i as f32, 0.0, -4.0 + j as f32));
             let q = Lookup {
                 p: sp.p,
                 k: 400,

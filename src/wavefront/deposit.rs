@@ -56,8 +56,11 @@ pub fn deposit_emission(
     let mut n = 0;
     for i in 0..w.paths.len() {
         if w.paths.kind[i] != PathKind::Camera {
-            let (density, hit) = (w.paths.mis[i], w.paths.hits.get(i));
-            let Some(hit) = hit.filter(|_| density > 0.0 && w.paths.depth[i] == 0) else { continue };
+            let density = w.paths.mis[i];
+            if !(density > 0.0 && w.paths.depth[i] == 0) {
+                continue;
+            }
+            let Some(hit) = w.paths.hits.get(i) else { continue };
             let found = emission_found(&ctx, &hit, w.paths.rays.direction(i), density);
             if found != Vec3::ZERO {
                 n += 1;

@@ -71,3 +71,16 @@ pub fn assert_terms_agree(a: &Film, b: &Film, tol: f32) {
         }
     }
 }
+
+/// A point of a floor facing +y at `p` (material and triangle 0).
+pub fn floor_point(p: Vec3) -> photonwave::scene::SurfacePoint {
+    photonwave::scene::SurfacePoint {
+        p,
+        p_error: Vec3::ZERO,
+        frame: photonwave::material::SurfaceFrame { ng: Vec3::Y, ns: Vec3::Y },
+        material: 0,
+        tri: 0,
+        uv: glam::Vec2::ZERO,
+        flat: true,
+    }
+}
