@@ -103,7 +103,7 @@ pub fn normalise_line_ends(text: &str) -> String {
 /// synced and renamed over `path` only when `write` succeeded; otherwise it is removed and the
 /// previous `path`, if any, is untouched.
 /// A symbolic link is written through: its target is replaced, not the link. A target that is
-/// not a regular file is never replaced ([`write_into_special`]).
+/// not a regular file is never replaced (`write_into_special`).
 pub fn replace(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     if let Some(kind) = special_target(path) {
         return write_into_special(path, kind, write);

@@ -391,7 +391,7 @@ fn check_exr_size(path: &Path) -> Result<()> {
 pub type DecodedExr = exr::image::FlatImage;
 
 /// Decodes the EXR at `path` whole. A damaged file is an error naming it, never a crash: sizes
-/// are checked before decoding ([`check_exr_size`]), and a panic inside the decoder is caught
+/// are checked before decoding (`check_exr_size`), and a panic inside the decoder is caught
 /// and reported as damage.
 pub fn decode_exr(path: &Path) -> Result<DecodedExr> {
     check_exr_size(path)?;

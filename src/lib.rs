@@ -47,7 +47,7 @@
 //!   continuation, density estimates, the random-stream layout;
 //!
 //! **Engines** — loops over the transport core:
-//! - [`reference`]: the scalar oracle, one ray at a time, that every fast path is tested against;
+//! - [`reference`](mod@reference): the scalar oracle, one ray at a time, that every fast path is tested against;
 //! - [`wavefront`]: bevy_ecs systems over structure-of-arrays queues, SIMD kernels;
 //! - [`path`]: an unbiased path tracer for checking energy;
 //!
@@ -57,7 +57,7 @@
 //!   renders, and their exact merge;
 //! - [`engine`]: the one render entry point — a single render or progressive passes;
 //! - [`diagnostics`]: the diagnostic layers — estimate radii and photon counts per pixel;
-//! - [`tools`] ([`tools::compare`], [`tools::sweep`], [`tools::plot`]), [`bench`], [`fuzzing`]:
+//! - [`tools`] ([`tools::compare`], [`tools::sweep`], [`tools::plot`]), [`bench`](mod@bench), [`fuzzing`]:
 //!   the CLI's `compare`, `sweep`, `bench` and the fuzz targets' entry points.
 
 // `!(x > 0.0)` is used on purpose throughout: unlike `x <= 0.0` it is also true for NaN, so a

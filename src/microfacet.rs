@@ -247,7 +247,7 @@ pub fn plastic_pdf(wo: Vec3, wi: Vec3, kd: Vec3, eta: f32, alpha: f32) -> f32 {
 }
 
 /// Samples the rough plastic: its coat (a visible normal, reflection about it) or its base
-/// (cosine-weighted), chosen by [`plastic_coat_probability`]; weight f·cos/pdf of the mixture.
+/// (cosine-weighted), chosen by `plastic_coat_probability`; weight f·cos/pdf of the mixture.
 #[must_use]
 pub fn plastic_sample(wo: Vec3, kd: Vec3, eta: f32, alpha: f32, u: [f32; 3]) -> Option<LocalSample> {
     let p = plastic_coat_probability(wo, kd, eta);

@@ -50,7 +50,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    /// Every kernel, in the order of [`Trial::nanos`] (each one's index is its discriminant).
+    /// Every kernel, in the order of `Trial::nanos` (each one's index is its discriminant).
     pub const ALL: [Kernel; 3] = [Kernel::Packets, Kernel::Single, Kernel::WidePackets];
 
     /// Its name in the summary.

@@ -3,13 +3,15 @@
 //! Reads a scene's camera hits and its global photon map; writes [`DensityRow`]s.
 
 use super::{median, time_alternating, RaySets, CHUNK};
+use crate::code_path::CodePath;
 use crate::parallel::map_chunks;
+use crate::photon_map::query_packet::{RadiusQuery, PACKET};
+use crate::photon_map::{Estimate, Filter, Lookup, Nearest, PhotonMap, Reflectance};
+use crate::reference::build_maps;
 use crate::scene::Scene;
+use crate::settings::Settings;
 use glam::Vec3;
 use serde::Serialize;
-
-/// Median seconds of our SIMD lookups and of the baseline's, timed alternately.
-type Timed = (f64, f64);
 
 /// One density-estimate measurement.
 #[derive(Clone, Debug, Serialize)]
@@ -56,207 +58,227 @@ pub const BENCH_PHOTONS: u32 = 200_000;
 /// Queries per density row.
 const QUERIES: usize = 65_536;
 
+/// The density rows' queries on one photon map, and every way the rows estimate them.
+struct Queries<'a> {
+    map: &'a PhotonMap,
+    /// Camera hits: position and normal.
+    points: Vec<(Vec3, Vec3)>,
+    settings: Settings,
+    /// The default maximum radius, in scene units.
+    r_max: f32,
+    threads: usize,
+}
+
+impl Queries<'_> {
+    /// The lookup at `p` with normal `n`: the `k` nearest within `r` (`k` = 0: every photon
+    /// within `r`).
+    fn lookup(&self, p: Vec3, n: Vec3, k: usize, r: f32) -> Lookup {
+        Lookup {
+            p,
+            k,
+            r_max: r,
+            kernel: self.settings.kernel,
+            filter: Filter { n, flags_mask: 0, plane: 0.0, slack: 0.0 },
+        }
+    }
+
+    /// Lambertian reflectance of albedo ½ about `n`.
+    fn f(n: Vec3) -> Reflectance<'static> {
+        Reflectance::Hemisphere { value: Vec3::splat(0.5 / std::f32::consts::PI), ng: n }
+    }
+
+    /// The default k.
+    fn k(&self) -> usize {
+        self.settings.k as usize
+    }
+
+    /// Sums `estimate(range)` over chunks of the queries on the bench's threads.
+    fn sum_chunks(&self, estimate: impl Fn(std::ops::Range<usize>) -> f32 + Sync) -> f32 {
+        map_chunks(self.points.len(), CHUNK, self.threads, estimate, |_| {}).into_iter().sum()
+    }
+
+    /// Every query's k-nearest estimate by code path `set`.
+    fn knn(&self, set: CodePath) -> Vec<Estimate> {
+        let (k, r) = (self.k(), self.r_max);
+        let chunk = |range: std::ops::Range<usize>| {
+            let mut scratch = Nearest::default();
+            self.points[range]
+                .iter()
+                .map(|&(p, n)| self.map.estimate(set, &self.lookup(p, n, k, r), Self::f(n), &mut scratch))
+                .collect::<Vec<_>>()
+        };
+        map_chunks(self.points.len(), CHUNK, self.threads, chunk, |_| {}).concat()
+    }
+
+    /// The sum of every query's fixed-radius estimate (red channel) by code path `set`.
+    fn radius(&self, set: CodePath, r: f32) -> f32 {
+        self.sum_chunks(|range| {
+            self.points[range]
+                .iter()
+                .map(|&(p, n)| self.map.estimate_radius(set, &self.lookup(p, n, 0, r), Self::f(n)).radiance.x)
+                .sum()
+        })
+    }
+
+    /// [`Self::radius`] with 8 consecutive queries at a time, one walk per packet.
+    fn radius_packets(&self, r: f32) -> f32 {
+        self.sum_chunks(|range| {
+            let mut out = [Estimate::default(); PACKET];
+            self.points[range]
+                .chunks(PACKET)
+                .map(|chunk| {
+                    let packet: Vec<RadiusQuery<'_>> = chunk
+                        .iter()
+                        .map(|&(p, n)| RadiusQuery { lookup: self.lookup(p, n, 0, r), f: Self::f(n), edges: None })
+                        .collect();
+                    self.map.estimate_radius_packet(CodePath::Simd, &packet, false, &mut out);
+                    out[..chunk.len()].iter().map(|e| e.radiance.x).sum::<f32>()
+                })
+                .sum()
+        })
+    }
+
+    /// Photons the tree walk tests per query, in the lookups' order through one scratch as a
+    /// thread runs them (k-nearest searches start from the last one's radius).
+    fn tested(&self, k: usize, r: f32) -> f64 {
+        let mut scratch = Nearest::default();
+        let tested: u64 =
+            self.points.iter().map(|&(p, n)| self.map.photons_tested(&self.lookup(p, n, k, r), &mut scratch)).sum();
+        tested as f64 / self.points.len() as f64
+    }
+
+    /// Photons each fixed-radius estimate sums, per query.
+    fn summed_radius(&self, r: f32) -> f64 {
+        let summed: f64 = self
+            .points
+            .iter()
+            .map(|&(p, n)| {
+                f64::from(self.map.estimate_radius(CodePath::Scalar, &self.lookup(p, n, 0, r), Self::f(n)).count)
+            })
+            .sum();
+        summed / self.points.len() as f64
+    }
+
+    /// The sum of every query's estimate through kiddo (k nearest, or `k` = 0: every photon
+    /// within the radius).
+    #[cfg(feature = "baselines")]
+    fn kiddo(&self, tree: &kiddo_baseline::Tree<'_>, k: usize, r: f32) -> f32 {
+        self.sum_chunks(|range| {
+            let mut found = Vec::new();
+            self.points[range]
+                .iter()
+                .map(|&(p, n)| tree.estimate(&self.lookup(p, n, k, r), Self::f(n), &mut found).radiance.x)
+                .sum()
+        })
+    }
+}
+
 /// SIMD against scalar density estimates on the scene's global photon map (default settings,
 /// [`BENCH_PHOTONS`] photons), at the camera hits (in tile order, as the camera pass asks),
 /// Lambertian reflectance. `knn`: the k = 64 nearest under the default maximum radius;
 /// `radius`: every photon within a fixed radius, the median radius the k-NN lookups found.
 pub(super) fn density(name: &str, scene: &Scene, sets: &RaySets, threads: usize, reps: usize) -> Vec<DensityRow> {
-    use crate::code_path::CodePath;
-    use crate::photon_map::{Filter, Lookup, Nearest, PhotonMap, Reflectance};
-    use crate::reference::build_maps;
-    use crate::settings::Settings;
     if sets.hits.is_empty() {
         return vec![];
     }
     let settings = Settings { photons: BENCH_PHOTONS, threads: threads as u32, ..Default::default() };
     // Default settings with a photon count: always valid, so an error here cannot happen.
     let Ok((maps, _, _)) = build_maps(scene, &settings) else { return vec![] };
-    let map = &maps.global;
-    if map.is_empty() {
+    if maps.global.is_empty() {
         return vec![];
     }
     let step = sets.hits.len().div_ceil(QUERIES).max(1);
-    let queries: Vec<(Vec3, Vec3)> = sets.hits.iter().step_by(step).copied().collect();
-    let r_max = settings.global_radius * scene.diagonal();
-    let lookup = |p: Vec3, n: Vec3, k: usize, r: f32| Lookup {
-        p,
-        k,
-        r_max: r,
-        kernel: settings.kernel,
-        filter: Filter { n, flags_mask: 0, plane: 0.0, slack: 0.0 },
+    let q = Queries {
+        map: &maps.global,
+        points: sets.hits.iter().step_by(step).copied().collect(),
+        r_max: settings.global_radius * scene.diagonal(),
+        settings,
+        threads,
     };
-    let f = |n: Vec3| Reflectance::Hemisphere { value: Vec3::splat(0.5 / std::f32::consts::PI), ng: n };
-    let knn = |set: CodePath| {
-        map_chunks(
-            queries.len(),
-            CHUNK,
-            threads,
-            |r| {
-                let mut scratch = Nearest::default();
-                queries[r]
-                    .iter()
-                    .map(|&(p, n)| map.estimate(set, &lookup(p, n, settings.k as usize, r_max), f(n), &mut scratch))
-                    .collect::<Vec<_>>()
-            },
-            |_| {},
-        )
-        .concat()
-    };
-    let radius_lookup = |set: CodePath, r: f32| {
-        map_chunks(
-            queries.len(),
-            CHUNK,
-            threads,
-            |range| {
-                queries[range]
-                    .iter()
-                    .map(|&(p, n)| map.estimate_radius(set, &lookup(p, n, 0, r), f(n)).radiance.x)
-                    .sum::<f32>()
-            },
-            |_| {},
-        )
-        .into_iter()
-        .sum::<f32>()
-    };
-    // The fixed-radius estimates 8 consecutive queries at a time, one walk per packet.
-    let radius_packets = |r: f32| {
-        use crate::photon_map::query_packet::{RadiusQuery, PACKET};
-        use crate::photon_map::Estimate;
-        map_chunks(
-            queries.len(),
-            CHUNK,
-            threads,
-            |range| {
-                let mut out = [Estimate::default(); PACKET];
-                queries[range]
-                    .chunks(PACKET)
-                    .map(|chunk| {
-                        let packet: Vec<RadiusQuery<'_>> = chunk
-                            .iter()
-                            .map(|&(p, n)| RadiusQuery { lookup: lookup(p, n, 0, r), f: f(n), edges: None })
-                            .collect();
-                        map.estimate_radius_packet(CodePath::Simd, &packet, false, &mut out);
-                        out[..chunk.len()].iter().map(|e| e.radiance.x).sum::<f32>()
-                    })
-                    .sum::<f32>()
-            },
-            |_| {},
-        )
-        .into_iter()
-        .sum::<f32>()
-    };
-    let scalar_knn = knn(CodePath::Scalar);
+    let scalar_knn = q.knn(CodePath::Scalar);
     let radii: Vec<f64> = scalar_knn.iter().map(|e| f64::from(e.radius)).collect();
-    let r_fixed = if radii.is_empty() { r_max } else { median(radii) as f32 };
-    let n = queries.len() as f64;
-    // In the lookups' order through one scratch, as a thread runs them (k-nearest searches start
-    // from the last one's radius).
-    let tested = |k: usize, r: f32| {
-        let mut scratch = Nearest::default();
-        queries.iter().map(|&(p, nrm)| map.photons_tested(&lookup(p, nrm, k, r), &mut scratch)).sum::<u64>() as f64 / n
-    };
-    let k = settings.k as usize;
-    let summed_knn = scalar_knn.iter().map(|e| f64::from(e.count)).sum::<f64>() / n;
-    let summed_radius = queries
-        .iter()
-        .map(|&(p, nrm)| f64::from(map.estimate_radius(CodePath::Scalar, &lookup(p, nrm, 0, r_fixed), f(nrm)).count))
-        .sum::<f64>()
-        / n;
-    // Each lookup through kiddo (k nearest, or `k` = 0: every photon within the radius), summed.
+    let r_fixed = if radii.is_empty() { q.r_max } else { median(radii) as f32 };
     #[cfg(feature = "baselines")]
-    let tree = kiddo_baseline::Tree::new(map);
+    let tree = kiddo_baseline::Tree::new(q.map);
     #[cfg(feature = "baselines")]
-    let through_kiddo = |k: usize, radius: f32| {
-        map_chunks(
-            queries.len(),
-            CHUNK,
-            threads,
-            |r| {
-                let mut found = Vec::new();
-                queries[r]
-                    .iter()
-                    .map(|&(p, nrm)| tree.estimate(&lookup(p, nrm, k, radius), f(nrm), &mut found).radiance.x)
-                    .sum::<f32>()
-            },
-            |_| {},
-        )
-        .into_iter()
-        .sum::<f32>()
-    };
-    #[cfg(feature = "baselines")]
-    let through_kiddo: Option<&dyn Fn(usize, f32) -> f32> = Some(&through_kiddo);
+    let kiddo = Some(|k: usize, r: f32| q.kiddo(&tree, k, r));
     #[cfg(not(feature = "baselines"))]
-    let through_kiddo: Option<&dyn Fn(usize, f32) -> f32> = None;
-    if let Some(kiddo) = through_kiddo {
-        // The baseline computes the same estimates: the same photons within a fixed radius (sums
-        // equal to rounding), nearly the same k nearest (its k are taken before the normal test).
-        let ours_knn: f32 = scalar_knn.iter().map(|e| e.radiance.x).sum();
-        let ours_radius = radius_lookup(CodePath::Simd, r_fixed);
-        let (theirs_knn, theirs_radius) = (kiddo(k, r_max), kiddo(0, r_fixed));
-        let close = |a: f32, b: f32, tol: f32| (a - b).abs() <= tol * a.abs().max(b.abs());
-        assert!(close(ours_knn, theirs_knn, 0.02), "{name}: kiddo k-NN sum {theirs_knn} against {ours_knn}");
-        assert!(
-            close(ours_radius, theirs_radius, 1e-4),
-            "{name}: kiddo radius sum {theirs_radius} against {ours_radius}"
-        );
-    }
-    // Each packet estimate equals its single SIMD estimate to the bit (tests/simd.rs); the sums
-    // differ only in the order they are added (chunk by chunk against packet by packet).
-    let (single, packed) = (radius_lookup(CodePath::Simd, r_fixed), radius_packets(r_fixed));
-    assert!(
-        (single - packed).abs() <= 1e-5 * single.abs().max(packed.abs()),
-        "{name}: packet radius sum {packed} against {single}"
-    );
+    let kiddo: Option<fn(usize, f32) -> f32> = None;
+    check_agreement(name, &q, &scalar_knn, r_fixed, kiddo.as_ref());
     // SIMD, scalar and (when built) kiddo in turn.
     let kiddo_run = |k: usize, r: f32| {
-        if let Some(kiddo) = through_kiddo {
+        if let Some(kiddo) = &kiddo {
             std::hint::black_box(kiddo(k, r));
         }
     };
+    let (k, r_max) = (q.k(), q.r_max);
     let [ts, tk, tkd] = time_alternating(
         reps,
-        [&mut || drop(knn(CodePath::Simd)), &mut || drop(knn(CodePath::Scalar)), &mut || kiddo_run(k, r_max)],
+        [&mut || drop(q.knn(CodePath::Simd)), &mut || drop(q.knn(CodePath::Scalar)), &mut || kiddo_run(k, r_max)],
     );
     let [rs, rk, rkd, rp] = time_alternating(
         reps,
         [
             &mut || {
-                std::hint::black_box(radius_lookup(CodePath::Simd, r_fixed));
+                std::hint::black_box(q.radius(CodePath::Simd, r_fixed));
             },
             &mut || {
-                std::hint::black_box(radius_lookup(CodePath::Scalar, r_fixed));
+                std::hint::black_box(q.radius(CodePath::Scalar, r_fixed));
             },
             &mut || kiddo_run(0, r_fixed),
             &mut || {
-                std::hint::black_box(radius_packets(r_fixed));
+                std::hint::black_box(q.radius_packets(r_fixed));
             },
         ],
     );
-    let kiddo_knn = through_kiddo.map(|_| (ts, tkd));
-    let kiddo_radius = through_kiddo.map(|_| (rs, rkd));
-    let row = |lookup, simd: f64, scalar: f64, tested: f64, summed: f64, kiddo: Option<Timed>, packet: Option<f64>| {
-        DensityRow {
+    let n = q.points.len() as f64;
+    let summed_knn = scalar_knn.iter().map(|e| f64::from(e.count)).sum::<f64>() / n;
+    let row =
+        |lookup, simd: f64, scalar: f64, tested: f64, summed, kiddo: Option<f64>, packet: Option<f64>| DensityRow {
             scene: name.to_string(),
             lookup,
-            count: queries.len(),
-            photons: map.len(),
+            count: q.points.len(),
+            photons: q.map.len(),
             simd_per_s: n / simd,
             scalar_per_s: n / scalar,
             ratio: scalar / simd,
             photons_tested_per_query: tested,
             ns_per_photon_tested: simd / n / tested * 1e9,
             photons_summed_per_query: summed,
-            map_bytes_per_photon: PhotonMap::bytes_per_photon() as f64 + map.tree_bytes_per_photon(),
-            kiddo_per_s: kiddo.map(|(_, k)| n / k),
-            ratio_vs_kiddo: kiddo.map(|(s, k)| k / s),
+            map_bytes_per_photon: PhotonMap::bytes_per_photon() as f64 + q.map.tree_bytes_per_photon(),
+            kiddo_per_s: kiddo.map(|k| n / k),
+            ratio_vs_kiddo: kiddo.map(|k| k / simd),
             packet_per_s: packet.map(|p| n / p),
             packet_ratio: packet.map(|p| scalar / p),
-        }
-    };
+        };
+    let timed_kiddo = |t| kiddo.as_ref().map(|_| t);
     vec![
-        row("knn", ts, tk, tested(k, r_max), summed_knn, kiddo_knn, None),
-        row("radius", rs, rk, tested(0, r_fixed), summed_radius, kiddo_radius, Some(rp)),
+        row("knn", ts, tk, q.tested(k, r_max), summed_knn, timed_kiddo(tkd), None),
+        row("radius", rs, rk, q.tested(0, r_fixed), q.summed_radius(r_fixed), timed_kiddo(rkd), Some(rp)),
     ]
+}
+
+/// Asserts that every timed way computes the same estimates: kiddo (when built) the same
+/// photons within a fixed radius (sums equal to rounding) and nearly the same k nearest (its k
+/// are taken before the normal test); the packets each equal to their single SIMD estimate to
+/// the bit (tests/simd.rs), so their sums differ only in the order they are added.
+fn check_agreement(
+    name: &str,
+    q: &Queries<'_>,
+    scalar_knn: &[Estimate],
+    r_fixed: f32,
+    kiddo: Option<&impl Fn(usize, f32) -> f32>,
+) {
+    let close = |a: f32, b: f32, tol: f32| (a - b).abs() <= tol * a.abs().max(b.abs());
+    let single = q.radius(CodePath::Simd, r_fixed);
+    if let Some(kiddo) = kiddo {
+        let ours_knn: f32 = scalar_knn.iter().map(|e| e.radiance.x).sum();
+        let (theirs_knn, theirs_radius) = (kiddo(q.k(), q.r_max), kiddo(0, r_fixed));
+        assert!(close(ours_knn, theirs_knn, 0.02), "{name}: kiddo k-NN sum {theirs_knn} against {ours_knn}");
+        assert!(close(single, theirs_radius, 1e-4), "{name}: kiddo radius sum {theirs_radius} against {single}");
+    }
+    let packed = q.radius_packets(r_fixed);
+    assert!(close(single, packed, 1e-5), "{name}: packet radius sum {packed} against {single}");
 }
 
 /// kiddo's k-d tree over a photon map's positions: the density benchmark's outside yardstick.

@@ -226,7 +226,7 @@ pub struct Options {
 /// The measurements `options` asks for on one scene.
 ///
 /// # Errors
-/// As [`traversal`].
+/// As [`traversal`](fn@traversal).
 pub fn run_scene(
     name: &str,
     scene: &Scene,

@@ -5,11 +5,14 @@
 
 use super::{median, time_each, time_pair, RaySets, CHUNK};
 use crate::error::Error;
+use crate::geometry::bvh::CwBaseline;
 use crate::geometry::packet::{closest_packets, occluded_packets};
+use crate::geometry::wide_traverse::Visits;
 use crate::geometry::RayQuery;
 use crate::parallel::map_chunks;
 use crate::scene::Scene;
 use serde::Serialize;
+use std::cell::Cell;
 use std::time::Instant;
 
 /// One traversal measurement.
@@ -87,15 +90,201 @@ pub struct TraversalRow {
     pub embree_extra_hits_by_call: Option<[i64; 4]>,
 }
 
-/// A per-ray kernel as a chunk counter for [`count_hits`].
-fn per_ray(hit: impl Fn(&RayQuery) -> bool + Sync) -> impl Fn(&[RayQuery]) -> usize + Sync {
-    move |c| c.iter().filter(|q| hit(q)).count()
-}
-
 /// Rays of `rays` that a kernel reports as hitting anything: `hits(chunk)` counts one chunk;
 /// chunks run on `threads` threads.
 fn count_hits(rays: &[RayQuery], threads: usize, hits: impl Fn(&[RayQuery]) -> usize + Sync) -> usize {
     map_chunks(rays.len(), CHUNK, threads, |r| hits(&rays[r]), |_| {}).into_iter().sum()
+}
+
+/// Lanes of a closest-hit answer that found a triangle.
+fn found<T>(out: &[Option<T>]) -> usize {
+    out.iter().filter(|h| h.is_some()).count()
+}
+
+/// Lanes of an any-hit answer that are blocked.
+fn blocked(out: &[bool]) -> usize {
+    out.iter().filter(|&&b| b).count()
+}
+
+/// Every traversal the rows time, each as "how many rays of this chunk hit" for one query kind
+/// (closest hit, or any hit when `any`).
+struct Kernels<'a> {
+    scene: &'a Scene,
+    cw: &'a CwBaseline,
+    any: bool,
+}
+
+impl Kernels<'_> {
+    /// BVH2 packets of 8 (the renderer's default kernel).
+    fn packet(&self, c: &[RayQuery]) -> usize {
+        let (bvh, tris) = (self.scene.bvh(), self.scene.columns());
+        if self.any {
+            let mut out = vec![false; c.len()];
+            occluded_packets(bvh, tris, c, &mut out);
+            blocked(&out)
+        } else {
+            let mut out = vec![None; c.len()];
+            closest_packets(bvh, tris, c, &mut out);
+            found(&out)
+        }
+    }
+
+    /// obvhs's single-ray traversal of the same BVH2.
+    fn obvhs(&self, c: &[RayQuery]) -> usize {
+        let (bvh, tris) = (self.scene.bvh(), self.scene.columns());
+        let hit = |q: &RayQuery| {
+            if self.any {
+                bvh.occluded_obvhs(tris, q.origin, q.direction, q.t_max)
+            } else {
+                bvh.closest_obvhs(tris, q.origin, q.direction, q.t_max).is_some()
+            }
+        };
+        c.iter().filter(|q| hit(q)).count()
+    }
+
+    /// The packet kernel's scalar twin (the scene's own single-ray queries).
+    fn twin(&self, c: &[RayQuery]) -> usize {
+        let hit = |q: &RayQuery| {
+            if self.any {
+                self.scene.occluded(q.origin, q.direction, q.t_max)
+            } else {
+                self.scene.intersect(q.origin, q.direction, q.t_max).is_some()
+            }
+        };
+        c.iter().filter(|q| hit(q)).count()
+    }
+
+    /// obvhs's CWBVH over the same boxes.
+    fn cwbvh(&self, c: &[RayQuery]) -> usize {
+        let tris = self.scene.columns();
+        let hit = |q: &RayQuery| {
+            if self.any {
+                self.cw.occluded(tris, q.origin, q.direction, q.t_max)
+            } else {
+                self.cw.closest(tris, q.origin, q.direction, q.t_max)
+            }
+        };
+        c.iter().filter(|q| hit(q)).count()
+    }
+
+    /// Single rays through the 8-wide BVH.
+    fn wide(&self, c: &[RayQuery]) -> usize {
+        use crate::geometry::wide_traverse as w;
+        let wide = self.scene.bvh().wide(self.scene.columns());
+        if self.any {
+            let mut out = vec![false; c.len()];
+            w::occluded_rays::<true>(wide, c, &mut out);
+            blocked(&out)
+        } else {
+            let mut out = vec![None; c.len()];
+            w::closest_rays::<true>(wide, c, &mut out);
+            found(&out)
+        }
+    }
+
+    /// Packets of 8 through the 8-wide BVH.
+    fn wide_packet(&self, c: &[RayQuery]) -> usize {
+        use crate::geometry::wide_packet as w;
+        let tris = self.scene.columns();
+        let wide = self.scene.bvh().wide(tris);
+        if self.any {
+            let mut out = vec![false; c.len()];
+            w::occluded_packets8(wide, tris, c, &mut out, w::THIN_LANES);
+            blocked(&out)
+        } else {
+            let mut out = vec![None; c.len()];
+            w::closest_packets8(wide, tris, c, &mut out, w::THIN_LANES);
+            found(&out)
+        }
+    }
+}
+
+/// Embree's trees over the scene: default and robust mode.
+#[cfg(feature = "embree")]
+struct Embree {
+    fast: super::embree::EmbreeScene,
+    robust: super::embree::EmbreeScene,
+}
+
+/// Without `--features embree` there is no Embree to time.
+#[cfg(not(feature = "embree"))]
+struct Embree;
+
+impl Embree {
+    #[cfg(feature = "embree")]
+    fn build(scene: &Scene) -> Result<Self, Error> {
+        use super::embree::EmbreeScene;
+        let build = |robust| EmbreeScene::build(scene.columns(), robust).map_err(|message| Error::Scene { message });
+        Ok(Embree { fast: build(false)?, robust: build(true)? })
+    }
+
+    #[cfg(not(feature = "embree"))]
+    #[allow(clippy::unnecessary_wraps)]
+    fn build(_: &Scene) -> Result<Self, Error> {
+        Ok(Embree)
+    }
+
+    /// Embree's four calls (default single rays and packets, robust single rays and packets),
+    /// each storing its hit count in `hits`; none without the feature.
+    #[cfg(feature = "embree")]
+    fn runs<'a>(
+        &'a self,
+        rays: &'a [RayQuery],
+        threads: usize,
+        any: bool,
+        hits: &'a [Cell<usize>],
+    ) -> Vec<Box<dyn FnMut() + 'a>> {
+        vec![
+            Box::new(move || hits[0].set(count_hits(rays, threads, |c| self.fast.count_single(c, any)))),
+            Box::new(move || hits[1].set(count_hits(rays, threads, |c| self.fast.count_packets(c, any)))),
+            Box::new(move || hits[2].set(count_hits(rays, threads, |c| self.robust.count_single(c, any)))),
+            Box::new(move || hits[3].set(count_hits(rays, threads, |c| self.robust.count_packets(c, any)))),
+        ]
+    }
+
+    #[cfg(not(feature = "embree"))]
+    #[allow(clippy::unused_self)]
+    fn runs<'a>(&'a self, _: &'a [RayQuery], _: usize, _: bool, _: &'a [Cell<usize>]) -> Vec<Box<dyn FnMut() + 'a>> {
+        vec![]
+    }
+}
+
+/// Median seconds and hit counts of one ray set and query.
+struct Timings {
+    /// packet, obvhs, 8-wide single, 8-wide packet, twin, CWBVH.
+    seconds: [f64; 6],
+    /// Rays each of those reports hit.
+    hits: [usize; 6],
+    /// Embree's four calls' seconds and hit counts, when built with the feature.
+    embree: Option<([f64; 4], [usize; 4])>,
+}
+
+/// Times every kernel on `rays`: ours, obvhs and (with the feature) Embree's four calls in the
+/// same alternating rounds; then the twin against the CWBVH, which are slower, as a pair.
+fn time_kernels(kernels: &Kernels<'_>, embree: &Embree, rays: &[RayQuery], threads: usize, reps: usize) -> Timings {
+    let hits: [Cell<usize>; 10] = Default::default();
+    let mut runs: Vec<Box<dyn FnMut() + '_>> = vec![
+        Box::new(|| hits[0].set(count_hits(rays, threads, |c| kernels.packet(c)))),
+        Box::new(|| hits[1].set(count_hits(rays, threads, |c| kernels.obvhs(c)))),
+        Box::new(|| hits[2].set(count_hits(rays, threads, |c| kernels.wide(c)))),
+        Box::new(|| hits[3].set(count_hits(rays, threads, |c| kernels.wide_packet(c)))),
+    ];
+    runs.extend(embree.runs(rays, threads, kernels.any, &hits[6..]));
+    let mut refs: Vec<&mut dyn FnMut()> = runs.iter_mut().map(|r| &mut **r as &mut dyn FnMut()).collect();
+    let t = time_each(reps, &mut refs);
+    drop(refs);
+    drop(runs);
+    let (tt, tc) = time_pair(
+        reps,
+        || hits[4].set(count_hits(rays, threads, |c| kernels.twin(c))),
+        || hits[5].set(count_hits(rays, threads, |c| kernels.cwbvh(c))),
+    );
+    let hits = hits.map(Cell::into_inner);
+    Timings {
+        seconds: [t[0], t[1], t[2], t[3], tt, tc],
+        hits: std::array::from_fn(|i| hits[i]),
+        embree: (t.len() == 8).then(|| ([t[4], t[5], t[6], t[7]], [hits[6], hits[7], hits[8], hits[9]])),
+    }
 }
 
 /// Packet against obvhs single-ray traversal on every set and query. Also checks that both
@@ -111,14 +300,8 @@ pub fn traversal(
     threads: usize,
     reps: usize,
 ) -> Result<Vec<TraversalRow>, Error> {
-    let cw = crate::geometry::bvh::CwBaseline::build(scene.columns());
-    #[cfg(feature = "embree")]
-    let embree_scene =
-        super::embree::EmbreeScene::build(scene.columns(), false).map_err(|message| Error::Scene { message })?;
-    #[cfg(feature = "embree")]
-    let embree_robust =
-        super::embree::EmbreeScene::build(scene.columns(), true).map_err(|message| Error::Scene { message })?;
-    let (bvh, tris) = (scene.bvh(), scene.columns());
+    let cw = CwBaseline::build(scene.columns());
+    let embree = Embree::build(scene)?;
     let mut rows = vec![];
     for (label, rays) in [("camera", &sets.camera), ("shadow", &sets.shadow), ("diffuse", &sets.diffuse)] {
         if rays.is_empty() {
@@ -126,157 +309,72 @@ pub fn traversal(
         }
         for any in [false, true] {
             let query = if any { "any" } else { "closest" };
-            // Each kernel as "how many rays of this chunk hit".
-            let packet = |c: &[RayQuery]| {
-                if any {
-                    let mut out = vec![false; c.len()];
-                    occluded_packets(bvh, tris, c, &mut out);
-                    out.iter().filter(|&&b| b).count()
-                } else {
-                    let mut out = vec![None; c.len()];
-                    closest_packets(bvh, tris, c, &mut out);
-                    out.iter().filter(|h| h.is_some()).count()
-                }
-            };
-            let obvhs = per_ray(|q: &RayQuery| {
-                if any {
-                    bvh.occluded_obvhs(tris, q.origin, q.direction, q.t_max)
-                } else {
-                    bvh.closest_obvhs(tris, q.origin, q.direction, q.t_max).is_some()
-                }
-            });
-            let twin = per_ray(|q: &RayQuery| {
-                if any {
-                    scene.occluded(q.origin, q.direction, q.t_max)
-                } else {
-                    scene.intersect(q.origin, q.direction, q.t_max).is_some()
-                }
-            });
-            let cwbvh = per_ray(|q: &RayQuery| {
-                if any {
-                    cw.occluded(tris, q.origin, q.direction, q.t_max)
-                } else {
-                    cw.closest(tris, q.origin, q.direction, q.t_max)
-                }
-            });
-            let wide = |c: &[RayQuery]| {
-                use crate::geometry::wide_traverse as w;
-                if any {
-                    let mut out = vec![false; c.len()];
-                    w::occluded_rays::<true>(bvh.wide(tris), c, &mut out);
-                    out.iter().filter(|&&b| b).count()
-                } else {
-                    let mut out = vec![None; c.len()];
-                    w::closest_rays::<true>(bvh.wide(tris), c, &mut out);
-                    out.iter().filter(|h| h.is_some()).count()
-                }
-            };
-            let (mut hp, mut hs, mut ht, mut hc, mut hw) = (0, 0, 0, 0, 0);
-            // One alternating round: ours, obvhs, and (with the feature) Embree's two.
-            let mut run_packet = || hp = count_hits(rays, threads, packet);
-            let mut run_obvhs = || hs = count_hits(rays, threads, &obvhs);
-            let mut run_wide = || hw = count_hits(rays, threads, wide);
-            let wide_packet = |c: &[RayQuery]| {
-                use crate::geometry::wide_packet as w;
-                if any {
-                    let mut out = vec![false; c.len()];
-                    w::occluded_packets8(bvh.wide(tris), tris, c, &mut out, w::THIN_LANES);
-                    out.iter().filter(|&&b| b).count()
-                } else {
-                    let mut out = vec![None; c.len()];
-                    w::closest_packets8(bvh.wide(tris), tris, c, &mut out, w::THIN_LANES);
-                    out.iter().filter(|h| h.is_some()).count()
-                }
-            };
-            let mut hwp = 0;
-            let mut run_wide_packet = || hwp = count_hits(rays, threads, wide_packet);
-            let mut kernels: Vec<&mut dyn FnMut()> =
-                vec![&mut run_packet, &mut run_obvhs, &mut run_wide, &mut run_wide_packet];
-            #[cfg(feature = "embree")]
-            let (mut h1, mut h8, mut hr1, mut hr8) = (0, 0, 0, 0);
-            #[cfg(feature = "embree")]
-            let mut run_embree1 = || h1 = count_hits(rays, threads, |c| embree_scene.count_single(c, any));
-            #[cfg(feature = "embree")]
-            let mut run_embree8 = || h8 = count_hits(rays, threads, |c| embree_scene.count_packets(c, any));
-            #[cfg(feature = "embree")]
-            let mut run_robust1 = || hr1 = count_hits(rays, threads, |c| embree_robust.count_single(c, any));
-            #[cfg(feature = "embree")]
-            let mut run_robust8 = || hr8 = count_hits(rays, threads, |c| embree_robust.count_packets(c, any));
-            #[cfg(feature = "embree")]
-            kernels.extend([
-                &mut run_embree1 as &mut dyn FnMut(),
-                &mut run_embree8,
-                &mut run_robust1,
-                &mut run_robust8,
-            ]);
-            let t = time_each(reps, &mut kernels);
-            drop(kernels);
-            let (tp, ts, tw, twp) = (t[0], t[1], t[2], t[3]);
-            #[cfg(feature = "embree")]
-            let embree = {
-                let extra = [h1, h8, hr1, hr8].map(|h| h as i64 - hp as i64);
-                Some((t[4], t[5], extra, t[6], t[7]))
-            };
-            #[cfg(not(feature = "embree"))]
-            let embree: Option<(f64, f64, [i64; 4], f64, f64)> = None;
+            let timings = time_kernels(&Kernels { scene, cw: &cw, any }, &embree, rays, threads, reps);
+            let [hp, hs, hw, hwp, ht, _] = timings.hits;
             assert_eq!(hp, hs, "{name} {label} {query}: packet and single-ray hit counts differ");
             assert_eq!(hw, hs, "{name} {label} {query}: 8-wide and obvhs hit counts differ");
             assert_eq!(hwp, hs, "{name} {label} {query}: 8-wide packets and obvhs hit counts differ");
-            let (tt, tc) =
-                time_pair(reps, || ht = count_hits(rays, threads, &twin), || hc = count_hits(rays, threads, &cwbvh));
             assert_eq!(ht, hs, "{name} {label} {query}: scalar twin and obvhs hit counts differ");
             // Not asserted: obvhs's CWBVH traversal loses a few hits (recorded, see BENCHMARKS.md).
-            let visits = count_visits(bvh.wide(tris), rays, any);
-            let m = rays.len() as f64 * 1e-6;
-            // What the renderer's trial would keep: the fastest candidate, ties to the earlier
-            // (camera rays never try single rays).
-            let mut candidates = vec![("packets", tp)];
-            if label != "camera" {
-                candidates.push(("single", tw));
-            }
-            candidates.push(("wide_packets", twp));
-            let (renderer_kernel, t_renderer) =
-                candidates.into_iter().reduce(|best, c| if c.1 < best.1 { c } else { best }).expect("packets");
-            rows.push(TraversalRow {
-                renderer_kernel,
-                renderer_mrays: m / t_renderer,
-                renderer_vs_embree: embree.map(|e| e.0.min(e.1) / t_renderer),
-                nodes_per_ray: visits.nodes as f64 / rays.len() as f64,
-                triangles_per_ray: visits.triangles as f64 / rays.len() as f64,
-                scalar_per_ray: visits.scalar as f64 / rays.len() as f64,
-                scene: name.to_string(),
-                rays: label,
-                query,
-                count: rays.len(),
-                packet_mrays: m / tp,
-                single_mrays: m / ts,
-                ratio: ts / tp,
-                twin_mrays: m / tt,
-                cwbvh_mrays: m / tc,
-                wide_mrays: m / tw,
-                wide_packet_mrays: m / twp,
-                cwbvh_lost_hits: hs as i64 - hc as i64,
-                embree1_mrays: embree.map(|e| m / e.0),
-                embree8_mrays: embree.map(|e| m / e.1),
-                ratio_vs_embree: embree.map(|e| e.0.min(e.1) / tp),
-                embree_extra_hits: embree.map(|e| e.2[0]),
-                embree_extra_hits_by_call: embree.map(|e| e.2),
-                embree_robust1_mrays: embree.map(|e| m / e.3),
-                embree_robust8_mrays: embree.map(|e| m / e.4),
-                renderer_vs_embree_robust: embree.map(|e| e.3.min(e.4) / t_renderer),
-            });
+            let visits = count_visits(scene.bvh().wide(scene.columns()), rays, any);
+            rows.push(TraversalRow::new(name, label, query, rays.len(), &timings, &visits));
         }
     }
     Ok(rows)
 }
 
+impl TraversalRow {
+    /// The row of one ray set (`label`, `count` rays) and query from its timings and the 8-wide
+    /// traversal's work.
+    fn new(name: &str, label: &'static str, query: &'static str, count: usize, t: &Timings, visits: &Visits) -> Self {
+        let [tp, ts, tw, twp, tt, tc] = t.seconds;
+        let hs = t.hits[1];
+        let m = count as f64 * 1e-6;
+        let per_ray = |n: u64| n as f64 / count as f64;
+        // What the renderer's trial would keep: the fastest candidate, ties to the earlier
+        // (camera rays never try single rays).
+        let mut candidates = vec![("packets", tp)];
+        if label != "camera" {
+            candidates.push(("single", tw));
+        }
+        candidates.push(("wide_packets", twp));
+        let (renderer_kernel, t_renderer) =
+            candidates.into_iter().reduce(|best, c| if c.1 < best.1 { c } else { best }).expect("packets");
+        let embree = t.embree.map(|(e, hits)| (e, hits.map(|h| h as i64 - t.hits[0] as i64)));
+        TraversalRow {
+            scene: name.to_string(),
+            rays: label,
+            query,
+            count,
+            packet_mrays: m / tp,
+            single_mrays: m / ts,
+            ratio: ts / tp,
+            twin_mrays: m / tt,
+            cwbvh_mrays: m / tc,
+            wide_mrays: m / tw,
+            wide_packet_mrays: m / twp,
+            nodes_per_ray: per_ray(visits.nodes),
+            triangles_per_ray: per_ray(visits.triangles),
+            scalar_per_ray: per_ray(visits.scalar),
+            cwbvh_lost_hits: hs as i64 - t.hits[5] as i64,
+            embree1_mrays: embree.map(|(e, _)| m / e[0]),
+            embree8_mrays: embree.map(|(e, _)| m / e[1]),
+            ratio_vs_embree: embree.map(|(e, _)| e[0].min(e[1]) / tp),
+            renderer_kernel,
+            renderer_mrays: m / t_renderer,
+            renderer_vs_embree: embree.map(|(e, _)| e[0].min(e[1]) / t_renderer),
+            embree_extra_hits: embree.map(|(_, x)| x[0]),
+            embree_robust1_mrays: embree.map(|(e, _)| m / e[2]),
+            embree_robust8_mrays: embree.map(|(e, _)| m / e[3]),
+            renderer_vs_embree_robust: embree.map(|(e, _)| e[2].min(e[3]) / t_renderer),
+            embree_extra_hits_by_call: embree.map(|(_, x)| x),
+        }
+    }
+}
+
 /// The 8-wide traversal's work over `rays` (closest hit, or any hit when `any`).
-fn count_visits(
-    bvh: &crate::geometry::wide::Bvh8,
-    rays: &[RayQuery],
-    any: bool,
-) -> crate::geometry::wide_traverse::Visits {
-    use crate::geometry::wide_traverse::{closest_counted, occluded_counted, Visits};
+fn count_visits(bvh: &crate::geometry::wide::Bvh8, rays: &[RayQuery], any: bool) -> Visits {
+    use crate::geometry::wide_traverse::{closest_counted, occluded_counted};
     let mut stack = crate::geometry::traverse::Stack::new();
     let mut v = Visits::default();
     for r in rays {

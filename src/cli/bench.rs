@@ -44,7 +44,7 @@ pub struct BenchArgs {
     /// Measure only `traversal` or only `density` [both].
     #[arg(long, value_parser = ["traversal", "density"])]
     pub only: Option<String>,
-    /// Sphere rings of `generated:sphere` (2·rings·2·rings triangles) [512].
+    /// Sphere rings of `generated:sphere` (2·rings × 2·rings quads, less the poles: 4·rings² − 4·rings triangles) [512].
     #[arg(long, default_value_t = 512)]
     pub rings: u32,
 }

@@ -13,9 +13,10 @@ use std::f32::consts::PI;
 pub const SPHERE_NAME: &str = "generated:sphere";
 
 /// A sphere of radius 0.3 at the centre of a closed unit box, its radius displaced by ±4 % in a
-/// 12 × 12 bump pattern, tessellated into `2·rings·segments` triangles (rings × segments quads,
-/// the pole quads split as well so all have area), lit by a square area light under the ceiling.
-/// `rings = 512, segments = 1024` gives 1 048 576 sphere triangles.
+/// 12 × 12 bump pattern, tessellated into `2·rings·segments − 2·segments` triangles
+/// (`super::shapes::sphere_grid`: rings × segments quads, the pole rows one triangle each), lit
+/// by a square area light under the ceiling. `rings = 512, segments = 1024` gives 1 046 528
+/// sphere triangles.
 pub fn displaced_sphere(rings: u32, segments: u32) -> Result<LoadedScene> {
     let (rings, segments) = (rings.max(2), segments.max(3));
     let mut sphere = MeshInput { source: SPHERE_NAME.to_string(), ..Default::default() };
@@ -29,20 +30,8 @@ pub fn displaced_sphere(rings: u32, segments: u32) -> Result<LoadedScene> {
             sphere.positions.push(centre + dir * r);
         }
     }
-    let row = segments + 1;
-    for i in 0..rings {
-        for j in 0..segments {
-            let (a, b) = (i * row + j, i * row + j + 1);
-            let (c, d) = (a + row, b + row);
-            // Pole rows have one collapsed edge; the triangle that collapses is skipped.
-            if i != 0 {
-                sphere.triangles.push([a, b, d]);
-            }
-            if i != rings - 1 {
-                sphere.triangles.push([a, d, c]);
-            }
-        }
-    }
+    // y up mirrors the grid's z-up parametrisation: each triangle reversed faces outward.
+    sphere.triangles = super::shapes::sphere_grid(rings, segments).into_iter().map(|[a, b, c]| [a, c, b]).collect();
     sphere.material = vec![0; sphere.triangles.len()];
 
     // The box, faces pointing inward, and the light just under the ceiling.

@@ -93,22 +93,33 @@ fn sphere(rings: u32, segments: u32) -> MeshInput {
             mesh.texcoords.push(Vec2::new(j as f32 / segments as f32, 1.0 - i as f32 / rings as f32));
         }
     }
+    mesh.triangles = sphere_grid(rings, segments);
+    mesh
+}
+
+/// The triangles of a sphere's `(rings + 1) × (segments + 1)` vertex grid (row `i` at
+/// θ = π·i/rings from the pole, column `j` at φ = 2π·j/segments): each quad split along the
+/// diagonal from (i, j + 1) to (i + 1, j), the pole rows keeping only the triangle with area, so
+/// `2·rings·segments − 2·segments` triangles. Counter-clockwise seen from outside when the
+/// directions are (sin θ cos φ, sin θ sin φ, cos θ); reversed for a mirrored parametrisation.
+pub(crate) fn sphere_grid(rings: u32, segments: u32) -> Vec<[u32; 3]> {
+    let mut triangles = Vec::with_capacity(2 * (rings as usize) * (segments as usize));
     let row = segments + 1;
     for i in 0..rings {
         for j in 0..segments {
             let (a, b) = (i * row + j, i * row + j + 1);
             let (c, d) = (a + row, b + row);
-            // Seen from outside, going down from the +z pole with φ increasing is counter-clockwise
-            // for (a, c, d); the pole rows keep only the triangle with area.
+            // Going down from the +z pole with φ increasing is counter-clockwise seen from
+            // outside for (a, c, d).
             if i != 0 {
-                mesh.triangles.push([a, c, b]);
+                triangles.push([a, c, b]);
             }
             if i + 1 != rings {
-                mesh.triangles.push([b, c, d]);
+                triangles.push([b, c, d]);
             }
         }
     }
-    mesh
+    triangles
 }
 
 #[cfg(test)]

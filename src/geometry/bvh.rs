@@ -42,7 +42,7 @@ pub struct Bvh {
 }
 
 impl Bvh {
-    /// Builds over the triangles (p0[i], p1[i], p2[i]). Returns the BVH and the permutation:
+    /// Builds over the triangles (`p0[i]`, `p1[i]`, `p2[i]`). Returns the BVH and the permutation:
     /// `order[k]` is the input index of the triangle the BVH calls `k`; callers reorder their
     /// per-triangle columns by it so that leaf indices address them directly.
     #[must_use]

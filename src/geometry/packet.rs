@@ -2,7 +2,7 @@
 //! branches. A node's two child boxes are tested against all 8 rays at once; a child is visited
 //! while any lane enters it before its current closest hit. Leaves test each triangle against
 //! all 8 rays with an 8-wide form of the watertight test that is bit-identical to the scalar one
-//! (see [`intersect8`]). Any-hit traversal tests leaf children as soon as their parent is
+//! (see `intersect8`). Any-hit traversal tests leaf children as soon as their parent is
 //! reached, before entering an inner sibling: a leaf is cheap and usually ends the lanes that
 //! leave a finely tessellated surface (3–4× faster on the 1 M-triangle sphere's bounce rays);
 //! closest-hit traversal does not, since a far leaf is usually pruned by a nearer hit. When a
@@ -117,7 +117,7 @@ impl Packet {
 
     /// Entry distances into `node`'s box per lane, NaN where a lane misses or enters beyond its
     /// `t_max` (so that every ordered comparison with it is false, even against t_max = ∞): the
-    /// 8-wide form of [`box_entry`], the same operations in the same order.
+    /// 8-wide form of [`box_entry`](super::slab::box_entry), the same operations in the same order.
     #[inline(always)]
     fn entry(&self, node: &Bvh2Node, t_max: f32x8) -> f32x8 {
         let b = &node.aabb;

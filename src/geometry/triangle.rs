@@ -5,7 +5,7 @@
 //! are then 2-D cross products that agree in sign along shared edges, so a ray through an edge
 //! or vertex hits at least one of the triangles that share it. Edge functions that round to
 //! exactly zero are recomputed in f64. Where the f32 bound cannot prove t > 0, or t's products
-//! underflow, t's sign is decided in f64 with a bound taken term by term ([`t_f64`]).
+//! underflow, t's sign is decided in f64 with a bound taken term by term (`t_f64`).
 
 use super::offset::gamma;
 use glam::Vec3;
@@ -113,7 +113,7 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
 /// Below this, the product of the determinant (for a ray inside the edges, one to three times
 /// the largest edge function) and the largest scaled z — about the largest term of t's
 /// numerator — comes so near f32's subnormal range that t (or its error bound) underflows: such
-/// a test is decided in f64 ([`F32Test::Tiny`]). Reached only by triangles
+/// a test is decided in f64 (`F32Test::Tiny`). Reached only by triangles
 /// and origins ~10⁻¹³ apart or less, far below any scene's features; the SIMD tests hand such
 /// lanes to the scalar test.
 pub const TINY_T_TERM: f32 = 7.888_609e-31;

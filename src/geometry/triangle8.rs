@@ -3,7 +3,7 @@
 //! eight triangles (a [`TriBlock`] of the 8-wide BVH's leaves, [`super::wide_traverse`]). Reads
 //! sheared vertices or blocks; writes per-lane hits, t and barycentrics.
 //!
-//! Both run [`watertight8`]: the scalar test's operations in the same order (no fused
+//! Both run `watertight8`: the scalar test's operations in the same order (no fused
 //! multiply-adds on either side), so every lane's decision, t and barycentrics are
 //! bit-identical to [`super::triangle::intersect_triangle`]'s (its scalar twin). The scalar test
 //! recomputes in f64 edge functions that round to exactly zero and the sign of a t that f32
@@ -180,7 +180,7 @@ impl ShearedRay {
 }
 
 /// One ray against the eight lanes of `block` within (0, `t_max`): (hit lanes, lanes for the
-/// scalar test, t, b0, b1, b2), as [`watertight8`].
+/// scalar test, t, b0, b1, b2), as `watertight8`.
 #[inline(always)]
 #[must_use]
 pub fn intersect_block(r: &ShearedRay, block: &TriBlock, t_max: f32) -> (u32, u32, f32x8, [f32x8; 3]) {

@@ -60,7 +60,7 @@ pub mod flags {
     /// the global map stands for indirect light only.
     pub const OWN_TERMS: u8 = DIRECT | CAUSTIC;
     /// Stored on a flat-shaded triangle: an estimate at it (an irradiance point precomputed
-    /// there) sets photons off its plane aside ([`super::Filter::flat`]). Never masked.
+    /// there) sets photons off its plane aside ([`super::Filter::plane`]). Never masked.
     pub const FLAT: u8 = 4;
 }
 

@@ -11,7 +11,7 @@
 //! ordering ~130 candidates (BENCHMARKS.md, "k-nearest lookups by counting").
 //!
 //! A search starts from a guess: lookups come in coherent order, so the k nearest mostly lie
-//! within a margin of the last search's k-th ([`Hint`]); a miss walks again under the maximum
+//! within a margin of the last search's k-th (`Hint`); a miss walks again under the maximum
 //! radius.
 //!
 //! The order is by (distance², index), so the k nearest are one set whatever order the walk met
@@ -25,7 +25,7 @@ use wide::f32x8;
 
 /// Candidates of one k-nearest walk, a block at a time: reusable across lookups (hold one per
 /// thread and pass it to each lookup, in a coherent order where there is one: each search starts
-/// from the last one's radius, see [`Hint`]).
+/// from the last one's radius, see `Hint`).
 #[derive(Clone, Debug, Default)]
 pub struct Nearest {
     /// Per block, the squared distance of each lane that holds a candidate; +∞ elsewhere.

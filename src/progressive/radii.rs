@@ -75,7 +75,7 @@ pub fn pilot_seed(seed: u64) -> u64 {
 }
 
 /// The first pass's radii from a pilot photon pass (traced with [`pilot_seed`]): per map, the
-/// density-weighed median k-nearest radius where the camera reads it ([`camera_knn_radii`]),
+/// density-weighed median k-nearest radius where the camera reads it (`camera_knn_radii`),
 /// else the median over the pilot's photons ([`median_knn_radius`]), else the maximum radius (a
 /// map empty or too sparse); with `per_pixel_radii`, each pixel's own as well ([`pixel_radii`]).
 /// `job` is the render's, whose pass (the user's seed, no radii) is the first.

@@ -144,7 +144,7 @@ impl From<crate::photon_map::Estimate> for Estimated {
 
 /// Final gather: `kd/N · Σ L(x, ωi)` over the N gather rays, L read from the photon maps at
 /// each ray's first non-specular hit (following mirrors and glass), or by the secondary gather
-/// where that hit is near ([`gather_hit`]); and the emission the rays hit straight away,
+/// where that hit is near (`gather_hit`); and the emission the rays hit straight away,
 /// weighted against light sampling by `mis`.
 #[allow(clippy::too_many_arguments)]
 pub fn final_gather(

@@ -59,7 +59,7 @@ pub struct SurfacePoint {
     /// Texture coordinates ((0, 0) in a scene without textures).
     pub uv: Vec2,
     /// The triangle is flat-shaded (its vertex normals are its geometric normal): its photons
-    /// lie in its plane ([`crate::photon_map::Filter::flat`]).
+    /// lie in its plane ([`crate::photon_map::Filter::plane`]).
     pub flat: bool,
 }
 

@@ -46,7 +46,7 @@ pub struct FixedLookup<'m> {
     pub value: Vec3,
     /// The triangle the point lies on, whose region's open edges cut the disk.
     pub tri: u32,
-    /// Whether the estimate is boundary-corrected ([`Settings::boundary_correction`]).
+    /// Whether the estimate is boundary-corrected ([`crate::settings::Settings::boundary_correction`]).
     pub corrected: bool,
 }
 
@@ -261,7 +261,7 @@ pub fn off_plane_visibility<'s>(scene: &'s Scene, q: Vec3, filter: &Filter) -> i
 }
 
 /// Whether a photon (position, normal) is visible from the point `q` (normal `n`, on the side
-/// the estimate looks from), for [`Settings::visibility`]: the segment between them, both lifted
+/// the estimate looks from), for [`crate::settings::Settings::visibility`]: the segment between them, both lifted
 /// off their surfaces by 10⁻³ of the search radius `r` (far below any wall worth stopping light)
 /// or by the points' rounding ([`position_slack`]: far from the origin 10⁻³ of a radius can be
 /// less than an ulp of a coordinate, and the segment would start inside its own surface),

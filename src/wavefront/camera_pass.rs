@@ -44,7 +44,7 @@ const TILES_PER_WORKER: usize = 8;
 
 /// The tile size for `samples` samples on `threads` workers: [`TILE`], or less where the workers
 /// would hold more than [`IN_FLIGHT`] samples together, or where it would leave fewer than
-/// [`TILES_PER_WORKER`] tiles per worker (a progressive pass of one sample per pixel at 320²
+/// `TILES_PER_WORKER` tiles per worker (a progressive pass of one sample per pixel at 320²
 /// makes 25 tiles of 4 096: on 16 workers the second round would keep 9 busy), but not below
 /// [`MIN_TILE`]. Only the speed and the memory depend on it, never the image.
 #[must_use]

@@ -12,8 +12,8 @@
 //! seed the two agree per pixel up to the order of floating-point additions.
 //!
 //! Parallelism is outside the schedules: each worker takes a unit of work — a *piece* of a
-//! photon wave ([`photon_pass`]: up to 2 048 consecutive paths) or a *tile* of the image
-//! ([`camera_pass`]: whole pixels, its samples run as one or more *waves* of at most a tile's
+//! photon wave ([`photon_pass`](mod@photon_pass): up to 2 048 consecutive paths) or a *tile* of the image
+//! ([`camera_pass`](mod@camera_pass): whole pixels, its samples run as one or more *waves* of at most a tile's
 //! samples in flight) — through the whole schedule on its own world, and every system is a plain
 //! loop over its queue on that worker's thread, pushing into the next queue in lane order. The
 //! image is bit-identical at any thread count.
@@ -23,7 +23,7 @@
 //! refraction.
 //!
 //! Files: [`schedule`] (the recipe), [`resources`] (what the systems share), [`queues`] (the SoA
-//! queues), [`photon_pass`] (waves of photon paths until the maps are full), [`camera_pass`]
+//! queues), [`photon_pass`](mod@photon_pass) (waves of photon paths until the maps are full), [`camera_pass`](mod@camera_pass)
 //! (tiles of samples, each through the camera schedule on one worker's own world), and one file
 //! per stage.
 

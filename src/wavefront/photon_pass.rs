@@ -35,7 +35,7 @@ pub const MIN_PIECE: usize = 256;
 const PIECES_PER_WORKER: usize = 4;
 
 /// The piece size for a wave of `paths` paths on `threads` workers: [`PIECE`], or less where
-/// that would leave fewer than [`PIECES_PER_WORKER`] pieces per worker (a progressive pass's one
+/// that would leave fewer than `PIECES_PER_WORKER` pieces per worker (a progressive pass's one
 /// batch is 8 pieces of 2 048: half of 16 workers would wait), but not below [`MIN_PIECE`].
 /// Only the speed depends on it, never the photons.
 #[must_use]

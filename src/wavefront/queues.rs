@@ -1,6 +1,6 @@
 //! Structure-of-arrays queues: every ray or photon in flight is one lane, every field one column.
 //! Kernels see plain slices; a bounce reads one queue and writes the next. Each queue is
-//! declared once, with [`soa_queue!`], from the fields of its work item (in the spirit of
+//! declared once, with `soa_queue!`, from the fields of its work item (in the spirit of
 //! pbrt-v4's `.soa` files), so every queue has the same `push`, `append`, `reserve`, `clear`
 //! and `len`.
 //!

@@ -7,7 +7,7 @@ use super::{classify, deposit, emit, gather, intersect, shade, Stage};
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{ExecutorKind, ScheduleLabel};
 
-/// One piece of a photon wave (consecutive paths, [`super::photon_pass`]): emit, then the
+/// One piece of a photon wave (consecutive paths, [`super::photon_pass`](mod@super::photon_pass)): emit, then the
 /// bounce loop.
 #[derive(ScheduleLabel, Clone, Debug, PartialEq, Eq, Hash)]
 pub struct PhotonPass;

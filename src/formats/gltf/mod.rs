@@ -1,6 +1,6 @@
 //! glTF 2.0 models (`.gltf` with its buffers and images, or `.glb`), through the `gltf` crate's
 //! document model: the default scene's node hierarchy with its transforms, triangle meshes,
-//! perspective cameras, `KHR_lights_punctual` lights and materials ([`materials`]).
+//! perspective cameras, `KHR_lights_punctual` lights and materials (`materials`).
 //!
 //! Reads the file, its buffers (the GLB's binary chunk, files beside it, or `data:` URIs) and
 //! images; writes one [`MeshInput`] in world space, materials into the [`MaterialTable`], and the

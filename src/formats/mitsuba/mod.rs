@@ -1,7 +1,7 @@
 //! Mitsuba scene files (`.xml`, versions 0.5 to 3.x, the subset research scenes use), read with
 //! `roxmltree`: `<default>` and `$param` substitution, `<ref>` and ids, the `perspective`
 //! (or `thinlens`) sensor and its film's size, shapes (`obj`, `ply`, `rectangle`, `disk`,
-//! `cube`, `sphere`) with their `to_world` transforms, BSDFs ([`bsdfs`]), area emitters on
+//! `cube`, `sphere`) with their `to_world` transforms, BSDFs (`bsdfs`), area emitters on
 //! shapes, and `point`, `spot`, `directional`, `envmap` and `constant` emitters.
 //!
 //! Writes the meshes, materials (into the [`MaterialTable`]), lights, environment, camera and
@@ -10,7 +10,7 @@
 //! metal without data, a shape file that cannot be read) is an error naming file and line.
 //!
 //! Mitsuba's camera looks down its local +z with +y up; its lat-long maps put u = atan2(x, −z)/2π
-//! (photonwave's: atan2(z, x)/2π, a quarter turn apart), which [`Ctx::envmap`] turns into
+//! (photonwave's: atan2(z, x)/2π, a quarter turn apart), which `Ctx::envmap` turns into
 //! photonwave's convention.
 
 mod bsdfs;

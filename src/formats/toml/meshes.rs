@@ -4,7 +4,7 @@
 //! `[materials]` (`material = "NAME"`, replacing whatever the mesh file says).
 //!
 //! Reads the entry; writes [`MeshInput`]s into the scene's list and materials into its
-//! [`MaterialTable`], and the lights and cameras a glTF file brings into [`Brought`].
+//! [`MaterialTable`], and the lights and cameras a glTF file brings into `Brought`.
 
 use super::materials::finite3;
 use crate::error::{Error, Result};
