@@ -33,10 +33,7 @@ fn materials() -> Vec<(String, Bsdf)> {
     for r in [0.3f32, 0.6, 1.0] {
         v.push((format!("conductor r={r}"), Bsdf::RoughConductor { ks: Vec3::ONE, alpha: alpha_of(r) }));
         v.push((format!("dielectric r={r}"), Bsdf::RoughDielectric { ior: 1.5, alpha: alpha_of(r) }));
-        v.push((
-            format!("plastic r={r}"),
-            Bsdf::RoughPlastic { kd: Vec3::new(0.8, 0.5, 0.2), ior: 1.5, alpha: alpha_of(r) },
-        ));
+        v.push((format!("plastic r={r}"), Bsdf::rough_plastic(Vec3::new(0.8, 0.5, 0.2), 1.5, alpha_of(r))));
     }
     v
 }
@@ -149,7 +146,7 @@ fn white_furnace_never_gains_energy_and_matches_quadrature() {
         for (kind, b) in [
             ("conductor", Bsdf::RoughConductor { ks: Vec3::ONE, alpha: alpha_of(r) }),
             ("dielectric", Bsdf::RoughDielectric { ior: 1.5, alpha: alpha_of(r) }),
-            ("white plastic", Bsdf::RoughPlastic { kd: Vec3::ONE, ior: 1.5, alpha: alpha_of(r) }),
+            ("white plastic", Bsdf::rough_plastic(Vec3::ONE, 1.5, alpha_of(r))),
         ] {
             for deg in [0.0f32, 45.0, 80.0] {
                 let wo = direction(deg);

@@ -59,16 +59,27 @@ impl Bsdf {
 
     /// The weight of a cosine-sampled final-gather ray `wi` from the diffuse part: `kd` for
     /// Lambertian and glossy materials (the 1/π and the cosine cancel), the base's
-    /// kd·(1 − F(wo))·(1 − F(wi)) for the rough plastic.
+    /// kd′·T(wo)·T(wi)/η² for the rough plastic ([`microfacet::Plastic::base`]).
     #[must_use]
     pub fn gather_weight(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Vec3 {
-        match *self {
-            Bsdf::RoughPlastic { kd, ior, .. } => {
+        match self.plastic() {
+            Some(p) => {
                 let (_, ns) = frame.oriented(wo);
                 let f = Frame::new(ns);
-                microfacet::plastic_base(f.to_local(wo), f.to_local(wi), kd, ior)
+                p.base(f.to_local(wo), f.to_local(wi))
             }
-            _ => self.diffuse(),
+            None => self.diffuse(),
+        }
+    }
+
+    /// A rough plastic's model ([`microfacet::Plastic`]); `None` for the other materials.
+    #[must_use]
+    pub fn plastic(&self) -> Option<microfacet::Plastic> {
+        match *self {
+            Bsdf::RoughPlastic { kd, alpha, nonlinear, coat } => {
+                Some(microfacet::Plastic { kd, coat, alpha, nonlinear })
+            }
+            _ => None,
         }
     }
 
@@ -80,7 +91,7 @@ impl Bsdf {
     }
 
     /// f(wo, wi) of that part alone: kd/π, or the rough plastic's base
-    /// kd/π·(1 − F(θo))(1 − F(θi)); zero for the others.
+    /// kd′·T(θo)·T(θi)/(π η²); zero for the others.
     #[must_use]
     pub fn eval_base(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Vec3 {
         let (ng, ns) = frame.oriented(wo);
@@ -89,13 +100,13 @@ impl Bsdf {
         }
         match *self {
             Bsdf::Lambert { kd } | Bsdf::Glossy { kd, .. } => kd / PI,
-            Bsdf::RoughPlastic { kd, ior, .. } => {
+            Bsdf::RoughPlastic { .. } => {
                 let f = Frame::new(ns);
                 let (lo, li) = (f.to_local(wo), f.to_local(wi));
-                if lo.z <= 0.0 || li.z <= 0.0 {
-                    return Vec3::ZERO;
+                match self.plastic() {
+                    Some(p) if lo.z > 0.0 && li.z > 0.0 => p.base(lo, li) / PI,
+                    _ => Vec3::ZERO,
                 }
-                microfacet::plastic_base(lo, li, kd, ior) / PI
             }
             _ => Vec3::ZERO,
         }
@@ -148,12 +159,12 @@ impl Bsdf {
                 }
                 ks * phong_lobe(reflect(wo, ns), wi, exponent)
             }
-            Bsdf::RoughPlastic { ior, alpha, .. } => {
+            Bsdf::RoughPlastic { alpha, coat, .. } => {
                 let (ng, f, _) = self.rough_frame(frame, wo);
                 if wi.dot(ng) <= 0.0 {
                     return Vec3::ZERO;
                 }
-                Vec3::splat(microfacet::plastic_coat_eval(f.to_local(wo), f.to_local(wi), ior, alpha))
+                Vec3::splat(microfacet::plastic_coat_eval(f.to_local(wo), f.to_local(wi), coat.eta, alpha))
             }
             _ => self.eval_rough(frame, wo, wi).unwrap_or(Vec3::ZERO),
         }
@@ -262,13 +273,13 @@ impl Bsdf {
         if let Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } = self {
             return self.sample_rough(frame, wo, u, true);
         }
-        if let Bsdf::RoughPlastic { ior, alpha, .. } = *self {
+        if let Bsdf::RoughPlastic { alpha, coat, .. } = *self {
             let (ng, f, _) = self.rough_frame(frame, wo);
             let lo = f.to_local(wo);
             if lo.z <= 0.0 {
                 return None;
             }
-            let s = microfacet::plastic_coat_sample(lo, ior, alpha, [u[0], u[1]])?;
+            let s = microfacet::plastic_coat_sample(lo, coat.eta, alpha, [u[0], u[1]])?;
             let wi = f.to_world(s.wi);
             return (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: s.weight, delta: false });
         }
@@ -312,9 +323,7 @@ impl Bsdf {
         let (lo, li) = (f.to_local(wo), f.to_local(wi));
         Some(match *self {
             Bsdf::RoughConductor { ks, alpha } if wi.dot(ng) > 0.0 => microfacet::conductor_eval(lo, li, ks, alpha),
-            Bsdf::RoughPlastic { kd, ior, alpha } if wi.dot(ng) > 0.0 => {
-                microfacet::plastic_eval(lo, li, kd, ior, alpha)
-            }
+            Bsdf::RoughPlastic { .. } if wi.dot(ng) > 0.0 => self.plastic().map_or(Vec3::ZERO, |p| p.eval(lo, li)),
             // Reflection stays on wo's geometric side, refraction crosses it.
             Bsdf::RoughDielectric { alpha, .. } if (wi.dot(ng) > 0.0) == (li.z > 0.0) => {
                 Vec3::splat(microfacet::dielectric_eval(lo, li, eta, alpha))
@@ -351,12 +360,12 @@ impl Bsdf {
                 }
                 microfacet::conductor_pdf(f.to_local(wo), f.to_local(wi), alpha)
             }
-            Bsdf::RoughPlastic { kd, ior, alpha } => {
+            Bsdf::RoughPlastic { .. } => {
                 let (ng, f, _) = self.rough_frame(frame, wo);
-                if wi.dot(ng) <= 0.0 {
-                    return 0.0;
+                match self.plastic() {
+                    Some(p) if wi.dot(ng) > 0.0 => p.pdf(f.to_local(wo), f.to_local(wi)),
+                    _ => 0.0,
                 }
-                microfacet::plastic_pdf(f.to_local(wo), f.to_local(wi), kd, ior, alpha)
             }
             Bsdf::RoughDielectric { alpha, .. } => {
                 let (ng, f, eta) = self.rough_frame(frame, wo);
@@ -382,7 +391,7 @@ impl Bsdf {
         let s = match *self {
             Bsdf::RoughConductor { ks, alpha } => microfacet::conductor_sample(lo, ks, alpha, [u[0], u[1]])?,
             Bsdf::RoughDielectric { alpha, .. } => microfacet::dielectric_sample(lo, eta, alpha, u, radiance)?,
-            Bsdf::RoughPlastic { kd, ior, alpha } => microfacet::plastic_sample(lo, kd, ior, alpha, u)?,
+            Bsdf::RoughPlastic { .. } => self.plastic()?.sample(lo, u)?,
             _ => return None,
         };
         let wi = f.to_world(s.wi);

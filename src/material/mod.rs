@@ -46,9 +46,31 @@ pub enum Bsdf {
     /// Rough (frosted) clear dielectric: GGX of width `alpha`, exact Fresnel, reflection and
     /// refraction through the microfacets; `ior` as for [`Bsdf::Glass`].
     RoughDielectric { ior: f32, alpha: f32 },
-    /// Rough plastic: a GGX dielectric coat (index `ior`, width `alpha`) over a Lambertian base
-    /// `kd` ([`microfacet::plastic_eval`]).
-    RoughPlastic { kd: Vec3, ior: f32, alpha: f32 },
+    /// Rough plastic, Mitsuba 3's `roughplastic` ([`microfacet::Plastic`]): a GGX dielectric
+    /// coat of width `alpha` over a Lambertian base `kd`; `coat` holds its index ratio and its
+    /// transmittance tables ([`Bsdf::rough_plastic`] builds it); `nonlinear` lets the base's
+    /// bounces under the coat tint by kd.
+    RoughPlastic { kd: Vec3, alpha: f32, nonlinear: bool, coat: microfacet::CoatAt },
+}
+
+impl Bsdf {
+    /// A rough plastic of base `kd`, coat index ratio `ior` and width `alpha`, Mitsuba's default
+    /// (linear) internal bounces.
+    #[must_use]
+    pub fn rough_plastic(kd: Vec3, ior: f32, alpha: f32) -> Bsdf {
+        let alpha = alpha.max(microfacet::MIN_ALPHA);
+        Bsdf::RoughPlastic { kd, alpha, nonlinear: false, coat: microfacet::CoatAt::new(ior, alpha) }
+    }
+
+    /// A rough plastic whose base's bounces under the coat tint by kd (`nonlinear`, Mitsuba's
+    /// flag of that name); other materials unchanged.
+    #[must_use]
+    pub fn with_nonlinear(self, nonlinear: bool) -> Bsdf {
+        match self {
+            Bsdf::RoughPlastic { kd, alpha, coat, .. } => Bsdf::RoughPlastic { kd, alpha, nonlinear, coat },
+            other => other,
+        }
+    }
 }
 
 /// The GGX α below which a rough conductor acts as a mirror for photons (roughness 0.3): its
@@ -140,16 +162,16 @@ impl Material {
             // The PBR extension's metallic workflow, per point: the base colour makes a metal's
             // reflectance or a plastic's base. Metal parts store photons (α at least
             // PHOTON_SPECULAR_ALPHA), as plastic does, so the material's photon class is one.
-            let (base, ior, alpha) = match self.bsdf {
-                Bsdf::RoughPlastic { kd, ior, alpha } => (kd_at(kd), ior, alpha_at(alpha)),
-                Bsdf::RoughConductor { ks, alpha } => (ks_at(ks), 1.5, alpha_at(alpha)),
+            let (base, ior, nonlinear, alpha) = match self.bsdf {
+                Bsdf::RoughPlastic { kd, alpha, nonlinear, coat } => (kd_at(kd), coat.eta, nonlinear, alpha_at(alpha)),
+                Bsdf::RoughConductor { ks, alpha } => (ks_at(ks), 1.5, false, alpha_at(alpha)),
                 other => return other,
             };
             let base = base.min(Vec3::ONE);
             return if m.lookup(uv).x >= 0.5 {
                 Bsdf::RoughConductor { ks: base, alpha: alpha.max(PHOTON_SPECULAR_ALPHA) }
             } else {
-                Bsdf::RoughPlastic { kd: base, ior, alpha }
+                plastic_at(base, ior, nonlinear, alpha)
             };
         }
         match self.bsdf {
@@ -171,13 +193,24 @@ impl Material {
                 };
                 Bsdf::RoughConductor { ks: ks_at(ks).min(Vec3::ONE), alpha: a }
             }
-            Bsdf::RoughPlastic { kd, ior, alpha } => {
-                Bsdf::RoughPlastic { kd: kd_at(kd).min(Vec3::ONE), ior, alpha: alpha_at(alpha) }
+            Bsdf::RoughPlastic { kd, alpha, nonlinear, coat } => {
+                let kd = kd_at(kd).min(Vec3::ONE);
+                match &self.maps.roughness {
+                    Some(_) => plastic_at(kd, coat.eta, nonlinear, alpha_at(alpha)),
+                    None => Bsdf::RoughPlastic { kd, alpha, nonlinear, coat },
+                }
             }
             Bsdf::RoughDielectric { ior, alpha } => Bsdf::RoughDielectric { ior, alpha: alpha_at(alpha) },
             b @ Bsdf::Glass { .. } => b,
         }
     }
+}
+
+/// A textured rough plastic at one point: its own α shapes the coat's lobe, the roughness
+/// levels around it give the coat's tables ([`microfacet::CoatAt::textured`]).
+fn plastic_at(kd: Vec3, ior: f32, nonlinear: bool, alpha: f32) -> Bsdf {
+    let alpha = alpha.max(microfacet::MIN_ALPHA);
+    Bsdf::RoughPlastic { kd, alpha, nonlinear, coat: microfacet::CoatAt::textured(ior, alpha) }
 }
 
 /// A BSDF sample whose pdf came out zero (see [`Bsdf::sample_checked`]).
@@ -229,9 +262,7 @@ mod tests {
             ..Material::new("m", bsdf, Vec3::ZERO)
         };
         let uv = Vec2::splat(0.5);
-        let Bsdf::RoughPlastic { alpha, .. } =
-            rough(Bsdf::RoughPlastic { kd: Vec3::ONE, ior: 1.5, alpha: 0.5 }, 0.6).bsdf_at(uv)
-        else {
+        let Bsdf::RoughPlastic { alpha, .. } = rough(Bsdf::rough_plastic(Vec3::ONE, 1.5, 0.5), 0.6).bsdf_at(uv) else {
             panic!()
         };
         assert!((alpha - 0.36).abs() < 1e-6);
@@ -254,12 +285,10 @@ mod tests {
             Some(Arc::new(Texture::new(std::path::Path::new("m.png"), 2, 1, vec![Vec3::ZERO, Vec3::ONE]).unwrap()));
         let m = Material {
             maps: Maps { metallic: two, ..Maps::default() },
-            ..Material::new("m", Bsdf::RoughPlastic { kd: Vec3::new(0.9, 0.5, 0.1), ior: 1.4, alpha: 0.04 }, Vec3::ZERO)
+            ..Material::new("m", Bsdf::rough_plastic(Vec3::new(0.9, 0.5, 0.1), 1.4, 0.04), Vec3::ZERO)
         };
-        assert_eq!(
-            m.bsdf_at(Vec2::new(0.25, 0.5)),
-            Bsdf::RoughPlastic { kd: Vec3::new(0.9, 0.5, 0.1), ior: 1.4, alpha: 0.04 }
-        );
+        let Bsdf::RoughPlastic { kd, alpha, coat, .. } = m.bsdf_at(Vec2::new(0.25, 0.5)) else { panic!() };
+        assert_eq!((kd, alpha, coat.eta), (Vec3::new(0.9, 0.5, 0.1), 0.04, 1.4));
         let metal = m.bsdf_at(Vec2::new(0.75, 0.5));
         assert_eq!(metal, Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.5, 0.1), alpha: PHOTON_SPECULAR_ALPHA });
         assert!(!metal.photon_specular(), "metal parts store photons, as the plastic does");

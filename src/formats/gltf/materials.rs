@@ -137,7 +137,7 @@ pub(super) fn convert(
             maps.metallic = Some(derived(t, Vec3::splat(metallic), Some(2)));
             maps.kd = base_map.as_ref().map(|t| derived(t, base, None));
             // One photon class for the material (metal parts at least PHOTON_SPECULAR_ALPHA).
-            Bsdf::RoughPlastic { kd: base, ior: 1.5, alpha: alpha.max(PHOTON_SPECULAR_ALPHA) }
+            Bsdf::rough_plastic(base, 1.5, alpha.max(PHOTON_SPECULAR_ALPHA))
         } else if metallic >= 0.5 {
             maps.ks = base_map.as_ref().map(|t| derived(t, base, None));
             if roughness < SMOOTH {
@@ -153,7 +153,7 @@ pub(super) fn convert(
             if roughness >= DIFFUSE {
                 Bsdf::Lambert { kd: base }
             } else {
-                Bsdf::RoughPlastic { kd: base, ior: 1.5, alpha }
+                Bsdf::rough_plastic(base, 1.5, alpha)
             }
         }
     };

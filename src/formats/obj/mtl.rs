@@ -200,7 +200,7 @@ pub fn material_from_mtl(m: &MtlMaterial, file: &Path, warnings: &mut Vec<String
         (_, None) if metal => Bsdf::Mirror { ks: kd.min(Vec3::ONE) },
         (_, Some(alpha)) if metal => Bsdf::RoughConductor { ks: kd.min(Vec3::ONE), alpha },
         // A rough non-metal: the PBR extension's dielectric, a coat over the base colour.
-        (_, Some(alpha)) => Bsdf::RoughPlastic { kd: kd.min(Vec3::ONE), ior: m.ni.unwrap_or(1.5), alpha },
+        (_, Some(alpha)) => Bsdf::rough_plastic(kd.min(Vec3::ONE), m.ni.unwrap_or(1.5), alpha),
         (2, _) if ks.max_element() > 0.0 => {
             let sum = (kd + ks).max_element();
             let scale = if sum > 1.0 && !ks_map && m.map("map_Kd").is_none() {
@@ -407,7 +407,7 @@ mod tests {
         assert!(m[0].map("map_Pr").is_some(), "map_Pr before Pr is kept");
         assert_eq!(b[1], Bsdf::RoughDielectric { ior: 1.4, alpha: alpha_of(0.5) });
         assert_eq!(b[2], Bsdf::Mirror { ks: Vec3::splat(0.8) });
-        assert_eq!(b[3], Bsdf::RoughPlastic { kd: Vec3::splat(0.5), ior: 1.5, alpha: alpha_of(0.3) });
+        assert_eq!(b[3], Bsdf::rough_plastic(Vec3::splat(0.5), 1.5, alpha_of(0.3)));
         assert!(w.is_empty(), "{w:?}");
         for bad in ["Pr 1.5", "Pr -0.1", "Pm 2"] {
             let e = parse(&format!("newmtl a\n{bad}\n")).0.unwrap_err().to_string();

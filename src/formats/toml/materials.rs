@@ -158,7 +158,7 @@ impl MaterialEntry {
                 if !(ior > 0.0 && ior.is_finite()) {
                     return Err(Error::setting(f("ior"), "must be a positive number"));
                 }
-                (Bsdf::RoughPlastic { kd: albedo(&f("kd"), kd)?, ior, alpha }, emission)
+                (Bsdf::rough_plastic(albedo(&f("kd"), kd)?, ior, alpha), emission)
             }
             MaterialEntry::RoughDielectric { ior, outside_ior, roughness, emission } => {
                 let alpha = roughness_alpha(&f("roughness"), roughness)?;

@@ -1,8 +1,9 @@
-//! Rough surfaces: the GGX (Trowbridge–Reitz) microfacet distribution with Smith's
-//! height-correlated masking–shadowing, sampled by its distribution of visible normals (Heitz
-//! 2018), for a rough conductor (Schlick's Fresnel from a reflectance colour), a rough
-//! dielectric (Walter et al. 2007: reflection and refraction through the microfacets) and a
-//! rough plastic (a dielectric coat over a Lambertian base).
+//! Rough surfaces: the GGX (Trowbridge–Reitz) microfacet distribution with Smith's separable
+//! masking–shadowing G1(wo)·G1(wi) (Mitsuba 3's, so that its scenes render as it does), sampled
+//! by its distribution of visible normals (Heitz 2018), for a rough conductor (Schlick's Fresnel
+//! from a reflectance colour), a rough dielectric (Walter et al. 2007: reflection and refraction
+//! through the microfacets) and a rough plastic (Mitsuba 3's `roughplastic`: a dielectric coat
+//! over a Lambertian base, with the coat's transmittance and internal reflection from [`coat`]).
 //!
 //! Every function works in a local frame whose z axis is the shading normal on the side of
 //! `wo`; directions are unit vectors pointing away from the surface. Single scattering only:
@@ -13,6 +14,9 @@
 use crate::optics::{fresnel_dielectric, refract};
 use glam::Vec3;
 use std::f32::consts::PI;
+
+pub mod coat;
+pub use coat::{Coat, CoatAt};
 
 /// The smallest α used: below it D's peak overflows f32 arithmetic in `eval`.
 pub const MIN_ALPHA: f32 = 1e-3;
@@ -29,8 +33,10 @@ pub fn d(m: Vec3, alpha: f32) -> f32 {
     if m.z <= 0.0 {
         return 0.0;
     }
+    // m.z²(α² − 1) + 1 written with the sine² as m.x² + m.y², not 1 − m.z²: near the peak of
+    // a narrow lobe 1 − m.z² cancels to a few ulps and D would be off by per cents.
     let a2 = alpha * alpha;
-    let t = m.z * m.z * (a2 - 1.0) + 1.0;
+    let t = m.x * m.x + m.y * m.y + a2 * m.z * m.z;
     a2 / (PI * t * t)
 }
 
@@ -41,7 +47,8 @@ pub fn lambda(w: Vec3, alpha: f32) -> f32 {
     if cos2 <= 0.0 {
         return f32::INFINITY;
     }
-    let tan2 = ((1.0 - cos2) / cos2).max(0.0);
+    // The sine² from x and y (1 − cos² cancels near the normal).
+    let tan2 = (w.x * w.x + w.y * w.y) / cos2;
     0.5 * (-1.0 + (1.0 + alpha * alpha * tan2).sqrt())
 }
 
@@ -51,10 +58,12 @@ pub fn g1(w: Vec3, alpha: f32) -> f32 {
     1.0 / (1.0 + lambda(w, alpha))
 }
 
-/// Height-correlated masking–shadowing G2(ωo, ωi).
+/// Masking–shadowing G2(ωo, ωi) = G1(ωo)·G1(ωi): Smith's separable form, as Mitsuba 3 has it
+/// (pbrt-v4's height-correlated 1/(1 + Λo + Λi) is up to a few per cent larger at grazing
+/// angles; Mitsuba's scenes were made with this one).
 #[must_use]
 pub fn g2(wo: Vec3, wi: Vec3, alpha: f32) -> f32 {
-    1.0 / (1.0 + lambda(wo, alpha) + lambda(wi, alpha))
+    g1(wo, alpha) * g1(wi, alpha)
 }
 
 /// The density of visible normals seen from `wo`: G1(wo)·max(0, wo·m)·D(m)/wo.z.
@@ -200,71 +209,85 @@ pub fn dielectric_sample(wo: Vec3, eta: f32, alpha: f32, u: [f32; 3], radiance: 
     Some(LocalSample { wi, weight: Vec3::splat(g2(wo, -wi, alpha) / g1(wo, alpha) * scale) })
 }
 
-/// Rough plastic: a GGX dielectric coat of relative index `eta` over a Lambertian base `kd`.
-/// f = F(wo·m)·D·G2/(4·wo.z·wi.z) + kd/π·(1 − F(wo.z))·(1 − F(wi.z)): the coat reflects by its
-/// microfacets; light that enters it (1 − F on the way in and out) meets the base. Reciprocal;
-/// it never gains energy (the coat's light and the base's share of what the coat lets through
-/// sum to at most 1; the tests measure it). Light bouncing between the base and the coat's
-/// underside is not followed, so a plastic is slightly darker than a real one.
-#[must_use]
-pub fn plastic_eval(wo: Vec3, wi: Vec3, kd: Vec3, eta: f32, alpha: f32) -> Vec3 {
-    if wo.z <= 0.0 || wi.z <= 0.0 {
-        return Vec3::ZERO;
-    }
-    let m = (wo + wi).normalize();
-    let coat = fresnel_dielectric(wo.dot(m), eta) * d(m, alpha) * g2(wo, wi, alpha) / (4.0 * wo.z * wi.z);
-    Vec3::splat(coat) + plastic_base(wo, wi, kd, eta) / PI
+/// A rough plastic at a point (Mitsuba 3's `roughplastic`): a GGX dielectric coat of width
+/// `alpha` over a Lambertian base `kd`, the coat's index ratio and tables in `coat`.
+/// f = F(wo·m)·D·G2/(4·wo.z·wi.z) + kd′·T(wo.z)·T(wi.z)/(π η²): the coat reflects by its
+/// microfacets; light crosses it into the base and back out (T each way, T the rough coat's
+/// transmittance), is spread over the solid angle inside (1/η²), and bounces between the base and
+/// the coat's underside (kd′ = kd / (1 − F_dr), or kd / (1 − kd·F_dr) when `nonlinear`).
+#[derive(Clone, Copy, Debug)]
+pub struct Plastic {
+    /// Base albedo.
+    pub kd: Vec3,
+    /// The coat's tables and index ratio.
+    pub coat: CoatAt,
+    /// The coat's GGX width at this point.
+    pub alpha: f32,
+    /// Whether the base's internal bounces tint by kd (Mitsuba's `nonlinear`).
+    pub nonlinear: bool,
 }
 
-/// The base's share times π: kd·(1 − F(wo.z))·(1 − F(wi.z)) (the weight of a cosine-sampled
-/// direction through the base alone).
-#[must_use]
-pub fn plastic_base(wo: Vec3, wi: Vec3, kd: Vec3, eta: f32) -> Vec3 {
-    kd * ((1.0 - fresnel_dielectric(wo.z, eta)) * (1.0 - fresnel_dielectric(wi.z, eta)))
-}
+impl Plastic {
+    /// f(wo, wi): coat and base; zero unless both lie above the surface.
+    #[must_use]
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        Vec3::splat(plastic_coat_eval(wo, wi, self.coat.eta, self.alpha)) + self.base(wo, wi) / PI
+    }
 
-/// Probability of sampling the plastic's coat rather than its base from `wo`: F(wo.z) against
-/// (1 − F(wo.z))·mean(kd).
-fn plastic_coat_probability(wo: Vec3, kd: Vec3, eta: f32) -> f32 {
-    let f = fresnel_dielectric(wo.z, eta);
-    let base = (1.0 - f) * kd.element_sum() / 3.0;
-    if f + base > 0.0 {
-        f / (f + base)
-    } else {
-        1.0
+    /// The base's share times π: kd′·T(wo.z)·T(wi.z)/η² (the weight of a cosine-sampled
+    /// direction through the base alone).
+    #[must_use]
+    pub fn base(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        let c = self.coat;
+        c.base_albedo(self.kd, self.nonlinear) * (c.transmittance(wo.z) * c.transmittance(wi.z) / (c.eta * c.eta))
     }
-}
 
-/// The pdf of [`plastic_sample`].
-#[must_use]
-pub fn plastic_pdf(wo: Vec3, wi: Vec3, kd: Vec3, eta: f32, alpha: f32) -> f32 {
-    if wo.z <= 0.0 || wi.z <= 0.0 {
-        return 0.0;
+    /// Probability of sampling the coat rather than the base from `wo`, as Mitsuba weighs them:
+    /// (1 − T(wo.z))·w against T(wo.z)·(1 − w), w = 1/(1 + mean(kd)).
+    #[must_use]
+    pub fn coat_probability(&self, wo: Vec3) -> f32 {
+        let w = 1.0 / (1.0 + self.kd.element_sum() / 3.0);
+        let t = self.coat.transmittance(wo.z);
+        let (coat, base) = ((1.0 - t) * w, t * (1.0 - w));
+        if coat + base > 0.0 {
+            coat / (coat + base)
+        } else {
+            1.0
+        }
     }
-    let p = plastic_coat_probability(wo, kd, eta);
-    let m = (wo + wi).normalize();
-    p * visible_d(wo, m, alpha) / (4.0 * wo.dot(m)) + (1.0 - p) * wi.z / PI
-}
 
-/// Samples the rough plastic: its coat (a visible normal, reflection about it) or its base
-/// (cosine-weighted), chosen by `plastic_coat_probability`; weight f·cos/pdf of the mixture.
-#[must_use]
-pub fn plastic_sample(wo: Vec3, kd: Vec3, eta: f32, alpha: f32, u: [f32; 3]) -> Option<LocalSample> {
-    let p = plastic_coat_probability(wo, kd, eta);
-    let wi = if u[2] < p {
-        let m = sample_visible_normal(wo, alpha, [u[0], u[1]]);
-        2.0 * wo.dot(m) * m - wo
-    } else {
-        crate::sampling::cosine_hemisphere([u[0], u[1]])
-    };
-    if wi.z <= 0.0 {
-        return None;
+    /// The pdf of [`Plastic::sample`].
+    #[must_use]
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let p = self.coat_probability(wo);
+        p * plastic_coat_pdf(wo, wi, self.alpha) + (1.0 - p) * wi.z / PI
     }
-    let pdf = plastic_pdf(wo, wi, kd, eta, alpha);
-    if !(pdf > 0.0) {
-        return None;
+
+    /// Samples the coat (a visible normal, reflection about it) or the base (cosine-weighted),
+    /// chosen by [`Plastic::coat_probability`]; weight f·cos/pdf of the mixture.
+    #[must_use]
+    pub fn sample(&self, wo: Vec3, u: [f32; 3]) -> Option<LocalSample> {
+        let wi = if u[2] < self.coat_probability(wo) {
+            let m = sample_visible_normal(wo, self.alpha, [u[0], u[1]]);
+            2.0 * wo.dot(m) * m - wo
+        } else {
+            crate::sampling::cosine_hemisphere([u[0], u[1]])
+        };
+        if wi.z <= 0.0 {
+            return None;
+        }
+        let pdf = self.pdf(wo, wi);
+        if !(pdf > 0.0) {
+            return None;
+        }
+        Some(LocalSample { wi, weight: self.eval(wo, wi) * (wi.z / pdf) })
     }
-    Some(LocalSample { wi, weight: plastic_eval(wo, wi, kd, eta, alpha) * (wi.z / pdf) })
 }
 
 /// The plastic's coat alone (its glossy lobe): F(wo·m)·D(m)·G2 / (4·wo.z·wi.z).

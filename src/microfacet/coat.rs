@@ -1,0 +1,259 @@
+//! The dielectric coat of a rough plastic as Mitsuba 3's `roughplastic` precomputes it: the
+//! coat's transmittance T(cos θ) from outside, tabulated at 64 equally spaced cosines and read by
+//! linear interpolation, and its internal diffuse reflectance F_dr (light from the base reflected
+//! back down by the coat's underside, total internal reflection included). The base's BSDF is
+//! then kd′·T(θo)·T(θi) / (π η²), kd′ = kd / (1 − F_dr) or, `nonlinear`, kd / (1 − kd·F_dr)
+//! ([`crate::microfacet::plastic_base`]).
+//!
+//! Both come from the rough interface's single scattering over the normals m visible from wo
+//! (cos θo = μ): its transmittance T(μ, η) = E_m[(1 − F(wo·m)) · G1(wt) · [wt below]], wt the
+//! refraction through m, and its reflectance R(μ, η) = E_m[F(wo·m) · G1(wr) · [wr above]], wr
+//! the reflection about m (light the microfacets shadow is in neither). Each is integrated by
+//! Gauss–Legendre quadrature over the visible-normal sampler's unit square: 32 × 32 nodes from
+//! outside (η > 1), 128 × 128 from inside, where total internal reflection makes the integrand
+//! jump. The table holds T(μ, η); F_dr = 2 · mean over the 64 table cosines of μ·R(μ, 1/η)
+//! (Mitsuba's own discretisation, kept so that the base matches it).
+//!
+//! Reads η and α; writes [`Coat`]s, built once per (η, α) and shared for the process's life
+//! ([`Coat::get`]): a scene has a handful, a roughness texture at most [`ROUGHNESS_LEVELS`] per η
+//! ([`CoatAt::textured`]).
+
+use super::{g1, sample_visible_normal, MIN_ALPHA};
+use crate::optics::{fresnel_dielectric, refract};
+use glam::Vec3;
+use std::collections::HashMap;
+use std::sync::{OnceLock, RwLock};
+
+/// Cosines in the transmittance table (Mitsuba's `MI_ROUGH_TRANSMITTANCE_RES`).
+pub const TRANSMITTANCE_RES: usize = 64;
+
+/// Roughness levels (α = roughness², equally spaced in roughness) a textured coat's tables are
+/// blended from: a point's α reads the two levels around it, its own α shapes the coat's lobe.
+pub const ROUGHNESS_LEVELS: u32 = 64;
+
+/// A plastic's coat: index ratio, width and the tables of the base's light through it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Coat {
+    /// η(inside) / η(outside).
+    pub eta: f32,
+    /// GGX width.
+    pub alpha: f32,
+    /// T(μ) at μ = i / 63 (μ = 0 taken as 10⁻⁶).
+    pub transmittance: [f32; TRANSMITTANCE_RES],
+    /// F_dr: the share of the base's (cosine-distributed) light the coat sends back down.
+    pub internal_reflectance: f32,
+}
+
+impl Coat {
+    /// Computes the tables for relative index `eta` (> 0) and width `alpha`.
+    #[must_use]
+    pub fn new(eta: f32, alpha: f32) -> Coat {
+        let alpha = alpha.max(MIN_ALPHA);
+        let mu = |i: usize| (i as f32 / (TRANSMITTANCE_RES - 1) as f32).max(1e-6);
+        let outside = GaussLegendre::new(if eta > 1.0 { 32 } else { 128 });
+        let inside = GaussLegendre::new(if 1.0 / eta > 1.0 { 32 } else { 128 });
+        let transmittance = std::array::from_fn(|i| rough_transmittance(mu(i), eta, alpha, &outside));
+        let sum: f64 = (0..TRANSMITTANCE_RES)
+            .map(|i| f64::from(rough_reflectance(mu(i), 1.0 / eta, alpha, &inside) * mu(i)))
+            .sum();
+        let internal_reflectance = (2.0 * sum / TRANSMITTANCE_RES as f64) as f32;
+        Coat { eta, alpha, transmittance, internal_reflectance }
+    }
+
+    /// The coat for (`eta`, `alpha`), computed on first use and kept: every material and every
+    /// point of one (η, α) shares it.
+    #[must_use]
+    pub fn get(eta: f32, alpha: f32) -> &'static Coat {
+        static COATS: OnceLock<RwLock<HashMap<(u32, u32), &'static Coat>>> = OnceLock::new();
+        let key = (eta.to_bits(), alpha.to_bits());
+        let coats = COATS.get_or_init(Default::default);
+        if let Some(c) = coats.read().unwrap_or_else(std::sync::PoisonError::into_inner).get(&key) {
+            return c;
+        }
+        let made = Coat::new(eta, alpha);
+        let mut all = coats.write().unwrap_or_else(std::sync::PoisonError::into_inner);
+        all.entry(key).or_insert_with(|| Box::leak(Box::new(made)))
+    }
+
+    /// T(cos θ): the table linearly interpolated (cos θ in [0, 1]).
+    #[must_use]
+    pub fn transmittance(&self, cos: f32) -> f32 {
+        let x = cos.clamp(0.0, 1.0) * (TRANSMITTANCE_RES - 1) as f32;
+        let i = (x as usize).min(TRANSMITTANCE_RES - 2);
+        let w = x - i as f32;
+        (1.0 - w) * self.transmittance[i] + w * self.transmittance[i + 1]
+    }
+}
+
+/// The coat a plastic reads at a point: its own (η, α) coat, or for a textured roughness the two
+/// roughness levels around the point's α, blended linearly in roughness (√α).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CoatAt {
+    /// η(inside) / η(outside).
+    pub eta: f32,
+    lower: &'static Coat,
+    upper: &'static Coat,
+    blend: f32,
+}
+
+impl CoatAt {
+    /// The coat of exactly (`eta`, `alpha`) ([`Coat::get`]).
+    #[must_use]
+    pub fn new(eta: f32, alpha: f32) -> CoatAt {
+        let c = Coat::get(eta, alpha);
+        CoatAt { eta, lower: c, upper: c, blend: 0.0 }
+    }
+
+    /// For a roughness that changes from point to point: the [`ROUGHNESS_LEVELS`] levels on
+    /// either side of √`alpha`, so that a texture needs at most that many tables per η.
+    #[must_use]
+    pub fn textured(eta: f32, alpha: f32) -> CoatAt {
+        let steps = (ROUGHNESS_LEVELS - 1) as f32;
+        let x = alpha.max(MIN_ALPHA).sqrt().min(1.0) * steps;
+        let k = (x.floor() as u32).min(ROUGHNESS_LEVELS - 2);
+        let level = |k: u32| Coat::get(eta, ((k as f32 / steps).powi(2)).max(MIN_ALPHA));
+        CoatAt { eta, lower: level(k), upper: level(k + 1), blend: (x - k as f32).clamp(0.0, 1.0) }
+    }
+
+    /// T(cos θ).
+    #[must_use]
+    pub fn transmittance(&self, cos: f32) -> f32 {
+        let t = self.lower.transmittance(cos);
+        if self.blend == 0.0 {
+            return t;
+        }
+        t + self.blend * (self.upper.transmittance(cos) - t)
+    }
+
+    /// F_dr.
+    #[must_use]
+    pub fn internal_reflectance(&self) -> f32 {
+        let f = self.lower.internal_reflectance;
+        f + self.blend * (self.upper.internal_reflectance - f)
+    }
+
+    /// kd′: the base's albedo divided by what the coat's underside sends back,
+    /// kd / (1 − F_dr), or kd / (1 − kd·F_dr) when `nonlinear`.
+    #[must_use]
+    pub fn base_albedo(&self, kd: Vec3, nonlinear: bool) -> Vec3 {
+        let f_dr = self.internal_reflectance();
+        let back = if nonlinear { kd * f_dr } else { Vec3::splat(f_dr) };
+        kd / (Vec3::ONE - back)
+    }
+}
+
+/// Gauss–Legendre nodes and weights on [0, 1].
+struct GaussLegendre {
+    nodes: Vec<f32>,
+    weights: Vec<f32>,
+}
+
+impl GaussLegendre {
+    /// `n` nodes: the roots of the Legendre polynomial P_n by Newton's iteration from
+    /// cos(π(i + ¾)/(n + ½)), weights 2/((1 − x²)P_n′(x)²), mapped from [−1, 1] to [0, 1].
+    fn new(n: usize) -> GaussLegendre {
+        let (mut nodes, mut weights) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for i in 0..n {
+            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 1.0;
+            for _ in 0..100 {
+                // P_n(x) and P_n'(x) by the three-term recurrence.
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                    (p0, p1) = (p1, p2);
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let step = p1 / dp;
+                x -= step;
+                if step.abs() < 1e-15 {
+                    break;
+                }
+            }
+            nodes.push((0.5 * (x + 1.0)) as f32);
+            weights.push((1.0 / ((1.0 - x * x) * dp * dp)) as f32);
+        }
+        GaussLegendre { nodes, weights }
+    }
+}
+
+/// E_m[scattered(wo, m)] over the normals visible from the direction at cos θ = μ: the
+/// quadrature `q` over the sampler's unit square.
+fn visible_mean(mu: f32, alpha: f32, q: &GaussLegendre, scattered: impl Fn(Vec3, Vec3) -> f32) -> f32 {
+    let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+    let mut sum = 0.0f64;
+    for (&u, &wu) in q.nodes.iter().zip(&q.weights) {
+        for (&v, &wv) in q.nodes.iter().zip(&q.weights) {
+            let m = sample_visible_normal(wo, alpha, [u, v]);
+            sum += f64::from(scattered(wo, m) * wu * wv);
+        }
+    }
+    sum as f32
+}
+
+/// R(μ, η): the rough interface's single-scattering reflectance (see the module doc).
+fn rough_reflectance(mu: f32, eta: f32, alpha: f32, q: &GaussLegendre) -> f32 {
+    visible_mean(mu, alpha, q, |wo, m| {
+        let wr = 2.0 * wo.dot(m) * m - wo;
+        if wr.z <= 0.0 {
+            return 0.0;
+        }
+        fresnel_dielectric(wo.dot(m), eta) * g1(wr, alpha)
+    })
+}
+
+/// T(μ, η): the rough interface's single-scattering transmittance (see the module doc).
+fn rough_transmittance(mu: f32, eta: f32, alpha: f32, q: &GaussLegendre) -> f32 {
+    visible_mean(mu, alpha, q, |wo, m| match refract(wo, m, eta) {
+        Some(wt) if wt.z < 0.0 => (1.0 - fresnel_dielectric(wo.dot(m), eta)) * g1(wt, alpha),
+        _ => 0.0,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gauss_legendre_integrates_polynomials_exactly() {
+        // n nodes integrate degree 2n − 1 exactly: ∫₀¹ x^k dx = 1/(k + 1).
+        let q = GaussLegendre::new(8);
+        for k in 0..16 {
+            let s: f32 = q.nodes.iter().zip(&q.weights).map(|(x, w)| w * x.powi(k)).sum();
+            assert!((s - 1.0 / (k + 1) as f32).abs() < 1e-6, "x^{k}: {s}");
+        }
+    }
+
+    #[test]
+    fn a_near_smooth_coat_transmits_one_minus_fresnel() {
+        // At α = 10⁻³ the coat is a smooth interface: T(μ) = 1 − F(μ), and F_dr is the smooth
+        // interface's internal diffuse reflectance for η = 1.5 (0.596 by 2∫ F(μ, 1/η) μ dμ; the
+        // 64-point mean Mitsuba uses puts it within 0.01).
+        let coat = Coat::new(1.5, MIN_ALPHA);
+        for i in [8, 32, 63] {
+            let mu = i as f32 / 63.0;
+            let want = 1.0 - fresnel_dielectric(mu, 1.5);
+            assert!((coat.transmittance[i] - want).abs() < 2e-3, "μ = {mu}: {} against {want}", coat.transmittance[i]);
+        }
+        assert!((coat.internal_reflectance - 0.596).abs() < 0.01, "F_dr = {}", coat.internal_reflectance);
+    }
+
+    #[test]
+    fn a_textured_roughness_blends_its_levels_closely() {
+        // Between two levels, the blend against the exact table of the α in the middle: T is
+        // smooth in √α, so the linear blend's error is second order.
+        let steps = (ROUGHNESS_LEVELS - 1) as f32;
+        let mut worst = 0.0f32;
+        for k in [3u32, 12, 30, 50] {
+            let r = (k as f32 + 0.5) / steps;
+            let (exact, blended) = (Coat::new(1.5, r * r), CoatAt::textured(1.5, r * r));
+            for i in 1..TRANSMITTANCE_RES {
+                let mu = i as f32 / steps;
+                worst = worst.max((exact.transmittance(mu) - blended.transmittance(mu)).abs());
+            }
+            let f = (exact.internal_reflectance - blended.internal_reflectance()).abs();
+            assert!(f < 1e-3, "F_dr at roughness {r}: off by {f}");
+        }
+        assert!(worst < 2e-3, "T off by {worst}");
+    }
+}

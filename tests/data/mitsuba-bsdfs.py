@@ -1,0 +1,112 @@
+#!/usr/bin/env python3
+"""Writes tests/data/mitsuba-bsdfs.tsv: Mitsuba 3's own BSDF values, for tests/mitsuba_bsdfs.rs.
+
+Each Mitsuba BSDF that photonwave renders as Mitsuba does is loaded through Mitsuba's Python API
+(`pip install mitsuba`, variant scalar_rgb) with a grid of parameters, and evaluated over pairs of
+directions in the local frame (normal +z): f (Mitsuba's `eval` divided by the cosine it includes)
+and the pdf of its `sample`. Mitsuba's wi (toward the viewer) is photonwave's wo, and Mitsuba's wo
+photonwave's wi; the table uses photonwave's names.
+
+Not needed to build or test: the table is checked in. Run it again when a BSDF or its parameter
+grid changes:  python3 tests/data/mitsuba-bsdfs.py
+"""
+import math
+import os
+
+import mitsuba as mi
+
+mi.set_variant("scalar_rgb")
+
+KD = [0.8, 0.5, 0.2]
+
+
+def configs():
+    """(name, photonwave parameters, Mitsuba dictionary) for every BSDF in the table."""
+    yield "diffuse", {"kd": KD}, {"type": "diffuse", "reflectance": {"type": "rgb", "value": KD}}
+    for alpha in [0.05, 0.2, 0.6]:
+        yield (
+            "roughconductor",
+            {"alpha": alpha},
+            {"type": "roughconductor", "distribution": "ggx", "alpha": alpha, "material": "none"},
+        )
+    for alpha in [0.1, 0.4]:
+        yield (
+            "roughdielectric",
+            {"alpha": alpha, "ior": 1.5},
+            {"type": "roughdielectric", "distribution": "ggx", "alpha": alpha, "int_ior": 1.5, "ext_ior": 1.0},
+        )
+    for alpha in [0.01, 0.1, 0.3]:
+        for nonlinear in [False, True]:
+            yield (
+                "roughplastic",
+                {"alpha": alpha, "ior": 1.5, "kd": KD, "nonlinear": nonlinear},
+                {
+                    "type": "roughplastic",
+                    "distribution": "ggx",
+                    "alpha": alpha,
+                    "int_ior": 1.5,
+                    "ext_ior": 1.0,
+                    "nonlinear": nonlinear,
+                    "diffuse_reflectance": {"type": "rgb", "value": KD},
+                },
+            )
+
+
+def direction(theta_deg, phi_deg):
+    t, p = math.radians(theta_deg), math.radians(phi_deg)
+    return [math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t)]
+
+
+def pairs(alpha, transmits):
+    """(wo, wi) pairs: a coarse grid over both hemispheres' angles, and directions near the
+    mirror (and, for a dielectric, the refracted) direction at a few multiples of alpha."""
+    out = []
+    for to in [0.0, 30.0, 60.0, 80.0]:
+        wo = direction(to, 10.0)
+        for ti in [5.0, 25.0, 45.0, 65.0, 85.0]:
+            for pi_ in [10.0, 100.0, 190.0]:
+                out.append((wo, direction(ti, pi_)))
+                if transmits:
+                    out.append((wo, direction(180.0 - ti, pi_)))
+        for k in [0.25, 1.0, 2.0]:
+            spread = math.degrees(k * alpha)
+            for ti in [to - spread, to + spread]:
+                out.append((wo, direction(abs(ti), 190.0 if ti >= 0 else 10.0)))
+        # Seen from inside a dielectric.
+        if transmits:
+            wo_in = direction(180.0 - to, 10.0)
+            for ti in [5.0, 25.0, 45.0, 65.0]:
+                for pi_ in [10.0, 190.0]:
+                    out.append((wo_in, direction(ti, pi_)))
+                    out.append((wo_in, direction(180.0 - ti, pi_)))
+    return out
+
+
+def main():
+    ctx = mi.BSDFContext()
+    si = mi.SurfaceInteraction3f()
+    si.n = mi.Normal3f(0, 0, 1)
+    si.sh_frame = mi.Frame3f(si.n)
+    si.uv = mi.Point2f(0.5, 0.5)
+    rows = []
+    for name, ours, theirs in configs():
+        bsdf = mi.load_dict(theirs)
+        params = ";".join(f"{k}={','.join(map(str, v)) if isinstance(v, list) else v}" for k, v in ours.items())
+        for wo, wi in pairs(ours.get("alpha", 0.0), name == "roughdielectric"):
+            si.wi = mi.Vector3f(wo)
+            value = bsdf.eval(ctx, si, mi.Vector3f(wi))
+            pdf = bsdf.pdf(ctx, si, mi.Vector3f(wi))
+            cos = abs(wi[2])
+            f = [float(value[c]) / cos for c in range(3)]
+            rows.append([name, params] + [f"{x:.9g}" for x in wo + wi + f] + [f"{float(pdf):.9g}"])
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "mitsuba-bsdfs.tsv")
+    with open(path, "w") as out:
+        out.write(f"# Mitsuba {mi.__version__} (scalar_rgb): f and pdf; written by mitsuba-bsdfs.py\n")
+        out.write("bsdf\tparams\two_x\two_y\two_z\twi_x\twi_y\twi_z\tf_r\tf_g\tf_b\tpdf\n")
+        for r in rows:
+            out.write("\t".join(r) + "\n")
+    print(f"{len(rows)} rows to {path}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,121 @@
+//! Mitsuba's BSDFs as Mitsuba 3 itself evaluates them: `tests/data/mitsuba-bsdfs.tsv`, written by
+//! `tests/data/mitsuba-bsdfs.py` through Mitsuba's Python API, holds f and the sampling pdf of
+//! every BSDF photonwave renders as Mitsuba does, over a grid of parameters and direction pairs;
+//! photonwave's eval and pdf must match them.
+//!
+//! Tolerance, derived. The analytic BSDFs (diffuse, rough conductor, rough dielectric) are the
+//! same formulas on both sides in f32: some 20 roundings of 6·10⁻⁸ each, so 2·10⁻⁶ relative; with
+//! D and Λ computed from the sine² as x² + y² (not 1 − cos², which loses the peak of a narrow
+//! lobe), near the peaks too. They are held to 10⁻⁵ (measured: 5.5·10⁻⁶). The rough plastic's
+//! base reads tables that both sides integrate with the same Gauss–Legendre nodes but through
+//! different maps from the unit square to visible normals (ours Heitz 2018's, Mitsuba's the
+//! concentric-disk one), so the two quadratures differ by up to 10⁻⁴ in T and F_dr (measured):
+//! f = coat + kd′·T·T/(πη²) with kd′ = kd/(1 − F_dr) moves by at most 3·10⁻⁴/(1 − F_dr) ≈
+//! 7·10⁻⁴ relative (held to 10⁻³; measured 4.7·10⁻⁴); the pdf's choice between coat and base
+//! weighs by 1 − T, which near normal incidence is 0.04, so 10⁻⁴ in T moves it by 0.25 % and the
+//! pdf by up to 0.4 % (held to 5·10⁻³; measured 3.9·10⁻³). Below 10⁻⁶ absolute (a grazing
+//! direction where G1 → 0, Mitsuba's cut-off of D·cos below 10⁻²⁰) values count as equal.
+
+use glam::Vec3;
+use photonwave::material::{Bsdf, SurfaceFrame};
+
+/// One row: BSDF name, parameters, wo, wi, f (RGB), pdf.
+struct Row {
+    bsdf: String,
+    params: String,
+    wo: Vec3,
+    wi: Vec3,
+    f: Vec3,
+    pdf: f32,
+}
+
+fn rows() -> Vec<Row> {
+    let text = include_str!("data/mitsuba-bsdfs.tsv");
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("bsdf\t"))
+        .map(|l| {
+            let c: Vec<&str> = l.split('\t').collect();
+            let x: Vec<f32> = c[2..].iter().map(|v| v.parse().expect("a number")).collect();
+            Row {
+                bsdf: c[0].to_string(),
+                params: c[1].to_string(),
+                wo: Vec3::new(x[0], x[1], x[2]),
+                wi: Vec3::new(x[3], x[4], x[5]),
+                f: Vec3::new(x[6], x[7], x[8]),
+                pdf: x[9],
+            }
+        })
+        .collect()
+}
+
+/// A parameter of a row (`name=value;…`), as numbers.
+fn param(params: &str, name: &str) -> Vec<f32> {
+    params
+        .split(';')
+        .find_map(|kv| kv.strip_prefix(name).and_then(|v| v.strip_prefix('=')))
+        .map(|v| {
+            v.split(',')
+                .map(|x| {
+                    if x == "True" {
+                        1.0
+                    } else if x == "False" {
+                        0.0
+                    } else {
+                        x.parse().unwrap()
+                    }
+                })
+                .collect()
+        })
+        .unwrap_or_else(|| panic!("no {name} in {params}"))
+}
+
+/// photonwave's BSDF for a row's Mitsuba BSDF and parameters, as the Mitsuba reader makes it.
+fn ours(bsdf: &str, params: &str) -> Bsdf {
+    let v3 = |v: Vec<f32>| Vec3::new(v[0], v[1], v[2]);
+    match bsdf {
+        "diffuse" => Bsdf::Lambert { kd: v3(param(params, "kd")) },
+        "roughconductor" => Bsdf::RoughConductor { ks: Vec3::ONE, alpha: param(params, "alpha")[0] },
+        "roughdielectric" => Bsdf::RoughDielectric { ior: param(params, "ior")[0], alpha: param(params, "alpha")[0] },
+        "roughplastic" => {
+            Bsdf::rough_plastic(v3(param(params, "kd")), param(params, "ior")[0], param(params, "alpha")[0])
+                .with_nonlinear(param(params, "nonlinear")[0] == 1.0)
+        }
+        other => panic!("no mapping for {other}"),
+    }
+}
+
+#[test]
+fn every_bsdf_evaluates_as_mitsuba_3_does() {
+    let frame = SurfaceFrame { ng: Vec3::Z, ns: Vec3::Z };
+    let abs = 1e-6f32;
+    let close = |a: f32, b: f32, rel: f32| (a - b).abs() <= rel * a.abs().max(b.abs()) + abs;
+    let mut worst: std::collections::BTreeMap<String, (f32, f32)> = Default::default();
+    let mut failures = vec![];
+    let all = rows();
+    assert!(all.len() > 1000, "the table has {} rows", all.len());
+    for r in &all {
+        let b = ours(&r.bsdf, &r.params);
+        let (f, pdf) = (b.eval(&frame, r.wo, r.wi), b.pdf(&frame, r.wo, r.wi));
+        let (rel_f, rel_pdf) = if r.bsdf == "roughplastic" { (1e-3, 5e-3) } else { (1e-5, 1e-5) };
+        let e = |a: f32, b: f32| (a - b).abs() / (a.abs().max(b.abs()) + 1e3 * abs);
+        let w = worst.entry(format!("{} {}", r.bsdf, r.params)).or_default();
+        w.0 = w.0.max((0..3).map(|c| e(f[c], r.f[c])).fold(0.0, f32::max));
+        w.1 = w.1.max(e(pdf, r.pdf));
+        if !(0..3).all(|c| close(f[c], r.f[c], rel_f)) || !close(pdf, r.pdf, rel_pdf) {
+            failures.push(format!(
+                "{} {} wo {:?} wi {:?}: f {f:?} against {:?}, pdf {pdf} against {}",
+                r.bsdf, r.params, r.wo, r.wi, r.f, r.pdf
+            ));
+        }
+    }
+    for (k, (ef, ep)) in &worst {
+        println!("{k}: worst relative error f {ef:.2e}, pdf {ep:.2e}");
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {} rows differ:\n{}",
+        failures.len(),
+        all.len(),
+        failures[..failures.len().min(20)].join("\n")
+    );
+}
