@@ -311,7 +311,7 @@ fn light_samples_weighed_against_gather_and_glossy_rays_keep_the_direct_light() 
     for (name, bsdf) in [
         ("phong", Bsdf::Glossy { kd: Vec3::splat(0.3), ks: Vec3::splat(0.7), exponent: 30.0 }),
         ("rough plastic", Bsdf::rough_plastic(Vec3::splat(0.5), 1.5, 0.05)),
-        ("rough conductor", Bsdf::RoughConductor { ks: Vec3::splat(0.9), alpha: 0.4 }),
+        ("rough conductor", Bsdf::RoughConductor { ks: Vec3::splat(0.9), alpha: 0.4, eta_k: None }),
     ] {
         let with: Vec<f32> = (0..4096).map(|i| mis_sample(&sp, &bsdf, wo, i)).collect();
         let without: Vec<f32> = (0..4096)

@@ -273,7 +273,7 @@ fn bsdf_samples_are_finite_or_absent() {
     let bsdf = (0u8..4, albedo(), albedo(), exponent, ior).prop_map(|(kind, a, b, exponent, ior)| match kind {
         0 => Bsdf::Lambert { kd: Vec3::splat(a) },
         1 => Bsdf::Glossy { kd: Vec3::splat(a * (1.0 - b)), ks: Vec3::splat(b), exponent },
-        2 => Bsdf::Mirror { ks: Vec3::splat(a) },
+        2 => Bsdf::Mirror { ks: Vec3::splat(a), eta_k: None },
         _ => Bsdf::Glass { ior },
     });
     let shading = prop_oneof![

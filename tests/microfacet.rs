@@ -31,7 +31,7 @@ fn direction(theta_deg: f32) -> Vec3 {
 fn materials() -> Vec<(String, Bsdf)> {
     let mut v = Vec::new();
     for r in [0.3f32, 0.6, 1.0] {
-        v.push((format!("conductor r={r}"), Bsdf::RoughConductor { ks: Vec3::ONE, alpha: alpha_of(r) }));
+        v.push((format!("conductor r={r}"), Bsdf::RoughConductor { ks: Vec3::ONE, alpha: alpha_of(r), eta_k: None }));
         v.push((format!("dielectric r={r}"), Bsdf::RoughDielectric { ior: 1.5, alpha: alpha_of(r) }));
         v.push((format!("plastic r={r}"), Bsdf::rough_plastic(Vec3::new(0.8, 0.5, 0.2), 1.5, alpha_of(r))));
     }
@@ -144,7 +144,7 @@ fn white_furnace_never_gains_energy_and_matches_quadrature() {
     // microfacets: the albedo falls with roughness and is ≥ 0.99 for a nearly smooth surface.
     for r in [0.1f32, 0.3, 0.6, 1.0] {
         for (kind, b) in [
-            ("conductor", Bsdf::RoughConductor { ks: Vec3::ONE, alpha: alpha_of(r) }),
+            ("conductor", Bsdf::RoughConductor { ks: Vec3::ONE, alpha: alpha_of(r), eta_k: None }),
             ("dielectric", Bsdf::RoughDielectric { ior: 1.5, alpha: alpha_of(r) }),
             ("white plastic", Bsdf::rough_plastic(Vec3::ONE, 1.5, alpha_of(r))),
         ] {

@@ -1,9 +1,10 @@
 //! Mitsuba's BSDFs as Mitsuba 3 itself evaluates them: `tests/data/mitsuba-bsdfs.tsv`, written by
 //! `tests/data/mitsuba-bsdfs.py` through Mitsuba's Python API, holds f and the sampling pdf of
-//! every BSDF photonwave renders as Mitsuba does, over a grid of parameters and direction pairs;
-//! photonwave's eval and pdf must match them.
+//! every BSDF photonwave renders as Mitsuba does, over a grid of parameters and direction pairs
+//! (conductors by Mitsuba's named metals and by η, k with a `specular_reflectance`; for the
+//! smooth `conductor`, a delta lobe, its sample's weight and direction); photonwave's must match.
 //!
-//! Tolerance, derived. The analytic BSDFs (diffuse, rough conductor, rough dielectric) are the
+//! Tolerance, derived. The analytic BSDFs (diffuse, conductors, rough dielectric) are the
 //! same formulas on both sides in f32: some 20 roundings of 6·10⁻⁸ each, so 2·10⁻⁶ relative; with
 //! D and Λ computed from the sine² as x² + y² (not 1 − cos², which loses the peak of a narrow
 //! lobe), near the peaks too. They are held to 10⁻⁵ (measured: 5.5·10⁻⁶). The rough plastic's
@@ -17,7 +18,8 @@
 //! direction where G1 → 0, Mitsuba's cut-off of D·cos below 10⁻²⁰) values count as equal.
 
 use glam::Vec3;
-use photonwave::material::{Bsdf, SurfaceFrame};
+use photonwave::material::{Bsdf, SurfaceFrame, Transport};
+use photonwave::optics::{named_metal, ComplexIor};
 
 /// One row: BSDF name, parameters, wo, wi, f (RGB), pdf.
 struct Row {
@@ -48,11 +50,14 @@ fn rows() -> Vec<Row> {
         .collect()
 }
 
-/// A parameter of a row (`name=value;…`), as numbers.
+/// A parameter of a row (`name=value;…`) as text.
+fn text<'a>(params: &'a str, name: &str) -> Option<&'a str> {
+    params.split(';').find_map(|kv| kv.strip_prefix(name).and_then(|v| v.strip_prefix('=')))
+}
+
+/// A parameter of a row, as numbers.
 fn param(params: &str, name: &str) -> Vec<f32> {
-    params
-        .split(';')
-        .find_map(|kv| kv.strip_prefix(name).and_then(|v| v.strip_prefix('=')))
+    text(params, name)
         .map(|v| {
             v.split(',')
                 .map(|x| {
@@ -74,7 +79,25 @@ fn ours(bsdf: &str, params: &str) -> Bsdf {
     let v3 = |v: Vec<f32>| Vec3::new(v[0], v[1], v[2]);
     match bsdf {
         "diffuse" => Bsdf::Lambert { kd: v3(param(params, "kd")) },
-        "roughconductor" => Bsdf::RoughConductor { ks: Vec3::ONE, alpha: param(params, "alpha")[0] },
+        "roughconductor" | "conductor" => {
+            // As the Mitsuba reader maps them: a named metal's complex index, or η and k, times
+            // `specular_reflectance`.
+            let (ks, eta_k) = match text(params, "metal") {
+                Some(metal) => (Vec3::ONE, named_metal(metal).expect("a metal Mitsuba names")),
+                None => match text(params, "eta") {
+                    Some(_) => (
+                        v3(param(params, "ks")),
+                        ComplexIor { eta: v3(param(params, "eta")), k: v3(param(params, "k")) },
+                    ),
+                    None => (Vec3::ONE, named_metal("none").unwrap()),
+                },
+            };
+            if bsdf == "conductor" {
+                Bsdf::Mirror { ks, eta_k: Some(eta_k) }
+            } else {
+                Bsdf::RoughConductor { ks, alpha: param(params, "alpha")[0], eta_k: Some(eta_k) }
+            }
+        }
         "roughdielectric" => Bsdf::RoughDielectric { ior: param(params, "ior")[0], alpha: param(params, "alpha")[0] },
         "roughplastic" => {
             Bsdf::rough_plastic(v3(param(params, "kd")), param(params, "ior")[0], param(params, "alpha")[0])
@@ -95,7 +118,14 @@ fn every_bsdf_evaluates_as_mitsuba_3_does() {
     assert!(all.len() > 1000, "the table has {} rows", all.len());
     for r in &all {
         let b = ours(&r.bsdf, &r.params);
-        let (f, pdf) = (b.eval(&frame, r.wo, r.wi), b.pdf(&frame, r.wo, r.wi));
+        let (f, pdf) = if r.bsdf == "conductor" {
+            // A delta lobe: the sample's weight and direction.
+            let s = b.sample(&frame, r.wo, [0.5; 3], Transport::Radiance).expect("a mirror reflects");
+            assert!((s.wi - r.wi).length() < 1e-6, "{:?} against {:?}", s.wi, r.wi);
+            (s.weight, 0.0)
+        } else {
+            (b.eval(&frame, r.wo, r.wi), b.pdf(&frame, r.wo, r.wi))
+        };
         let (rel_f, rel_pdf) = if r.bsdf == "roughplastic" { (1e-3, 5e-3) } else { (1e-5, 1e-5) };
         let e = |a: f32, b: f32| (a - b).abs() / (a.abs().max(b.abs()) + 1e3 * abs);
         let w = worst.entry(format!("{} {}", r.bsdf, r.params)).or_default();

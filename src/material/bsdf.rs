@@ -7,7 +7,7 @@
 
 use super::{Bsdf, BsdfSample, SurfaceFrame, Transport, ZeroPdf, PHOTON_SPECULAR_ALPHA};
 use crate::microfacet;
-use crate::optics::{fresnel_dielectric, reflect, refract};
+use crate::optics::{conductor_reflectance, fresnel_dielectric, reflect, refract};
 use crate::sampling::{cosine_hemisphere, Frame};
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -238,10 +238,14 @@ impl Bsdf {
                 let f = kd / PI + ks * phong_lobe(r, wi, exponent);
                 Some(BsdfSample { wi, weight: f * cos / pdf, delta: false })
             }
-            Bsdf::Mirror { ks } => {
+            Bsdf::Mirror { ks, eta_k } => {
                 let (ng, ns) = frame.oriented(wo);
                 let wi = reflect(wo, ns);
-                (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: ks, delta: true })
+                let weight = match eta_k {
+                    Some(ior) => ks * crate::optics::fresnel_conductor(wo.dot(ns), ior),
+                    None => ks,
+                };
+                (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight, delta: true })
             }
             Bsdf::Glass { ior } => sample_glass(frame, wo, ior, u[0], transport),
             Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } | Bsdf::RoughPlastic { .. } => {
@@ -322,7 +326,9 @@ impl Bsdf {
         };
         let (lo, li) = (f.to_local(wo), f.to_local(wi));
         Some(match *self {
-            Bsdf::RoughConductor { ks, alpha } if wi.dot(ng) > 0.0 => microfacet::conductor_eval(lo, li, ks, alpha),
+            Bsdf::RoughConductor { ks, alpha, eta_k } if wi.dot(ng) > 0.0 => {
+                microfacet::conductor_eval(lo, li, |cos| conductor_reflectance(ks, eta_k, cos), alpha)
+            }
             Bsdf::RoughPlastic { .. } if wi.dot(ng) > 0.0 => self.plastic().map_or(Vec3::ZERO, |p| p.eval(lo, li)),
             // Reflection stays on wo's geometric side, refraction crosses it.
             Bsdf::RoughDielectric { alpha, .. } if (wi.dot(ng) > 0.0) == (li.z > 0.0) => {
@@ -389,7 +395,9 @@ impl Bsdf {
             return None;
         }
         let s = match *self {
-            Bsdf::RoughConductor { ks, alpha } => microfacet::conductor_sample(lo, ks, alpha, [u[0], u[1]])?,
+            Bsdf::RoughConductor { ks, alpha, eta_k } => {
+                microfacet::conductor_sample(lo, |cos| conductor_reflectance(ks, eta_k, cos), alpha, [u[0], u[1]])?
+            }
             Bsdf::RoughDielectric { alpha, .. } => microfacet::dielectric_sample(lo, eta, alpha, u, radiance)?,
             Bsdf::RoughPlastic { .. } => self.plastic()?.sample(lo, u)?,
             _ => return None,

@@ -35,14 +35,16 @@ pub enum Bsdf {
     /// Lambertian `kd` plus a normalised modified-Phong lobe `ks·(n+2)/(2π)·cos^n α` around the mirror
     /// direction (Lafortune & Willems 1994); kd + ks ≤ 1 per channel, so it never gains energy.
     Glossy { kd: Vec3, ks: Vec3, exponent: f32 },
-    /// Perfect mirror with reflectance `ks`.
-    Mirror { ks: Vec3 },
+    /// Perfect mirror: reflectance `ks` at every angle, or with the complex index `eta_k` its
+    /// exact Fresnel times `ks` (Mitsuba's `conductor`).
+    Mirror { ks: Vec3, eta_k: Option<crate::optics::ComplexIor> },
     /// Smooth clear dielectric with index of refraction `ior` (relative to the outside, the side
     /// the geometric normal points to), exact Fresnel.
     Glass { ior: f32 },
     /// Rough conductor ([`crate::microfacet`]): GGX of width `alpha` (roughness²), Schlick's
-    /// Fresnel from the normal-incidence reflectance `ks`.
-    RoughConductor { ks: Vec3, alpha: f32 },
+    /// Fresnel from the normal-incidence reflectance `ks`, or with the complex index `eta_k` its
+    /// exact Fresnel times `ks` ([`crate::optics::conductor_reflectance`]).
+    RoughConductor { ks: Vec3, alpha: f32, eta_k: Option<crate::optics::ComplexIor> },
     /// Rough (frosted) clear dielectric: GGX of width `alpha`, exact Fresnel, reflection and
     /// refraction through the microfacets; `ior` as for [`Bsdf::Glass`].
     RoughDielectric { ior: f32, alpha: f32 },
@@ -164,12 +166,12 @@ impl Material {
             // PHOTON_SPECULAR_ALPHA), as plastic does, so the material's photon class is one.
             let (base, ior, nonlinear, alpha) = match self.bsdf {
                 Bsdf::RoughPlastic { kd, alpha, nonlinear, coat } => (kd_at(kd), coat.eta, nonlinear, alpha_at(alpha)),
-                Bsdf::RoughConductor { ks, alpha } => (ks_at(ks), 1.5, false, alpha_at(alpha)),
+                Bsdf::RoughConductor { ks, alpha, .. } => (ks_at(ks), 1.5, false, alpha_at(alpha)),
                 other => return other,
             };
             let base = base.min(Vec3::ONE);
             return if m.lookup(uv).x >= 0.5 {
-                Bsdf::RoughConductor { ks: base, alpha: alpha.max(PHOTON_SPECULAR_ALPHA) }
+                Bsdf::RoughConductor { ks: base, alpha: alpha.max(PHOTON_SPECULAR_ALPHA), eta_k: None }
             } else {
                 plastic_at(base, ior, nonlinear, alpha)
             };
@@ -182,8 +184,8 @@ impl Material {
                 let scale = if sum > 1.0 { 1.0 / sum } else { 1.0 };
                 Bsdf::Glossy { kd: kd * scale, ks: ks * scale, exponent }
             }
-            Bsdf::Mirror { ks } => Bsdf::Mirror { ks: ks_at(ks).min(Vec3::ONE) },
-            Bsdf::RoughConductor { ks, alpha } => {
+            Bsdf::Mirror { ks, eta_k } => Bsdf::Mirror { ks: ks_at(ks).min(Vec3::ONE), eta_k },
+            Bsdf::RoughConductor { ks, alpha, eta_k } => {
                 let a = alpha_at(alpha);
                 // The same photon class as the constant roughness.
                 let a = if alpha < PHOTON_SPECULAR_ALPHA {
@@ -191,7 +193,7 @@ impl Material {
                 } else {
                     a.max(PHOTON_SPECULAR_ALPHA)
                 };
-                Bsdf::RoughConductor { ks: ks_at(ks).min(Vec3::ONE), alpha: a }
+                Bsdf::RoughConductor { ks: ks_at(ks).min(Vec3::ONE), alpha: a, eta_k }
             }
             Bsdf::RoughPlastic { kd, alpha, nonlinear, coat } => {
                 let kd = kd_at(kd).min(Vec3::ONE);
@@ -267,12 +269,12 @@ mod tests {
         };
         assert!((alpha - 0.36).abs() < 1e-6);
         // A conductor whose photons are stored (α ≥ 0.09) stays there, and one whose photons pass stays below.
-        let stored = rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.25 }, 0.1).bsdf_at(uv);
-        assert_eq!(stored, Bsdf::RoughConductor { ks: Vec3::ONE, alpha: PHOTON_SPECULAR_ALPHA });
-        let passed = rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.01 }, 0.9).bsdf_at(uv);
+        let stored = rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.25, eta_k: None }, 0.1).bsdf_at(uv);
+        assert_eq!(stored, Bsdf::RoughConductor { ks: Vec3::ONE, alpha: PHOTON_SPECULAR_ALPHA, eta_k: None });
+        let passed = rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.01, eta_k: None }, 0.9).bsdf_at(uv);
         assert!(passed.photon_specular(), "{passed:?}");
         let Bsdf::RoughConductor { alpha, .. } =
-            rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.01 }, 0.2).bsdf_at(uv)
+            rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.01, eta_k: None }, 0.2).bsdf_at(uv)
         else {
             panic!()
         };
@@ -290,7 +292,10 @@ mod tests {
         let Bsdf::RoughPlastic { kd, alpha, coat, .. } = m.bsdf_at(Vec2::new(0.25, 0.5)) else { panic!() };
         assert_eq!((kd, alpha, coat.eta), (Vec3::new(0.9, 0.5, 0.1), 0.04, 1.4));
         let metal = m.bsdf_at(Vec2::new(0.75, 0.5));
-        assert_eq!(metal, Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.5, 0.1), alpha: PHOTON_SPECULAR_ALPHA });
+        assert_eq!(
+            metal,
+            Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.5, 0.1), alpha: PHOTON_SPECULAR_ALPHA, eta_k: None }
+        );
         assert!(!metal.photon_specular(), "metal parts store photons, as the plastic does");
     }
 

@@ -3,7 +3,7 @@
 //! linear interpolation, and its internal diffuse reflectance F_dr (light from the base reflected
 //! back down by the coat's underside, total internal reflection included). The base's BSDF is
 //! then kd′·T(θo)·T(θi) / (π η²), kd′ = kd / (1 − F_dr) or, `nonlinear`, kd / (1 − kd·F_dr)
-//! ([`crate::microfacet::plastic_base`]).
+//! ([`crate::microfacet::Plastic::base`]).
 //!
 //! Both come from the rough interface's single scattering over the normals m visible from wo
 //! (cos θo = μ): its transmittance T(μ, η) = E_m[(1 − F(wo·m)) · G1(wt) · [wt below]], wt the

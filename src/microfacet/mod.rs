@@ -1,9 +1,10 @@
 //! Rough surfaces: the GGX (Trowbridge–Reitz) microfacet distribution with Smith's separable
 //! masking–shadowing G1(wo)·G1(wi) (Mitsuba 3's, so that its scenes render as it does), sampled
-//! by its distribution of visible normals (Heitz 2018), for a rough conductor (Schlick's Fresnel
-//! from a reflectance colour), a rough dielectric (Walter et al. 2007: reflection and refraction
-//! through the microfacets) and a rough plastic (Mitsuba 3's `roughplastic`: a dielectric coat
-//! over a Lambertian base, with the coat's transmittance and internal reflection from [`coat`]).
+//! by its distribution of visible normals (Heitz 2018), for a rough conductor (the exact Fresnel
+//! of a complex index, or Schlick's from a reflectance colour: [`crate::optics`]), a rough
+//! dielectric (Walter et al. 2007: reflection and refraction through the microfacets) and a rough
+//! plastic (Mitsuba 3's `roughplastic`: a dielectric coat over a Lambertian base, with the coat's
+//! transmittance and internal reflection from [`coat`]).
 //!
 //! Every function works in a local frame whose z axis is the shading normal on the side of
 //! `wo`; directions are unit vectors pointing away from the surface. Single scattering only:
@@ -93,13 +94,6 @@ pub fn sample_visible_normal(wo: Vec3, alpha: f32, u: [f32; 2]) -> Vec3 {
     Vec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(1e-6)).normalize()
 }
 
-/// Schlick's Fresnel for a conductor of normal-incidence reflectance `f0`.
-#[must_use]
-pub fn schlick(f0: Vec3, cos: f32) -> Vec3 {
-    let c = (1.0 - cos.clamp(0.0, 1.0)).powi(5);
-    f0 + (Vec3::ONE - f0) * c
-}
-
 /// A sampled direction of a rough surface, in the local frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LocalSample {
@@ -109,15 +103,15 @@ pub struct LocalSample {
     pub weight: Vec3,
 }
 
-/// Rough conductor: f = F(wo·m)·D(m)·G2 / (4·wo.z·wi.z), m the half vector; zero unless both
-/// directions lie above the surface.
+/// Rough conductor: f = F(wo·m)·D(m)·G2 / (4·wo.z·wi.z), m the half vector, `fresnel` F as a
+/// function of wo·m; zero unless both directions lie above the surface.
 #[must_use]
-pub fn conductor_eval(wo: Vec3, wi: Vec3, f0: Vec3, alpha: f32) -> Vec3 {
+pub fn conductor_eval(wo: Vec3, wi: Vec3, fresnel: impl Fn(f32) -> Vec3, alpha: f32) -> Vec3 {
     if wo.z <= 0.0 || wi.z <= 0.0 {
         return Vec3::ZERO;
     }
     let m = (wo + wi).normalize();
-    schlick(f0, wo.dot(m)) * (d(m, alpha) * g2(wo, wi, alpha) / (4.0 * wo.z * wi.z))
+    fresnel(wo.dot(m)) * (d(m, alpha) * g2(wo, wi, alpha) / (4.0 * wo.z * wi.z))
 }
 
 /// The pdf of [`conductor_sample`]: D_wo(m)/(4·wo·m).
@@ -133,13 +127,13 @@ pub fn conductor_pdf(wo: Vec3, wi: Vec3, alpha: f32) -> f32 {
 /// Samples the rough conductor: a visible normal, then mirror reflection about it; weight
 /// F·G2/G1(wo). `None` when the reflection falls below the surface.
 #[must_use]
-pub fn conductor_sample(wo: Vec3, f0: Vec3, alpha: f32, u: [f32; 2]) -> Option<LocalSample> {
+pub fn conductor_sample(wo: Vec3, fresnel: impl Fn(f32) -> Vec3, alpha: f32, u: [f32; 2]) -> Option<LocalSample> {
     let m = sample_visible_normal(wo, alpha, u);
     let wi = 2.0 * wo.dot(m) * m - wo;
     if wi.z <= 0.0 {
         return None;
     }
-    let weight = schlick(f0, wo.dot(m)) * (g2(wo, wi, alpha) / g1(wo, alpha));
+    let weight = fresnel(wo.dot(m)) * (g2(wo, wi, alpha) / g1(wo, alpha));
     Some(LocalSample { wi, weight })
 }
 

@@ -4,7 +4,7 @@
 Each Mitsuba BSDF that photonwave renders as Mitsuba does is loaded through Mitsuba's Python API
 (`pip install mitsuba`, variant scalar_rgb) with a grid of parameters, and evaluated over pairs of
 directions in the local frame (normal +z): f (Mitsuba's `eval` divided by the cosine it includes)
-and the pdf of its `sample`. Mitsuba's wi (toward the viewer) is photonwave's wo, and Mitsuba's wo
+and the pdf of its `sample`; for the smooth conductor (a delta lobe), its sample's weight. Mitsuba's wi (toward the viewer) is photonwave's wo, and Mitsuba's wo
 photonwave's wi; the table uses photonwave's names.
 
 Not needed to build or test: the table is checked in. Run it again when a BSDF or its parameter
@@ -29,6 +29,25 @@ def configs():
             {"alpha": alpha},
             {"type": "roughconductor", "distribution": "ggx", "alpha": alpha, "material": "none"},
         )
+    # Named metals (Mitsuba's own complex indices) and an explicit η, k with a colour scale.
+    for alpha, metal in [(0.1, "Cu"), (0.3, "Au")]:
+        yield (
+            "roughconductor",
+            {"alpha": alpha, "metal": metal},
+            {"type": "roughconductor", "distribution": "ggx", "alpha": alpha, "material": metal},
+        )
+    yield (
+        "roughconductor",
+        {"alpha": 0.2, "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 2.1], "ks": [0.9, 0.8, 0.7]},
+        {
+            "type": "roughconductor",
+            "distribution": "ggx",
+            "alpha": 0.2,
+            "eta": {"type": "rgb", "value": [0.2, 0.9, 1.1]},
+            "k": {"type": "rgb", "value": [3.9, 2.4, 2.1]},
+            "specular_reflectance": {"type": "rgb", "value": [0.9, 0.8, 0.7]},
+        },
+    )
     for alpha in [0.1, 0.4]:
         yield (
             "roughdielectric",
@@ -50,6 +69,12 @@ def configs():
                     "diffuse_reflectance": {"type": "rgb", "value": KD},
                 },
             )
+
+
+def smooth():
+    """The smooth conductor: its sample's weight is its Fresnel reflectance."""
+    for metal in ["none", "Ag", "Al", "Au", "Cr", "Cu", "W"]:
+        yield "conductor", {"metal": metal}, {"type": "conductor", "material": metal}
 
 
 def direction(theta_deg, phi_deg):
@@ -89,9 +114,19 @@ def main():
     si.sh_frame = mi.Frame3f(si.n)
     si.uv = mi.Point2f(0.5, 0.5)
     rows = []
-    for name, ours, theirs in configs():
+    for name, ours, theirs in list(configs()) + list(smooth()):
         bsdf = mi.load_dict(theirs)
         params = ";".join(f"{k}={','.join(map(str, v)) if isinstance(v, list) else v}" for k, v in ours.items())
+        if name == "conductor":
+            # A delta lobe: its sample's weight (f·cos/pdf of the mirror direction) in f, pdf 0.
+            for theta in [0.0, 30.0, 60.0, 80.0, 89.0]:
+                wo = direction(theta, 10.0)
+                si.wi = mi.Vector3f(wo)
+                bs, weight = bsdf.sample(ctx, si, 0.5, mi.Point2f(0.5, 0.5))
+                wi = [float(bs.wo[c]) for c in range(3)]
+                f = [float(weight[c]) for c in range(3)]
+                rows.append([name, params] + [f"{x:.9g}" for x in wo + wi + f] + ["0"])
+            continue
         for wo, wi in pairs(ours.get("alpha", 0.0), name == "roughdielectric"):
             si.wi = mi.Vector3f(wo)
             value = bsdf.eval(ctx, si, mi.Vector3f(wi))

@@ -141,9 +141,9 @@ pub(super) fn convert(
         } else if metallic >= 0.5 {
             maps.ks = base_map.as_ref().map(|t| derived(t, base, None));
             if roughness < SMOOTH {
-                Bsdf::Mirror { ks: base }
+                Bsdf::Mirror { ks: base, eta_k: None }
             } else {
-                Bsdf::RoughConductor { ks: base, alpha }
+                Bsdf::RoughConductor { ks: base, alpha, eta_k: None }
             }
         } else {
             if metallic > 0.0 {

@@ -7,7 +7,7 @@
 //! | `dielectric` | smooth glass of index `int_ior` / `ext_ior` (numbers or Mitsuba's names) |
 //! | `thindielectric` | smooth glass, warned of (a thin sheet does not bend light; glass does) |
 //! | `roughdielectric` | GGX rough dielectric of width `alpha` |
-//! | `conductor`, `roughconductor` | mirror or GGX rough conductor, reflectance from `eta`, `k` or the named `material` ([`crate::optics::METALS`]), times `specular_reflectance` |
+//! | `conductor`, `roughconductor` | mirror or GGX rough conductor, the exact Fresnel of `eta`, `k` or the named `material` ([`crate::optics::METALS`]), times `specular_reflectance` |
 //! | `plastic`, `roughplastic` | Mitsuba's rough plastic over `diffuse_reflectance`, `nonlinear` read (a smooth coat as α = 0.01, warned of); `specular_reflectance` not read |
 //! | `phong` | normalised Phong (`diffuse_reflectance`, `specular_reflectance`, `exponent`) |
 //! | `bumpmap`, `normalmap`, `mask`, `coating`, `roughcoating`, `blendbsdf`, `mixturebsdf` | the (first) inner BSDF, warned of by name |
@@ -16,8 +16,8 @@
 //! `diffuse`, `roughconductor` (GGX), `roughdielectric` (GGX) and `roughplastic` (GGX) evaluate
 //! as Mitsuba 3 does: `tests/mitsuba_bsdfs.rs` holds their f and pdf to a table written through
 //! Mitsuba's own Python API (`tests/data/mitsuba-bsdfs.py`). Not in it: `phong` (Mitsuba 3 has
-//! none), conductors' Fresnel from `eta`/`k` or a named metal (Schlick's from the normal-incidence
-//! reflectance here), the smooth `plastic`, `thindielectric`, each warned of or noted here.
+//! none), the smooth `conductor` and `dielectric` (delta lobes, no eval or pdf; their Fresnel is the
+//! same function), the smooth `plastic` and `thindielectric` (each warned of).
 //!
 //! Beckmann and Phong microfacet distributions are rendered as GGX of the same α, anisotropic
 //! `alpha_u`/`alpha_v` as their mean; each is warned of. Textures: `bitmap` (`filename`, sRGB for
@@ -29,7 +29,7 @@ use super::Ctx;
 use crate::error::Result;
 use crate::material::{Bsdf, Maps, Material};
 use crate::microfacet::MIN_ALPHA;
-use crate::optics::{conductor_f0, named_metal_f0};
+use crate::optics::{named_metal, ComplexIor};
 use crate::texture::{Encoding, Texture};
 use glam::{Vec2, Vec3};
 use roxmltree::Node;
@@ -247,20 +247,21 @@ impl Ctx<'_> {
                         "none".into()
                     }
                 });
-                let f0 = match (self.r.prop(node, "eta"), self.r.prop(node, "k")) {
-                    (Some(e), Some(k)) => conductor_f0(self.r.colour_of(e)?, self.r.colour_of(k)?),
-                    _ => named_metal_f0(&metal).ok_or_else(|| {
+                let eta_k = match (self.r.prop(node, "eta"), self.r.prop(node, "k")) {
+                    (Some(e), Some(k)) => ComplexIor { eta: self.r.colour_of(e)?, k: self.r.colour_of(k)? },
+                    _ => named_metal(&metal).ok_or_else(|| {
                         let known: Vec<&str> = crate::optics::METALS.iter().map(|m| m.0).collect();
                         self.r.error(node, format!("metal `{metal}` is not known (known: {}, none)", known.join(", ")))
                     })?,
                 };
                 let s = self.coloured(node, "specular_reflectance", Vec3::ONE, Encoding::Srgb)?;
-                let ks = (f0 * s.value).min(Vec3::ONE);
+                // Mitsuba's exact conductor Fresnel, scaled by `specular_reflectance`.
+                let (ks, eta_k) = (s.value.min(Vec3::ONE), Some(eta_k));
                 let maps = Maps { ks: s.map, ..Maps::default() };
                 let bsdf = if kind == "conductor" {
-                    Bsdf::Mirror { ks }
+                    Bsdf::Mirror { ks, eta_k }
                 } else {
-                    Bsdf::RoughConductor { ks, alpha: self.alpha(node, kind)? }
+                    Bsdf::RoughConductor { ks, alpha: self.alpha(node, kind)?, eta_k }
                 };
                 (bsdf, maps, s.uv)
             }

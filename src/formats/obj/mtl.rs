@@ -192,13 +192,15 @@ pub fn material_from_mtl(m: &MtlMaterial, file: &Path, warnings: &mut Vec<String
     let rough = m.pr.filter(|&r| r > 0.0).map(alpha_of);
     let metal = m.pm.is_some_and(|p| p >= 0.5);
     let bsdf = match (m.illum.unwrap_or(2), rough) {
-        (3 | 5 | 8, None) => Bsdf::Mirror { ks: m.ks.unwrap_or(Vec3::ONE).min(Vec3::ONE) },
-        (3 | 5 | 8, Some(alpha)) => Bsdf::RoughConductor { ks: m.ks.unwrap_or(Vec3::ONE).min(Vec3::ONE), alpha },
+        (3 | 5 | 8, None) => Bsdf::Mirror { ks: m.ks.unwrap_or(Vec3::ONE).min(Vec3::ONE), eta_k: None },
+        (3 | 5 | 8, Some(alpha)) => {
+            Bsdf::RoughConductor { ks: m.ks.unwrap_or(Vec3::ONE).min(Vec3::ONE), alpha, eta_k: None }
+        }
         (4 | 6 | 7 | 9, None) => Bsdf::Glass { ior: m.ni.unwrap_or(1.5) },
         (4 | 6 | 7 | 9, Some(alpha)) => Bsdf::RoughDielectric { ior: m.ni.unwrap_or(1.5), alpha },
         // The PBR extension's metals take their colour from `Kd` (the base colour).
-        (_, None) if metal => Bsdf::Mirror { ks: kd.min(Vec3::ONE) },
-        (_, Some(alpha)) if metal => Bsdf::RoughConductor { ks: kd.min(Vec3::ONE), alpha },
+        (_, None) if metal => Bsdf::Mirror { ks: kd.min(Vec3::ONE), eta_k: None },
+        (_, Some(alpha)) if metal => Bsdf::RoughConductor { ks: kd.min(Vec3::ONE), alpha, eta_k: None },
         // A rough non-metal: the PBR extension's dielectric, a coat over the base colour.
         (_, Some(alpha)) => Bsdf::rough_plastic(kd.min(Vec3::ONE), m.ni.unwrap_or(1.5), alpha),
         (2, _) if ks.max_element() > 0.0 => {
@@ -403,10 +405,10 @@ mod tests {
         let m = m.unwrap();
         let mut w2 = Vec::new();
         let b: Vec<Bsdf> = m.iter().map(|x| material_from_mtl(x, Path::new("t.mtl"), &mut w2).bsdf).collect();
-        assert_eq!(b[0], Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.6, 0.3), alpha: alpha_of(0.4) });
+        assert_eq!(b[0], Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.6, 0.3), alpha: alpha_of(0.4), eta_k: None });
         assert!(m[0].map("map_Pr").is_some(), "map_Pr before Pr is kept");
         assert_eq!(b[1], Bsdf::RoughDielectric { ior: 1.4, alpha: alpha_of(0.5) });
-        assert_eq!(b[2], Bsdf::Mirror { ks: Vec3::splat(0.8) });
+        assert_eq!(b[2], Bsdf::Mirror { ks: Vec3::splat(0.8), eta_k: None });
         assert_eq!(b[3], Bsdf::rough_plastic(Vec3::splat(0.5), 1.5, alpha_of(0.3)));
         assert!(w.is_empty(), "{w:?}");
         for bad in ["Pr 1.5", "Pr -0.1", "Pm 2"] {

@@ -8,7 +8,7 @@
 
 use crate::error::{Error, Result};
 use crate::material::{Bsdf, Material};
-use crate::optics::{conductor_f0, named_metal_f0, METALS};
+use crate::optics::{named_metal, ComplexIor, METALS};
 use glam::Vec3;
 use serde::Deserialize;
 
@@ -148,10 +148,12 @@ impl MaterialEntry {
                 }
                 (Bsdf::Glossy { kd, ks, exponent }, emission)
             }
-            MaterialEntry::Mirror { ks, emission } => (Bsdf::Mirror { ks: albedo(&f("ks"), ks)? }, emission),
+            MaterialEntry::Mirror { ks, emission } => {
+                (Bsdf::Mirror { ks: albedo(&f("ks"), ks)?, eta_k: None }, emission)
+            }
             MaterialEntry::RoughConductor { ks, roughness, emission } => {
                 let alpha = roughness_alpha(&f("roughness"), roughness)?;
-                (Bsdf::RoughConductor { ks: albedo(&f("ks"), ks)?, alpha }, emission)
+                (Bsdf::RoughConductor { ks: albedo(&f("ks"), ks)?, alpha, eta_k: None }, emission)
             }
             MaterialEntry::RoughPlastic { kd, ior, roughness, emission } => {
                 let alpha = roughness_alpha(&f("roughness"), roughness)?;
@@ -168,8 +170,8 @@ impl MaterialEntry {
                 (Bsdf::RoughDielectric { ior: finite_ratio(&f("ior"), ior / outside_ior)?, alpha }, emission)
             }
             MaterialEntry::Conductor { eta, k, ref metal, roughness, emission } => {
-                let ks = match (eta, k, metal) {
-                    (None, None, Some(name)) => named_metal_f0(name).ok_or_else(|| {
+                let eta_k = match (eta, k, metal) {
+                    (None, None, Some(name)) => named_metal(name).ok_or_else(|| {
                         let known: Vec<&str> = METALS.iter().map(|m| m.0).collect();
                         Error::setting(
                             f("metal"),
@@ -181,14 +183,17 @@ impl MaterialEntry {
                         if eta.min_element() <= 0.0 {
                             return Err(Error::setting(f("eta"), "must be positive"));
                         }
-                        conductor_f0(eta, k)
+                        ComplexIor { eta, k }
                     }
                     _ => return Err(Error::setting(f("type"), "a conductor takes `eta` and `k`, or `metal`")),
                 };
+                // The exact Fresnel of the complex index (`ks` is its scale).
+                let (ks, eta_k) = (Vec3::ONE, Some(eta_k));
                 if roughness == 0.0 {
-                    (Bsdf::Mirror { ks }, emission)
+                    (Bsdf::Mirror { ks, eta_k }, emission)
                 } else {
-                    (Bsdf::RoughConductor { ks, alpha: roughness_alpha(&f("roughness"), roughness)? }, emission)
+                    let alpha = roughness_alpha(&f("roughness"), roughness)?;
+                    (Bsdf::RoughConductor { ks, alpha, eta_k }, emission)
                 }
             }
             MaterialEntry::Glass { ior, outside_ior, emission } => {
