@@ -19,6 +19,16 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     (0.5 * (r_parl * r_parl + r_perp * r_perp)).clamp(0.0, 1.0)
 }
 
+/// The reflectance of a thin slab of relative index `eta` at incidence cos θ = `cos_i`: each face
+/// reflects R = F(cos θ, η), and light bouncing between the faces adds T·R·T/(1 − R²) (T = 1 − R,
+/// no absorption), so R′ = R + (1 − R)²R/(1 − R²) = 2R/(1 + R); the slab transmits 1 − R′ straight
+/// through. Mitsuba's `thindielectric` takes this reflectance.
+#[must_use]
+pub fn thin_slab_reflectance(cos_i: f32, eta: f32) -> f32 {
+    let r = fresnel_dielectric(cos_i.abs(), eta);
+    2.0 * r / (1.0 + r)
+}
+
 /// Mirror reflection of `wo` about `n`.
 #[inline]
 #[must_use]

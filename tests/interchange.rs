@@ -633,3 +633,56 @@ fn mitsuba_textures_envmaps_phong_and_every_fov_axis() {
         assert!((got - want).abs().max_element() < 1e-5, "column {column}: {got} against {want}");
     }
 }
+
+/// A Mitsuba `thindielectric` pane between the camera and a black-backed emitter (Le = 1): every
+/// camera ray passes straight through with probability 1 − R′(θ), R′ the slab's reflectance
+/// 2R/(1 + R), and what it reflects leaves the scene. So each engine's image mean is the mean
+/// over pixels of 1 − R′ (≈ 0.923 at η = 1.5 near normal incidence), a solid glass interface's
+/// would be (1 − R)/η² ≈ 0.43. Tolerance: a sample is 1 or 0, so the image mean of N samples has
+/// σ = √(R′(1 − R′)/N) (0.0026 at N = 16²·40); held to 4σ at each of four seeds per engine.
+#[test]
+fn a_thin_sheet_passes_one_minus_its_reflectance_straight_through() {
+    let d = scratch_dir("thin-sheet");
+    let xml = "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><float name=\"fov\" value=\"10\"/>\
+<transform name=\"to_world\"><lookat origin=\"0, 0, 3\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform>\
+<film type=\"hdrfilm\"><integer name=\"width\" value=\"16\"/><integer name=\"height\" value=\"16\"/></film></sensor>\n\
+<shape type=\"rectangle\"><transform name=\"to_world\"><scale value=\"4\"/><translate z=\"-1\"/></transform>\
+<bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0\"/></bsdf><emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter></shape>\n\
+<shape type=\"rectangle\"><transform name=\"to_world\"><scale value=\"4\"/></transform><bsdf type=\"thindielectric\"/></shape>\n</scene>\n";
+    let path = d.join("pane.xml");
+    std::fs::write(&path, xml).unwrap();
+    let loaded = load_scene(&path).unwrap();
+    let cam = loaded.camera.unwrap();
+    let rays = cam.prepare(16, 16).unwrap();
+    let eta = 1.5 / 1.000277;
+    // The expected mean: 1 − R′ at each pixel centre's angle to the pane's normal.
+    let dirs = (0..16 * 16).map(|i| {
+        let (x, y) = ((i % 16) as f32 + 0.5, (i / 16) as f32 + 0.5);
+        let t = (5f32.to_radians()).tan();
+        Vec3::new((x / 8.0 - 1.0) * t, (1.0 - y / 8.0) * t, -1.0).normalize()
+    });
+    let expected: f64 =
+        dirs.map(|w| 1.0 - f64::from(photonwave::optics::thin_slab_reflectance(-w.z, eta))).sum::<f64>() / 256.0;
+    let n = 16.0 * 16.0 * 40.0;
+    let sigma = (expected * (1.0 - expected) / n).sqrt();
+    let scene = Arc::new(loaded.scene);
+    for engine in [Engine::Wavefront, Engine::Reference, Engine::Path] {
+        for seed in 1..=4 {
+            let s = Settings {
+                width: 16,
+                height: 16,
+                spp: 40,
+                photons: 2000,
+                caustic_photons: 2000,
+                seed,
+                ..Settings::default()
+            };
+            let film = render(&scene, &rays, &s, engine, None, &NoProgress).unwrap().0;
+            let mean = f64::from(film.mean().element_sum() / 3.0);
+            assert!(
+                (mean - expected).abs() < 4.0 * sigma,
+                "{engine:?} seed {seed}: mean {mean} against 1 − R′ = {expected} (σ {sigma})"
+            );
+        }
+    }
+}

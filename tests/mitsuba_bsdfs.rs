@@ -2,7 +2,8 @@
 //! `tests/data/mitsuba-bsdfs.py` through Mitsuba's Python API, holds f and the sampling pdf of
 //! every BSDF photonwave renders as Mitsuba does, over a grid of parameters and direction pairs
 //! (conductors by Mitsuba's named metals and by η, k with a `specular_reflectance`; for the
-//! smooth `conductor`, a delta lobe, its sample's weight and direction); photonwave's must match.
+//! smooth `conductor` and the `thindielectric`, delta lobes, a sample's direction and weight and
+//! the probability of its lobe); photonwave's must match.
 //!
 //! Tolerance, derived. The analytic BSDFs (diffuse, conductors, rough dielectric) are the
 //! same formulas on both sides in f32: some 20 roundings of 6·10⁻⁸ each, so 2·10⁻⁶ relative; with
@@ -19,7 +20,7 @@
 
 use glam::Vec3;
 use photonwave::material::{Bsdf, SurfaceFrame, Transport};
-use photonwave::optics::{named_metal, ComplexIor};
+use photonwave::optics::{named_metal, thin_slab_reflectance, ComplexIor};
 
 /// One row: BSDF name, parameters, wo, wi, f (RGB), pdf.
 struct Row {
@@ -103,6 +104,7 @@ fn ours(bsdf: &str, params: &str) -> Bsdf {
             Bsdf::rough_plastic(v3(param(params, "kd")), param(params, "ior")[0], param(params, "alpha")[0])
                 .with_nonlinear(param(params, "nonlinear")[0] == 1.0)
         }
+        "thindielectric" => Bsdf::ThinGlass { ior: param(params, "ior")[0] },
         other => panic!("no mapping for {other}"),
     }
 }
@@ -118,11 +120,18 @@ fn every_bsdf_evaluates_as_mitsuba_3_does() {
     assert!(all.len() > 1000, "the table has {} rows", all.len());
     for r in &all {
         let b = ours(&r.bsdf, &r.params);
-        let (f, pdf) = if r.bsdf == "conductor" {
-            // A delta lobe: the sample's weight and direction.
-            let s = b.sample(&frame, r.wo, [0.5; 3], Transport::Radiance).expect("a mirror reflects");
-            assert!((s.wi - r.wi).length() < 1e-6, "{:?} against {:?}", s.wi, r.wi);
-            (s.weight, 0.0)
+        let (f, pdf) = if b.is_delta() {
+            // A delta lobe: the sample's direction and weight, and the chosen lobe's probability
+            // (the sheet's reflectance R′ or 1 − R′; 1 for the mirror).
+            let reflects = r.wi.z * r.wo.z > 0.0;
+            let u = if reflects { 0.0 } else { 0.99999 };
+            let s = b.sample(&frame, r.wo, [u, 0.5, 0.5], Transport::Radiance).expect("a delta lobe scatters");
+            assert!((s.wi - r.wi).length() < 1e-6, "{} {}: {:?} against {:?}", r.bsdf, r.params, s.wi, r.wi);
+            let p = match b {
+                Bsdf::ThinGlass { ior } => thin_slab_reflectance(r.wo.z, ior),
+                _ => 1.0,
+            };
+            (s.weight, if reflects { p } else { 1.0 - p })
         } else {
             (b.eval(&frame, r.wo, r.wi), b.pdf(&frame, r.wo, r.wi))
         };

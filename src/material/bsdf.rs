@@ -7,7 +7,7 @@
 
 use super::{Bsdf, BsdfSample, SurfaceFrame, Transport, ZeroPdf, PHOTON_SPECULAR_ALPHA};
 use crate::microfacet;
-use crate::optics::{conductor_reflectance, fresnel_dielectric, reflect, refract};
+use crate::optics::{conductor_reflectance, fresnel_dielectric, reflect, refract, thin_slab_reflectance};
 use crate::sampling::{cosine_hemisphere, Frame};
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -16,13 +16,13 @@ impl Bsdf {
     /// True for materials that only scatter into delta directions (mirror, glass).
     #[must_use]
     pub fn is_delta(&self) -> bool {
-        matches!(self, Bsdf::Mirror { .. } | Bsdf::Glass { .. })
+        matches!(self, Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::ThinGlass { .. })
     }
 
     /// True for materials that let light through (glass, rough glass).
     #[must_use]
     pub fn transmits(&self) -> bool {
-        matches!(self, Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. })
+        matches!(self, Bsdf::Glass { .. } | Bsdf::ThinGlass { .. } | Bsdf::RoughDielectric { .. })
     }
 
     /// True for surfaces photons pass on as specular (neither stored there nor ending a caustic
@@ -31,7 +31,7 @@ impl Bsdf {
     #[must_use]
     pub fn photon_specular(&self) -> bool {
         match *self {
-            Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. } => true,
+            Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::ThinGlass { .. } | Bsdf::RoughDielectric { .. } => true,
             Bsdf::RoughConductor { alpha, .. } => alpha < PHOTON_SPECULAR_ALPHA,
             _ => false,
         }
@@ -141,7 +141,7 @@ impl Bsdf {
                     kd / PI + ks * phong_lobe(reflect(wo, ns), wi, exponent)
                 }
             }
-            Bsdf::Mirror { .. } | Bsdf::Glass { .. } => Vec3::ZERO,
+            Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::ThinGlass { .. } => Vec3::ZERO,
             _ => self.eval_rough(frame, wo, wi).unwrap_or(Vec3::ZERO),
         }
     }
@@ -248,6 +248,7 @@ impl Bsdf {
                 (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight, delta: true })
             }
             Bsdf::Glass { ior } => sample_glass(frame, wo, ior, u[0], transport),
+            Bsdf::ThinGlass { ior } => sample_thin_glass(frame, wo, ior, u[0]),
             Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } | Bsdf::RoughPlastic { .. } => {
                 self.sample_rough(frame, wo, u, transport == Transport::Radiance)
             }
@@ -381,7 +382,7 @@ impl Bsdf {
                 }
                 microfacet::dielectric_pdf(f.to_local(wo), li, eta, alpha)
             }
-            Bsdf::Mirror { .. } | Bsdf::Glass { .. } => 0.0,
+            Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::ThinGlass { .. } => 0.0,
         }
     }
 
@@ -446,6 +447,18 @@ fn sample_phong(r: Vec3, n: f32, u: [f32; 2]) -> Vec3 {
     let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
     let phi = 2.0 * PI * u[1];
     Frame::new(r).to_world(Vec3::new(sin_a * phi.cos(), sin_a * phi.sin(), cos_a))
+}
+
+/// A thin sheet: reflection about the shading normal with the slab's reflectance R′
+/// ([`thin_slab_reflectance`]) as its probability, otherwise straight through (wi = −wo); the
+/// weight is 1 either way, and no (η_wo/η_wi)² (the light leaves into the medium it came from).
+fn sample_thin_glass(frame: &SurfaceFrame, wo: Vec3, ior: f32, u: f32) -> Option<BsdfSample> {
+    let (ng, ns) = frame.oriented(wo);
+    if u < thin_slab_reflectance(wo.dot(ns), ior) {
+        let wi = reflect(wo, ns);
+        return (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: Vec3::ONE, delta: true });
+    }
+    Some(BsdfSample { wi: -wo, weight: Vec3::ONE, delta: true })
 }
 
 /// Chooses reflection with probability F, refraction otherwise; the weight is 1 (power) or

@@ -41,6 +41,10 @@ pub enum Bsdf {
     /// Smooth clear dielectric with index of refraction `ior` (relative to the outside, the side
     /// the geometric normal points to), exact Fresnel.
     Glass { ior: f32 },
+    /// A thin dielectric sheet of index `ior` (Mitsuba's `thindielectric`, a window pane): light
+    /// passes straight through, unbent, or is reflected, with the slab's reflectance
+    /// ([`crate::optics::thin_slab_reflectance`]: the two faces and every bounce between them).
+    ThinGlass { ior: f32 },
     /// Rough conductor ([`crate::microfacet`]): GGX of width `alpha` (roughness²), Schlick's
     /// Fresnel from the normal-incidence reflectance `ks`, or with the complex index `eta_k` its
     /// exact Fresnel times `ks` ([`crate::optics::conductor_reflectance`]).
@@ -203,7 +207,7 @@ impl Material {
                 }
             }
             Bsdf::RoughDielectric { ior, alpha } => Bsdf::RoughDielectric { ior, alpha: alpha_at(alpha) },
-            b @ Bsdf::Glass { .. } => b,
+            b @ (Bsdf::Glass { .. } | Bsdf::ThinGlass { .. }) => b,
         }
     }
 }

@@ -130,7 +130,7 @@ impl Scene {
         }
         for (m, _) in self.materials.iter().zip(&used).filter(|(_, u)| **u) {
             self.kinds.0 |= m.bsdf.photon_specular();
-            self.kinds.1 |= matches!(m.bsdf, Bsdf::Glass { .. });
+            self.kinds.1 |= matches!(m.bsdf, Bsdf::Glass { .. } | Bsdf::ThinGlass { .. });
             self.kinds.2 |= !m.bsdf.is_delta();
         }
     }

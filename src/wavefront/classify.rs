@@ -27,7 +27,7 @@ pub fn classify(scene: &Scene, hits: &HitColumns, paths: bool, out: &mut Classif
             let bsdf = &scene.materials[scene.material[tri as usize] as usize].bsdf;
             match bsdf {
                 Bsdf::Mirror { .. } => &mut out.mirror,
-                Bsdf::Glass { .. } => &mut out.glass,
+                Bsdf::Glass { .. } | Bsdf::ThinGlass { .. } => &mut out.glass,
                 b if paths && b.photon_specular() => &mut out.mirror,
                 _ => &mut out.diffuse,
             }

@@ -4,7 +4,7 @@
 Each Mitsuba BSDF that photonwave renders as Mitsuba does is loaded through Mitsuba's Python API
 (`pip install mitsuba`, variant scalar_rgb) with a grid of parameters, and evaluated over pairs of
 directions in the local frame (normal +z): f (Mitsuba's `eval` divided by the cosine it includes)
-and the pdf of its `sample`; for the smooth conductor (a delta lobe), its sample's weight. Mitsuba's wi (toward the viewer) is photonwave's wo, and Mitsuba's wo
+and the pdf of its `sample`; for the delta lobes (smooth conductor, thin dielectric), a sample's direction, weight and lobe probability. Mitsuba's wi (toward the viewer) is photonwave's wo, and Mitsuba's wo
 photonwave's wi; the table uses photonwave's names.
 
 Not needed to build or test: the table is checked in. Run it again when a BSDF or its parameter
@@ -75,6 +75,7 @@ def smooth():
     """The smooth conductor: its sample's weight is its Fresnel reflectance."""
     for metal in ["none", "Ag", "Al", "Au", "Cr", "Cu", "W"]:
         yield "conductor", {"metal": metal}, {"type": "conductor", "material": metal}
+    yield "thindielectric", {"ior": 1.5}, {"type": "thindielectric", "int_ior": 1.5, "ext_ior": 1.0}
 
 
 def direction(theta_deg, phi_deg):
@@ -117,15 +118,21 @@ def main():
     for name, ours, theirs in list(configs()) + list(smooth()):
         bsdf = mi.load_dict(theirs)
         params = ";".join(f"{k}={','.join(map(str, v)) if isinstance(v, list) else v}" for k, v in ours.items())
-        if name == "conductor":
-            # A delta lobe: its sample's weight (f·cos/pdf of the mirror direction) in f, pdf 0.
-            for theta in [0.0, 30.0, 60.0, 80.0, 89.0]:
+        if name in ("conductor", "thindielectric"):
+            # Delta lobes: a sample's direction and weight (f·cos/pdf) in f, and the probability
+            # of the lobe it chose in pdf (1 for the mirror); the thin sheet's reflection
+            # (sample1 = 0) and transmission (sample1 just below 1), from either side.
+            choices = [0.5] if name == "conductor" else [0.0, 0.99999]
+            for theta in [0.0, 30.0, 60.0, 80.0, 89.0, 120.0, 170.0]:
+                if name == "conductor" and theta > 90.0:
+                    continue
                 wo = direction(theta, 10.0)
                 si.wi = mi.Vector3f(wo)
-                bs, weight = bsdf.sample(ctx, si, 0.5, mi.Point2f(0.5, 0.5))
-                wi = [float(bs.wo[c]) for c in range(3)]
-                f = [float(weight[c]) for c in range(3)]
-                rows.append([name, params] + [f"{x:.9g}" for x in wo + wi + f] + ["0"])
+                for u in choices:
+                    bs, weight = bsdf.sample(ctx, si, u, mi.Point2f(0.5, 0.5))
+                    wi = [float(bs.wo[c]) for c in range(3)]
+                    f = [float(weight[c]) for c in range(3)]
+                    rows.append([name, params] + [f"{x:.9g}" for x in wo + wi + f] + [f"{float(bs.pdf):.9g}"])
             continue
         for wo, wi in pairs(ours.get("alpha", 0.0), name == "roughdielectric"):
             si.wi = mi.Vector3f(wo)

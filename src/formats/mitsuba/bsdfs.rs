@@ -5,7 +5,7 @@
 //! | `diffuse` | Lambertian (`reflectance`, a colour or a texture) |
 //! | `twosided` | its inner BSDF (photonwave's opaque materials are two-sided already) |
 //! | `dielectric` | smooth glass of index `int_ior` / `ext_ior` (numbers or Mitsuba's names) |
-//! | `thindielectric` | smooth glass, warned of (a thin sheet does not bend light; glass does) |
+//! | `thindielectric` | a thin sheet: straight through or reflected with the slab's reflectance |
 //! | `roughdielectric` | GGX rough dielectric of width `alpha` |
 //! | `conductor`, `roughconductor` | mirror or GGX rough conductor, the exact Fresnel of `eta`, `k` or the named `material` ([`crate::optics::METALS`]), times `specular_reflectance` |
 //! | `plastic`, `roughplastic` | Mitsuba's rough plastic over `diffuse_reflectance`, `nonlinear` read (a smooth coat as α = 0.01, warned of); `specular_reflectance` not read |
@@ -17,7 +17,8 @@
 //! as Mitsuba 3 does: `tests/mitsuba_bsdfs.rs` holds their f and pdf to a table written through
 //! Mitsuba's own Python API (`tests/data/mitsuba-bsdfs.py`). Not in it: `phong` (Mitsuba 3 has
 //! none), the smooth `conductor` and `dielectric` (delta lobes, no eval or pdf; their Fresnel is the
-//! same function), the smooth `plastic` and `thindielectric` (each warned of).
+//! same function; `thindielectric`'s directions and reflectance are in the table as its sample's),
+//! the smooth `plastic` (warned of).
 //!
 //! Beckmann and Phong microfacet distributions are rendered as GGX of the same α, anisotropic
 //! `alpha_u`/`alpha_v` as their mean; each is warned of. Textures: `bitmap` (`filename`, sRGB for
@@ -225,17 +226,10 @@ impl Ctx<'_> {
             }
             "dielectric" | "thindielectric" | "roughdielectric" => {
                 let ior = self.ior_ratio(node, 1.5046)?;
-                if kind == "thindielectric" {
-                    self.warn(
-                        node,
-                        "thindielectric is rendered as solid glass (refraction bends rays a thin sheet would not)"
-                            .to_string(),
-                    );
-                }
-                let bsdf = if kind == "roughdielectric" {
-                    Bsdf::RoughDielectric { ior, alpha: self.alpha(node, kind)? }
-                } else {
-                    Bsdf::Glass { ior }
+                let bsdf = match kind {
+                    "roughdielectric" => Bsdf::RoughDielectric { ior, alpha: self.alpha(node, kind)? },
+                    "thindielectric" => Bsdf::ThinGlass { ior },
+                    _ => Bsdf::Glass { ior },
                 };
                 (bsdf, Maps::default(), None)
             }
