@@ -103,6 +103,7 @@ fn ours(bsdf: &str, params: &str) -> Bsdf {
         "roughplastic" => {
             Bsdf::rough_plastic(v3(param(params, "kd")), param(params, "ior")[0], param(params, "alpha")[0])
                 .with_nonlinear(param(params, "nonlinear")[0] == 1.0)
+                .with_coat_scale(v3(param(params, "ks")))
         }
         "thindielectric" => Bsdf::ThinGlass { ior: param(params, "ior")[0] },
         other => panic!("no mapping for {other}"),

@@ -76,8 +76,8 @@ impl Bsdf {
     #[must_use]
     pub fn plastic(&self) -> Option<microfacet::Plastic> {
         match *self {
-            Bsdf::RoughPlastic { kd, alpha, nonlinear, coat } => {
-                Some(microfacet::Plastic { kd, coat, alpha, nonlinear })
+            Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat } => {
+                Some(microfacet::Plastic { kd, ks, coat, alpha, nonlinear })
             }
             _ => None,
         }
@@ -159,12 +159,12 @@ impl Bsdf {
                 }
                 ks * phong_lobe(reflect(wo, ns), wi, exponent)
             }
-            Bsdf::RoughPlastic { alpha, coat, .. } => {
+            Bsdf::RoughPlastic { ks, alpha, coat, .. } => {
                 let (ng, f, _) = self.rough_frame(frame, wo);
                 if wi.dot(ng) <= 0.0 {
                     return Vec3::ZERO;
                 }
-                Vec3::splat(microfacet::plastic_coat_eval(f.to_local(wo), f.to_local(wi), coat.eta, alpha))
+                ks * microfacet::plastic_coat_eval(f.to_local(wo), f.to_local(wi), coat.eta, alpha)
             }
             _ => self.eval_rough(frame, wo, wi).unwrap_or(Vec3::ZERO),
         }
@@ -278,7 +278,7 @@ impl Bsdf {
         if let Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } = self {
             return self.sample_rough(frame, wo, u, true);
         }
-        if let Bsdf::RoughPlastic { alpha, coat, .. } = *self {
+        if let Bsdf::RoughPlastic { ks, alpha, coat, .. } = *self {
             let (ng, f, _) = self.rough_frame(frame, wo);
             let lo = f.to_local(wo);
             if lo.z <= 0.0 {
@@ -286,7 +286,7 @@ impl Bsdf {
             }
             let s = microfacet::plastic_coat_sample(lo, coat.eta, alpha, [u[0], u[1]])?;
             let wi = f.to_world(s.wi);
-            return (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: s.weight, delta: false });
+            return (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: ks * s.weight, delta: false });
         }
         let Bsdf::Glossy { ks, exponent, .. } = *self else { return None };
         let (ng, ns) = frame.oriented(wo);

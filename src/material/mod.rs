@@ -53,10 +53,11 @@ pub enum Bsdf {
     /// refraction through the microfacets; `ior` as for [`Bsdf::Glass`].
     RoughDielectric { ior: f32, alpha: f32 },
     /// Rough plastic, Mitsuba 3's `roughplastic` ([`microfacet::Plastic`]): a GGX dielectric
-    /// coat of width `alpha` over a Lambertian base `kd`; `coat` holds its index ratio and its
+    /// coat of width `alpha` over a Lambertian base `kd`, the coat's reflection scaled by `ks`
+    /// (Mitsuba's `specular_reflectance`, 1 elsewhere); `coat` holds its index ratio and its
     /// transmittance tables ([`Bsdf::rough_plastic`] builds it); `nonlinear` lets the base's
     /// bounces under the coat tint by kd.
-    RoughPlastic { kd: Vec3, alpha: f32, nonlinear: bool, coat: microfacet::CoatAt },
+    RoughPlastic { kd: Vec3, ks: Vec3, alpha: f32, nonlinear: bool, coat: microfacet::CoatAt },
 }
 
 impl Bsdf {
@@ -65,7 +66,7 @@ impl Bsdf {
     #[must_use]
     pub fn rough_plastic(kd: Vec3, ior: f32, alpha: f32) -> Bsdf {
         let alpha = alpha.max(microfacet::MIN_ALPHA);
-        Bsdf::RoughPlastic { kd, alpha, nonlinear: false, coat: microfacet::CoatAt::new(ior, alpha) }
+        Bsdf::RoughPlastic { kd, ks: Vec3::ONE, alpha, nonlinear: false, coat: microfacet::CoatAt::new(ior, alpha) }
     }
 
     /// A rough plastic whose base's bounces under the coat tint by kd (`nonlinear`, Mitsuba's
@@ -73,7 +74,19 @@ impl Bsdf {
     #[must_use]
     pub fn with_nonlinear(self, nonlinear: bool) -> Bsdf {
         match self {
-            Bsdf::RoughPlastic { kd, alpha, coat, .. } => Bsdf::RoughPlastic { kd, alpha, nonlinear, coat },
+            Bsdf::RoughPlastic { kd, ks, alpha, coat, .. } => Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat },
+            other => other,
+        }
+    }
+
+    /// A rough plastic whose coat's reflection is scaled by `ks` (Mitsuba's
+    /// `specular_reflectance`); other materials unchanged.
+    #[must_use]
+    pub fn with_coat_scale(self, ks: Vec3) -> Bsdf {
+        match self {
+            Bsdf::RoughPlastic { kd, alpha, nonlinear, coat, .. } => {
+                Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat }
+            }
             other => other,
         }
     }
@@ -169,7 +182,9 @@ impl Material {
             // reflectance or a plastic's base. Metal parts store photons (α at least
             // PHOTON_SPECULAR_ALPHA), as plastic does, so the material's photon class is one.
             let (base, ior, nonlinear, alpha) = match self.bsdf {
-                Bsdf::RoughPlastic { kd, alpha, nonlinear, coat } => (kd_at(kd), coat.eta, nonlinear, alpha_at(alpha)),
+                Bsdf::RoughPlastic { kd, alpha, nonlinear, coat, .. } => {
+                    (kd_at(kd), coat.eta, nonlinear, alpha_at(alpha))
+                }
                 Bsdf::RoughConductor { ks, alpha, .. } => (ks_at(ks), 1.5, false, alpha_at(alpha)),
                 other => return other,
             };
@@ -199,11 +214,11 @@ impl Material {
                 };
                 Bsdf::RoughConductor { ks: ks_at(ks).min(Vec3::ONE), alpha: a, eta_k }
             }
-            Bsdf::RoughPlastic { kd, alpha, nonlinear, coat } => {
+            Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat } => {
                 let kd = kd_at(kd).min(Vec3::ONE);
                 match &self.maps.roughness {
-                    Some(_) => plastic_at(kd, coat.eta, nonlinear, alpha_at(alpha)),
-                    None => Bsdf::RoughPlastic { kd, alpha, nonlinear, coat },
+                    Some(_) => plastic_at(kd, coat.eta, nonlinear, alpha_at(alpha)).with_coat_scale(ks),
+                    None => Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat },
                 }
             }
             Bsdf::RoughDielectric { ior, alpha } => Bsdf::RoughDielectric { ior, alpha: alpha_at(alpha) },
@@ -216,7 +231,7 @@ impl Material {
 /// levels around it give the coat's tables ([`microfacet::CoatAt::textured`]).
 fn plastic_at(kd: Vec3, ior: f32, nonlinear: bool, alpha: f32) -> Bsdf {
     let alpha = alpha.max(microfacet::MIN_ALPHA);
-    Bsdf::RoughPlastic { kd, alpha, nonlinear, coat: microfacet::CoatAt::textured(ior, alpha) }
+    Bsdf::RoughPlastic { kd, ks: Vec3::ONE, alpha, nonlinear, coat: microfacet::CoatAt::textured(ior, alpha) }
 }
 
 /// A BSDF sample whose pdf came out zero (see [`Bsdf::sample_checked`]).

@@ -205,7 +205,7 @@ pub fn dielectric_sample(wo: Vec3, eta: f32, alpha: f32, u: [f32; 3], radiance: 
 
 /// A rough plastic at a point (Mitsuba 3's `roughplastic`): a GGX dielectric coat of width
 /// `alpha` over a Lambertian base `kd`, the coat's index ratio and tables in `coat`.
-/// f = F(wo·m)·D·G2/(4·wo.z·wi.z) + kd′·T(wo.z)·T(wi.z)/(π η²): the coat reflects by its
+/// f = ks·F(wo·m)·D·G2/(4·wo.z·wi.z) + kd′·T(wo.z)·T(wi.z)/(π η²): the coat reflects by its
 /// microfacets; light crosses it into the base and back out (T each way, T the rough coat's
 /// transmittance), is spread over the solid angle inside (1/η²), and bounces between the base and
 /// the coat's underside (kd′ = kd / (1 − F_dr), or kd / (1 − kd·F_dr) when `nonlinear`).
@@ -213,6 +213,8 @@ pub fn dielectric_sample(wo: Vec3, eta: f32, alpha: f32, u: [f32; 3], radiance: 
 pub struct Plastic {
     /// Base albedo.
     pub kd: Vec3,
+    /// The coat reflection's scale (Mitsuba's `specular_reflectance`).
+    pub ks: Vec3,
     /// The coat's tables and index ratio.
     pub coat: CoatAt,
     /// The coat's GGX width at this point.
@@ -228,7 +230,7 @@ impl Plastic {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Vec3::ZERO;
         }
-        Vec3::splat(plastic_coat_eval(wo, wi, self.coat.eta, self.alpha)) + self.base(wo, wi) / PI
+        self.ks * plastic_coat_eval(wo, wi, self.coat.eta, self.alpha) + self.base(wo, wi) / PI
     }
 
     /// The base's share times π: kd′·T(wo.z)·T(wi.z)/η² (the weight of a cosine-sampled
@@ -240,10 +242,11 @@ impl Plastic {
     }
 
     /// Probability of sampling the coat rather than the base from `wo`, as Mitsuba weighs them:
-    /// (1 − T(wo.z))·w against T(wo.z)·(1 − w), w = 1/(1 + mean(kd)).
+    /// (1 − T(wo.z))·w against T(wo.z)·(1 − w), w = mean(ks)/(mean(ks) + mean(kd)).
     #[must_use]
     pub fn coat_probability(&self, wo: Vec3) -> f32 {
-        let w = 1.0 / (1.0 + self.kd.element_sum() / 3.0);
+        let (s, d) = (self.ks.element_sum(), self.kd.element_sum());
+        let w = if s + d > 0.0 { s / (s + d) } else { 1.0 };
         let t = self.coat.transmittance(wo.z);
         let (coat, base) = ((1.0 - t) * w, t * (1.0 - w));
         if coat + base > 0.0 {

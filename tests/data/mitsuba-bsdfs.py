@@ -58,7 +58,7 @@ def configs():
         for nonlinear in [False, True]:
             yield (
                 "roughplastic",
-                {"alpha": alpha, "ior": 1.5, "kd": KD, "nonlinear": nonlinear},
+                {"alpha": alpha, "ior": 1.5, "kd": KD, "nonlinear": nonlinear, "ks": [1.0, 1.0, 1.0]},
                 {
                     "type": "roughplastic",
                     "distribution": "ggx",
@@ -76,6 +76,24 @@ def smooth():
     for metal in ["none", "Ag", "Al", "Au", "Cr", "Cu", "W"]:
         yield "conductor", {"metal": metal}, {"type": "conductor", "material": metal}
     yield "thindielectric", {"ior": 1.5}, {"type": "thindielectric", "int_ior": 1.5, "ext_ior": 1.0}
+
+
+def scaled():
+    """A rough plastic whose coat is scaled by `specular_reflectance`."""
+    ks = [0.9, 0.6, 0.3]
+    yield (
+        "roughplastic",
+        {"alpha": 0.1, "ior": 1.5, "kd": KD, "nonlinear": False, "ks": ks},
+        {
+            "type": "roughplastic",
+            "distribution": "ggx",
+            "alpha": 0.1,
+            "int_ior": 1.5,
+            "ext_ior": 1.0,
+            "diffuse_reflectance": {"type": "rgb", "value": KD},
+            "specular_reflectance": {"type": "rgb", "value": ks},
+        },
+    )
 
 
 def direction(theta_deg, phi_deg):
@@ -115,7 +133,7 @@ def main():
     si.sh_frame = mi.Frame3f(si.n)
     si.uv = mi.Point2f(0.5, 0.5)
     rows = []
-    for name, ours, theirs in list(configs()) + list(smooth()):
+    for name, ours, theirs in list(configs()) + list(scaled()) + list(smooth()):
         bsdf = mi.load_dict(theirs)
         params = ";".join(f"{k}={','.join(map(str, v)) if isinstance(v, list) else v}" for k, v in ours.items())
         if name in ("conductor", "thindielectric"):

@@ -8,7 +8,7 @@
 //! | `thindielectric` | a thin sheet: straight through or reflected with the slab's reflectance |
 //! | `roughdielectric` | GGX rough dielectric of width `alpha` |
 //! | `conductor`, `roughconductor` | mirror or GGX rough conductor, the exact Fresnel of `eta`, `k` or the named `material` ([`crate::optics::METALS`]), times `specular_reflectance` |
-//! | `plastic`, `roughplastic` | Mitsuba's rough plastic over `diffuse_reflectance`, `nonlinear` read (a smooth coat as α = 0.01, warned of); `specular_reflectance` not read |
+//! | `plastic`, `roughplastic` | Mitsuba's rough plastic over `diffuse_reflectance`, with `nonlinear` and `specular_reflectance` (a texture as its mean, warned of); a smooth coat as α = 0.01, warned of |
 //! | `phong` | normalised Phong (`diffuse_reflectance`, `specular_reflectance`, `exponent`) |
 //! | `bumpmap`, `normalmap`, `mask`, `coating`, `roughcoating`, `blendbsdf`, `mixturebsdf` | the (first) inner BSDF, warned of by name |
 //! | anything else | grey Lambertian (0.5), warned of with its line |
@@ -272,7 +272,17 @@ impl Ctx<'_> {
                     self.alpha(node, kind)?
                 };
                 let nonlinear = self.r.boolean(node, "nonlinear", false)?;
-                let bsdf = Bsdf::rough_plastic(c.value.min(Vec3::ONE), ior, alpha).with_nonlinear(nonlinear);
+                let s = self.coloured(node, "specular_reflectance", Vec3::ONE, Encoding::Srgb)?;
+                let ks = match &s.map {
+                    Some(t) => {
+                        self.warn(node, format!("{kind}: a textured `specular_reflectance` is rendered as its mean"));
+                        t.mean()
+                    }
+                    None => s.value,
+                };
+                let bsdf = Bsdf::rough_plastic(c.value.min(Vec3::ONE), ior, alpha)
+                    .with_nonlinear(nonlinear)
+                    .with_coat_scale(ks.min(Vec3::ONE));
                 (bsdf, Maps { kd: c.map, ..Maps::default() }, c.uv)
             }
             "phong" => {
