@@ -25,7 +25,7 @@
 //! - [`optics`]: reflection, refraction and Fresnel at a smooth interface;
 //! - [`microfacet`]: GGX rough conductors, dielectrics and Mitsuba's rough plastic with its coat
 //!   tables (eval, pdf, visible-normal sampling);
-//! - [`material`]: BSDFs (Lambert, glossy Phong, mirror, glass, the rough ones) and their textures;
+//! - [`material`]: BSDFs (Lambert, glossy Phong, mirror, glass, thin glass, the rough ones) and their textures;
 //! - [`photon_map`]: the 20-byte photon, the 8-wide photon tree, k-NN and fixed-radius density estimates;
 //! - [`settings`]: the user's knobs, their layering and validation;
 //! - [`scene`]: the scene model — triangles in BVH order, materials, lights (area, point, spot,

@@ -1,6 +1,6 @@
 //! Materials and their BSDFs: Lambertian, glossy (Lambertian + normalised Phong lobe), perfect
-//! mirror and smooth dielectric, and the GGX rough ones; their evaluate, pdf and sample are in
-//! `bsdf`.
+//! mirror (constant or a conductor's exact Fresnel), smooth dielectric, thin dielectric sheet,
+//! and the GGX rough ones; their evaluate, pdf and sample are in `bsdf`.
 //!
 //! Directions are world-space unit vectors pointing away from the surface: `wo` toward the viewer
 //! (or where the photon came from), `wi` toward the next vertex. Opaque materials are two-sided:
