@@ -202,11 +202,13 @@ def write_pbr_glb(groups, path):
         materials.append(m)
     materials.append({"name": "gold", "pbrMetallicRoughness": {"baseColorFactor": [0.95, 0.78, 0.41, 1.0], "metallicFactor": 1.0, "roughnessFactor": 0.3}})
     materials.append({"name": "glass", "pbrMetallicRoughness": {"metallicFactor": 0.0, "roughnessFactor": 0.0},
-                      "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}, "KHR_materials_ior": {"ior": 1.5}}})
+                      "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}, "KHR_materials_ior": {"ior": 1.5},
+                                     # A solid ball (without a volume glTF's transmission is thin-walled).
+                                     "KHR_materials_volume": {"thicknessFactor": 0.2}}})
     nodes.append({"name": "camera", "camera": 0, "translation": list(EYE)})
     doc = {
         "asset": {"version": "2.0", "generator": "photonwave scenes/interchange.py"},
-        "extensionsUsed": ["KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior"],
+        "extensionsUsed": ["KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"],
         "scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}], "nodes": nodes,
         "cameras": [{"type": "perspective", "perspective": {"yfov": math.radians(FOV), "znear": 0.01, "aspectRatio": 1.0}}],
         "meshes": meshes, "materials": materials, "accessors": accessors, "bufferViews": views,

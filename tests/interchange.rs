@@ -153,7 +153,7 @@ fn gltf_hierarchy_cameras_and_lights() {
 fn gltf_materials_map_onto_the_bsdfs_they_name() {
     let d = scratch_dir("gltf-materials");
     let node = json!([{"mesh": 0}]);
-    let extra = json!({"extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_emissive_strength"]});
+    let extra = json!({"extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_emissive_strength", "KHR_materials_volume"]});
     let cases = [
         (
             json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.4, 0.3, 1], "metallicFactor": 0, "roughnessFactor": 1}}),
@@ -173,8 +173,15 @@ fn gltf_materials_map_onto_the_bsdfs_they_name() {
         ),
         (
             json!({"pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
-                "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_ior": {"ior": 1.33}}}),
+                "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_ior": {"ior": 1.33},
+                    "KHR_materials_volume": {"thicknessFactor": 0.2}}}),
             Bsdf::Glass { ior: 1.33 },
+        ),
+        // Without a volume the spec makes it thin-walled: a sheet that does not bend light.
+        (
+            json!({"pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
+                "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_ior": {"ior": 1.33}}}),
+            Bsdf::ThinGlass { ior: 1.33 },
         ),
     ];
     for (material, want) in cases {

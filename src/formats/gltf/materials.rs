@@ -2,9 +2,11 @@
 //!
 //! The metallic–roughness model mapped (base colour b, metallic m, roughness r, all factors times
 //! their textures):
-//! - transmission ≥ ½ (`KHR_materials_transmission`): smooth glass (r < 0.05) or a GGX rough
-//!   dielectric of α = r², index `KHR_materials_ior` (1.5 by default); clear: a tint or a
-//!   `KHR_materials_volume` attenuation is warned of, not rendered;
+//! - transmission ≥ ½ (`KHR_materials_transmission`), index `KHR_materials_ior` (1.5 by
+//!   default): with `KHR_materials_volume` of a non-zero thickness the boundary of a solid —
+//!   smooth glass (r < 0.05) or a GGX rough dielectric of α = r²; without it thin-walled, as the
+//!   spec has it — a thin sheet (light passes unbent) when smooth, a rough dielectric (warned of)
+//!   when rough; clear: a tint or a volume's attenuation is warned of, not rendered;
 //! - m ≥ ½: a mirror of reflectance b (r < 0.05) or a GGX rough conductor (Schlick from b);
 //! - otherwise a rough plastic (GGX coat of index 1.5 over a Lambertian base b), or Lambertian b
 //!   where r ≥ 0.95 (the 4 % coat at that roughness scatters nearly diffusely itself);
@@ -123,10 +125,18 @@ pub(super) fn convert(
         if m.volume().is_some_and(|v| v.attenuation_distance().is_finite()) {
             warn("KHR_materials_volume attenuation (absorption inside the glass) is not rendered yet".into());
         }
-        if roughness < SMOOTH {
-            Bsdf::Glass { ior }
-        } else {
-            Bsdf::RoughDielectric { ior, alpha }
+        // The spec's rule: without KHR_materials_volume (or with a zero thickness) the surface
+        // is thin-walled — light passes through unbent — and with it the boundary of a solid.
+        let solid = m.volume().is_some_and(|v| v.thickness_factor() > 0.0);
+        match (roughness < SMOOTH, solid) {
+            (true, true) => Bsdf::Glass { ior },
+            (true, false) => Bsdf::ThinGlass { ior },
+            (false, solid) => {
+                if !solid {
+                    warn("rough thin-walled transmission is rendered as a solid rough dielectric".into());
+                }
+                Bsdf::RoughDielectric { ior, alpha }
+            }
         }
     } else {
         if transmission > 0.0 {
