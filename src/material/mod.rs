@@ -181,18 +181,20 @@ impl Material {
             // The PBR extension's metallic workflow, per point: the base colour makes a metal's
             // reflectance or a plastic's base. Metal parts store photons (α at least
             // PHOTON_SPECULAR_ALPHA), as plastic does, so the material's photon class is one.
-            let (base, ior, nonlinear, alpha) = match self.bsdf {
-                Bsdf::RoughPlastic { kd, alpha, nonlinear, coat, .. } => {
-                    (kd_at(kd), coat.eta, nonlinear, alpha_at(alpha))
+            let (base, ks, coat, nonlinear, alpha) = match self.bsdf {
+                Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat } => {
+                    (kd_at(kd), ks, coat, nonlinear, alpha_at(alpha))
                 }
-                Bsdf::RoughConductor { ks, alpha, .. } => (ks_at(ks), 1.5, false, alpha_at(alpha)),
+                Bsdf::RoughConductor { ks, alpha, .. } => {
+                    (ks_at(ks), Vec3::ONE, metal_map_coat(), false, alpha_at(alpha))
+                }
                 other => return other,
             };
             let base = base.min(Vec3::ONE);
             return if m.lookup(uv).x >= 0.5 {
                 Bsdf::RoughConductor { ks: base, alpha: alpha.max(PHOTON_SPECULAR_ALPHA), eta_k: None }
             } else {
-                plastic_at(base, ior, nonlinear, alpha)
+                plastic_at(base, ks, coat, nonlinear, alpha)
             };
         }
         match self.bsdf {
@@ -217,7 +219,7 @@ impl Material {
             Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat } => {
                 let kd = kd_at(kd).min(Vec3::ONE);
                 match &self.maps.roughness {
-                    Some(_) => plastic_at(kd, coat.eta, nonlinear, alpha_at(alpha)).with_coat_scale(ks),
+                    Some(_) => plastic_at(kd, ks, coat, nonlinear, alpha_at(alpha)),
                     None => Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat },
                 }
             }
@@ -228,10 +230,16 @@ impl Material {
 }
 
 /// A textured rough plastic at one point: its own α shapes the coat's lobe, the roughness
-/// levels around it give the coat's tables ([`microfacet::CoatAt::textured`]).
-fn plastic_at(kd: Vec3, ior: f32, nonlinear: bool, alpha: f32) -> Bsdf {
+/// levels of its coat's η around it give the coat's tables ([`microfacet::CoatAt::at`]).
+fn plastic_at(kd: Vec3, ks: Vec3, coat: microfacet::CoatAt, nonlinear: bool, alpha: f32) -> Bsdf {
     let alpha = alpha.max(microfacet::MIN_ALPHA);
-    Bsdf::RoughPlastic { kd, ks: Vec3::ONE, alpha, nonlinear, coat: microfacet::CoatAt::textured(ior, alpha) }
+    Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat: coat.at(alpha) }
+}
+
+/// The coat (index 1.5) of the plastic parts a metallic map makes of a rough conductor.
+fn metal_map_coat() -> microfacet::CoatAt {
+    static COAT: std::sync::OnceLock<microfacet::CoatAt> = std::sync::OnceLock::new();
+    *COAT.get_or_init(|| microfacet::CoatAt::new(1.5, microfacet::MIN_ALPHA))
 }
 
 /// A BSDF sample whose pdf came out zero (see [`Bsdf::sample_checked`]).

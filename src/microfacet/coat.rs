@@ -16,7 +16,7 @@
 //!
 //! Reads η and α; writes [`Coat`]s, built once per (η, α) and shared for the process's life
 //! ([`Coat::get`]): a scene has a handful, a roughness texture at most [`ROUGHNESS_LEVELS`] per η
-//! ([`CoatAt::textured`]).
+//! ([`CoatAt::at`]).
 
 use super::{g1, sample_visible_normal, MIN_ALPHA};
 use crate::optics::{fresnel_dielectric, refract};
@@ -85,6 +85,41 @@ impl Coat {
     }
 }
 
+/// The [`ROUGHNESS_LEVELS`] coats of one η, each computed on its first use: found once per
+/// material ([`CoatAt::new`]), so that a textured point reads them without the shared map's lock.
+#[derive(Debug)]
+pub struct Levels {
+    eta: f32,
+    coats: [OnceLock<&'static Coat>; ROUGHNESS_LEVELS as usize],
+}
+
+impl PartialEq for Levels {
+    /// One per η: the same levels are the same object.
+    fn eq(&self, other: &Levels) -> bool {
+        std::ptr::eq(self, other)
+    }
+}
+
+impl Levels {
+    /// The levels of `eta`, made on first use and kept.
+    fn of(eta: f32) -> &'static Levels {
+        static LEVELS: OnceLock<RwLock<HashMap<u32, &'static Levels>>> = OnceLock::new();
+        let all = LEVELS.get_or_init(Default::default);
+        if let Some(l) = all.read().unwrap_or_else(std::sync::PoisonError::into_inner).get(&eta.to_bits()) {
+            return l;
+        }
+        let mut all = all.write().unwrap_or_else(std::sync::PoisonError::into_inner);
+        all.entry(eta.to_bits())
+            .or_insert_with(|| Box::leak(Box::new(Levels { eta, coats: std::array::from_fn(|_| OnceLock::new()) })))
+    }
+
+    /// Level `k`: the coat of α = (k / (levels − 1))².
+    fn level(&self, k: u32) -> &'static Coat {
+        let steps = (ROUGHNESS_LEVELS - 1) as f32;
+        self.coats[k as usize].get_or_init(|| Coat::get(self.eta, ((k as f32 / steps).powi(2)).max(MIN_ALPHA)))
+    }
+}
+
 /// The coat a plastic reads at a point: its own (η, α) coat, or for a textured roughness the two
 /// roughness levels around the point's α, blended linearly in roughness (√α).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -94,6 +129,7 @@ pub struct CoatAt {
     lower: &'static Coat,
     upper: &'static Coat,
     blend: f32,
+    levels: &'static Levels,
 }
 
 impl CoatAt {
@@ -101,18 +137,24 @@ impl CoatAt {
     #[must_use]
     pub fn new(eta: f32, alpha: f32) -> CoatAt {
         let c = Coat::get(eta, alpha);
-        CoatAt { eta, lower: c, upper: c, blend: 0.0 }
+        CoatAt { eta, lower: c, upper: c, blend: 0.0, levels: Levels::of(eta) }
     }
 
-    /// For a roughness that changes from point to point: the [`ROUGHNESS_LEVELS`] levels on
-    /// either side of √`alpha`, so that a texture needs at most that many tables per η.
+    /// This coat's η at a point whose roughness a texture sets: the [`ROUGHNESS_LEVELS`] levels
+    /// on either side of √`alpha`, so that a texture needs at most that many tables per η.
     #[must_use]
-    pub fn textured(eta: f32, alpha: f32) -> CoatAt {
+    pub fn at(&self, alpha: f32) -> CoatAt {
         let steps = (ROUGHNESS_LEVELS - 1) as f32;
         let x = alpha.max(MIN_ALPHA).sqrt().min(1.0) * steps;
         let k = (x.floor() as u32).min(ROUGHNESS_LEVELS - 2);
-        let level = |k: u32| Coat::get(eta, ((k as f32 / steps).powi(2)).max(MIN_ALPHA));
-        CoatAt { eta, lower: level(k), upper: level(k + 1), blend: (x - k as f32).clamp(0.0, 1.0) }
+        let l = self.levels;
+        CoatAt {
+            eta: self.eta,
+            lower: l.level(k),
+            upper: l.level(k + 1),
+            blend: (x - k as f32).clamp(0.0, 1.0),
+            levels: l,
+        }
     }
 
     /// T(cos θ).
@@ -246,7 +288,7 @@ mod tests {
         let mut worst = 0.0f32;
         for k in [3u32, 12, 30, 50] {
             let r = (k as f32 + 0.5) / steps;
-            let (exact, blended) = (Coat::new(1.5, r * r), CoatAt::textured(1.5, r * r));
+            let (exact, blended) = (Coat::new(1.5, r * r), CoatAt::new(1.5, 0.1).at(r * r));
             for i in 1..TRANSMITTANCE_RES {
                 let mu = i as f32 / steps;
                 worst = worst.max((exact.transmittance(mu) - blended.transmittance(mu)).abs());

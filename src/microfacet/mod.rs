@@ -262,7 +262,11 @@ impl Plastic {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
-        let p = self.coat_probability(wo);
+        self.mixture_pdf(self.coat_probability(wo), wo, wi)
+    }
+
+    /// The pdf of choosing the coat with probability `p`, the base otherwise.
+    fn mixture_pdf(&self, p: f32, wo: Vec3, wi: Vec3) -> f32 {
         p * plastic_coat_pdf(wo, wi, self.alpha) + (1.0 - p) * wi.z / PI
     }
 
@@ -270,7 +274,11 @@ impl Plastic {
     /// chosen by [`Plastic::coat_probability`]; weight f·cos/pdf of the mixture.
     #[must_use]
     pub fn sample(&self, wo: Vec3, u: [f32; 3]) -> Option<LocalSample> {
-        let wi = if u[2] < self.coat_probability(wo) {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let p = self.coat_probability(wo);
+        let wi = if u[2] < p {
             let m = sample_visible_normal(wo, self.alpha, [u[0], u[1]]);
             2.0 * wo.dot(m) * m - wo
         } else {
@@ -279,7 +287,7 @@ impl Plastic {
         if wi.z <= 0.0 {
             return None;
         }
-        let pdf = self.pdf(wo, wi);
+        let pdf = self.mixture_pdf(p, wo, wi);
         if !(pdf > 0.0) {
             return None;
         }
