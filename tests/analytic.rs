@@ -8,6 +8,7 @@ use common::*;
 use glam::Vec3;
 use photonwave::code_path::CodePath;
 use photonwave::material::{Bsdf, Material};
+use photonwave::microfacet::Alpha;
 use photonwave::photon_map::{Filter, Lookup, Nearest, Photon, PhotonMap, Reflectance};
 use photonwave::progress::NoProgress;
 use photonwave::reference::photons::trace_photons;
@@ -310,8 +311,8 @@ fn light_samples_weighed_against_gather_and_glossy_rays_keep_the_direct_light() 
     let wo = Vec3::new(-to_light.x, to_light.y, -to_light.z);
     for (name, bsdf) in [
         ("phong", Bsdf::Glossy { kd: Vec3::splat(0.3), ks: Vec3::splat(0.7), exponent: 30.0 }),
-        ("rough plastic", Bsdf::rough_plastic(Vec3::splat(0.5), 1.5, 0.05)),
-        ("rough conductor", Bsdf::RoughConductor { ks: Vec3::splat(0.9), alpha: 0.4, eta_k: None }),
+        ("rough plastic", Bsdf::rough_plastic(Vec3::splat(0.5), 1.5, Alpha::ggx(0.05))),
+        ("rough conductor", Bsdf::RoughConductor { ks: Vec3::splat(0.9), alpha: Alpha::beckmann(0.4), eta_k: None }),
     ] {
         let with: Vec<f32> = (0..4096).map(|i| mis_sample(&sp, &bsdf, wo, i)).collect();
         let without: Vec<f32> = (0..4096)

@@ -10,6 +10,7 @@ use glam::{Vec2, Vec3};
 use photonwave::engine::{render, Engine};
 use photonwave::formats::{load_scene, LoadedScene};
 use photonwave::material::Bsdf;
+use photonwave::microfacet::Alpha;
 use photonwave::optics::conductor_f0;
 use photonwave::progress::NoProgress;
 use photonwave::scene::Light;
@@ -161,7 +162,7 @@ fn gltf_materials_map_onto_the_bsdfs_they_name() {
         ),
         (
             json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.4, 0.3, 1], "metallicFactor": 0, "roughnessFactor": 0.5}}),
-            Bsdf::rough_plastic(Vec3::new(0.5, 0.4, 0.3), 1.5, 0.25),
+            Bsdf::rough_plastic(Vec3::new(0.5, 0.4, 0.3), 1.5, Alpha::ggx(0.25)),
         ),
         (
             json!({"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.7, 0.3, 1], "metallicFactor": 1, "roughnessFactor": 0}}),
@@ -169,7 +170,7 @@ fn gltf_materials_map_onto_the_bsdfs_they_name() {
         ),
         (
             json!({"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.7, 0.3, 1], "metallicFactor": 1, "roughnessFactor": 0.4}}),
-            Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.7, 0.3), alpha: 0.16000001, eta_k: None },
+            Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.7, 0.3), alpha: Alpha::ggx(0.16000001), eta_k: None },
         ),
         (
             json!({"pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
@@ -406,7 +407,7 @@ fn toml_transforms_shapes_and_conductors() {
     assert_eq!(corners(&a.scene), corners(&b.scene));
     let m = &a.scene.materials[a.scene.material[0] as usize];
     assert!(
-        matches!(m.bsdf, Bsdf::RoughConductor { ks, alpha, eta_k: Some(c) } if ks == Vec3::ONE && is_gold(c) && (alpha - 0.09).abs() < 1e-6),
+        matches!(m.bsdf, Bsdf::RoughConductor { ks, alpha, eta_k: Some(c) } if ks == Vec3::ONE && is_gold(c) && alpha == Alpha::ggx(0.09)),
         "{m:?}"
     );
     let c = load("[[mesh]]\nshape = \"sphere\"\nmaterial = \"m\"\n[materials.m]\ntype = \"conductor\"\neta = [1.5, 1.5, 1.5]\nk = [0, 0, 0]\n").unwrap();
@@ -483,12 +484,14 @@ fn mitsuba_shapes_materials_emitters_and_errors() {
     let kinds: Vec<String> = s.materials.iter().map(|m| format!("{:?}", m.bsdf)).collect();
     assert!(
         s.materials.iter().any(
-            |m| matches!(m.bsdf, Bsdf::RoughConductor { alpha, eta_k: Some(c), .. } if is_gold(c) && alpha == 0.25)
+            |m| matches!(m.bsdf, Bsdf::RoughConductor { alpha, eta_k: Some(c), .. } if is_gold(c) && alpha == Alpha::ggx(0.25))
         ),
         "{kinds:?}"
     );
     assert!(
-        s.materials.iter().any(|m| m.bsdf == Bsdf::rough_plastic(Vec3::new(0.2, 0.3, 0.4), 1.49 / 1.000277, 0.1).with_nonlinear(true)),
+        s.materials.iter().any(|m| m.bsdf
+            == Bsdf::rough_plastic(Vec3::new(0.2, 0.3, 0.4), 1.49 / 1.000277, Alpha::beckmann(0.1))
+                .with_nonlinear(true)),
         "{kinds:?}"
     );
     assert!(
@@ -531,6 +534,7 @@ fn mitsuba_shapes_materials_emitters_and_errors() {
         // Found in review: a wrapper that names itself, a negative colour.
         ("<bsdf type=\"twosided\" id=\"w\"><ref id=\"w\"/></bsdf><shape type=\"cube\"><ref id=\"w\"/></shape>\n", "nest more than 16"),
         ("<shape type=\"cube\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"-1\"/></bsdf></shape>\n", "not negative"),
+        ("<shape type=\"cube\"><bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"gxx\"/></bsdf></shape>\n", "s.xml:8: roughconductor: unknown microfacet distribution `gxx`"),
     ] {
         let e = load_scene(&write(&d, "s.xml", scene(body))).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(e.contains(want), "{want}: {e}");
@@ -612,16 +616,13 @@ fn mitsuba_textures_envmaps_phong_and_every_fov_axis() {
                 && (ks - Vec3::splat(0.8 / 1.4)).abs().max_element() < 1e-6 && exponent == 40.0)),
         "{kinds:?}"
     );
-    // Anisotropic Beckmann (the default distribution): GGX of the mean α, 0.2, both warned of.
+    // Anisotropic Beckmann (the default distribution): Beckmann of the mean α, 0.2, warned of.
     assert!(s
         .materials
         .iter()
-        .any(|m| matches!(m.bsdf, Bsdf::RoughConductor { alpha, .. } if (alpha - 0.2).abs() < 1e-6)));
+        .any(|m| matches!(m.bsdf, Bsdf::RoughConductor { alpha, .. } if alpha == Alpha::beckmann(0.2))));
     let w = s.warnings.join("\n");
-    assert!(
-        w.contains("anisotropic roughness (0.1, 0.3)") && w.contains("beckmann distribution is rendered as GGX"),
-        "{w}"
-    );
+    assert!(w.contains("anisotropic roughness (0.1, 0.3)") && !w.contains("distribution"), "{w}");
     // The bitmap: sRGB decoded, its uvscale kept.
     let wood = s.materials.iter().find_map(|m| m.maps.kd.as_ref().filter(|t| t.width == 2)).expect("the bitmap");
     assert_eq!((wood.texels[0], wood.texels[1]), (Vec3::X, Vec3::Z));

@@ -32,7 +32,7 @@ impl Bsdf {
     pub fn photon_specular(&self) -> bool {
         match *self {
             Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::ThinGlass { .. } | Bsdf::RoughDielectric { .. } => true,
-            Bsdf::RoughConductor { alpha, .. } => alpha < PHOTON_SPECULAR_ALPHA,
+            Bsdf::RoughConductor { alpha, .. } => alpha.width() < PHOTON_SPECULAR_ALPHA,
             _ => false,
         }
     }

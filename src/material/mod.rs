@@ -1,6 +1,6 @@
 //! Materials and their BSDFs: Lambertian, glossy (Lambertian + normalised Phong lobe), perfect
 //! mirror (constant or a conductor's exact Fresnel), smooth dielectric, thin dielectric sheet,
-//! and the GGX rough ones; their evaluate, pdf and sample are in `bsdf`.
+//! and the microfacet rough ones (GGX or Beckmann); their evaluate, pdf and sample are in `bsdf`.
 //!
 //! Directions are world-space unit vectors pointing away from the surface: `wo` toward the viewer
 //! (or where the photon came from), `wi` toward the next vertex. Opaque materials are two-sided:
@@ -45,27 +45,26 @@ pub enum Bsdf {
     /// passes straight through, unbent, or is reflected, with the slab's reflectance
     /// ([`crate::optics::thin_slab_reflectance`]: the two faces and every bounce between them).
     ThinGlass { ior: f32 },
-    /// Rough conductor ([`crate::microfacet`]): GGX of width `alpha` (roughness²), Schlick's
+    /// Rough conductor ([`crate::microfacet`]): microfacets `alpha` (GGX or Beckmann), Schlick's
     /// Fresnel from the normal-incidence reflectance `ks`, or with the complex index `eta_k` its
     /// exact Fresnel times `ks` ([`crate::optics::conductor_reflectance`]).
-    RoughConductor { ks: Vec3, alpha: f32, eta_k: Option<crate::optics::ComplexIor> },
-    /// Rough (frosted) clear dielectric: GGX of width `alpha`, exact Fresnel, reflection and
+    RoughConductor { ks: Vec3, alpha: microfacet::Alpha, eta_k: Option<crate::optics::ComplexIor> },
+    /// Rough (frosted) clear dielectric: microfacets `alpha`, exact Fresnel, reflection and
     /// refraction through the microfacets; `ior` as for [`Bsdf::Glass`].
-    RoughDielectric { ior: f32, alpha: f32 },
-    /// Rough plastic, Mitsuba 3's `roughplastic` ([`microfacet::Plastic`]): a GGX dielectric
-    /// coat of width `alpha` over a Lambertian base `kd`, the coat's reflection scaled by `ks`
+    RoughDielectric { ior: f32, alpha: microfacet::Alpha },
+    /// Rough plastic, Mitsuba 3's `roughplastic` ([`microfacet::Plastic`]): a dielectric coat
+    /// of microfacets `alpha` over a Lambertian base `kd`, the coat's reflection scaled by `ks`
     /// (Mitsuba's `specular_reflectance`, 1 elsewhere); `coat` holds its index ratio and its
     /// transmittance tables ([`Bsdf::rough_plastic`] builds it); `nonlinear` lets the base's
     /// bounces under the coat tint by kd.
-    RoughPlastic { kd: Vec3, ks: Vec3, alpha: f32, nonlinear: bool, coat: microfacet::CoatAt },
+    RoughPlastic { kd: Vec3, ks: Vec3, alpha: microfacet::Alpha, nonlinear: bool, coat: microfacet::CoatAt },
 }
 
 impl Bsdf {
     /// A rough plastic of base `kd`, coat index ratio `ior` and width `alpha`, Mitsuba's default
     /// (linear) internal bounces.
     #[must_use]
-    pub fn rough_plastic(kd: Vec3, ior: f32, alpha: f32) -> Bsdf {
-        let alpha = alpha.max(microfacet::MIN_ALPHA);
+    pub fn rough_plastic(kd: Vec3, ior: f32, alpha: microfacet::Alpha) -> Bsdf {
         Bsdf::RoughPlastic { kd, ks: Vec3::ONE, alpha, nonlinear: false, coat: microfacet::CoatAt::new(ior, alpha) }
     }
 
@@ -92,7 +91,7 @@ impl Bsdf {
     }
 }
 
-/// The GGX α below which a rough conductor acts as a mirror for photons (roughness 0.3): its
+/// The α (the larger width) below which a rough conductor acts as a mirror for photons (roughness 0.3): its
 /// photons pass on as specular, so its caustics go into the caustic map, instead of being
 /// stored on it. Rough dielectrics always pass photons on (a photon stored on frosted glass
 /// could never light what lies behind it). The effects plan says which surfaces are which.
@@ -174,8 +173,11 @@ impl Material {
         }
         let kd_at = |kd: Vec3| self.maps.kd.as_ref().map_or(kd, |t| t.lookup(uv));
         let ks_at = |ks: Vec3| self.maps.ks.as_ref().map_or(ks, |t| t.lookup(uv));
-        let alpha_at = |alpha: f32| {
-            self.maps.roughness.as_ref().map_or(alpha, |t| microfacet::alpha_of(t.lookup(uv).x.clamp(0.0, 1.0)))
+        let alpha_at = |alpha: microfacet::Alpha| {
+            self.maps
+                .roughness
+                .as_ref()
+                .map_or(alpha, |t| alpha.with_width(microfacet::alpha_of(t.lookup(uv).x.clamp(0.0, 1.0))))
         };
         if let Some(m) = &self.maps.metallic {
             // The PBR extension's metallic workflow, per point: the base colour makes a metal's
@@ -192,7 +194,11 @@ impl Material {
             };
             let base = base.min(Vec3::ONE);
             return if m.lookup(uv).x >= 0.5 {
-                Bsdf::RoughConductor { ks: base, alpha: alpha.max(PHOTON_SPECULAR_ALPHA), eta_k: None }
+                Bsdf::RoughConductor {
+                    ks: base,
+                    alpha: alpha.with_width(alpha.width().max(PHOTON_SPECULAR_ALPHA)),
+                    eta_k: None,
+                }
             } else {
                 plastic_at(base, ks, coat, nonlinear, alpha)
             };
@@ -209,10 +215,10 @@ impl Material {
             Bsdf::RoughConductor { ks, alpha, eta_k } => {
                 let a = alpha_at(alpha);
                 // The same photon class as the constant roughness.
-                let a = if alpha < PHOTON_SPECULAR_ALPHA {
-                    a.min(PHOTON_SPECULAR_ALPHA * (1.0 - f32::EPSILON))
+                let a = if alpha.width() < PHOTON_SPECULAR_ALPHA {
+                    a.with_width(a.width().min(PHOTON_SPECULAR_ALPHA * (1.0 - f32::EPSILON)))
                 } else {
-                    a.max(PHOTON_SPECULAR_ALPHA)
+                    a.with_width(a.width().max(PHOTON_SPECULAR_ALPHA))
                 };
                 Bsdf::RoughConductor { ks: ks_at(ks).min(Vec3::ONE), alpha: a, eta_k }
             }
@@ -231,15 +237,14 @@ impl Material {
 
 /// A textured rough plastic at one point: its own α shapes the coat's lobe, the roughness
 /// levels of its coat's η around it give the coat's tables ([`microfacet::CoatAt::at`]).
-fn plastic_at(kd: Vec3, ks: Vec3, coat: microfacet::CoatAt, nonlinear: bool, alpha: f32) -> Bsdf {
-    let alpha = alpha.max(microfacet::MIN_ALPHA);
-    Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat: coat.at(alpha) }
+fn plastic_at(kd: Vec3, ks: Vec3, coat: microfacet::CoatAt, nonlinear: bool, alpha: microfacet::Alpha) -> Bsdf {
+    Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat: coat.at(alpha.width()) }
 }
 
 /// The coat (index 1.5) of the plastic parts a metallic map makes of a rough conductor.
 fn metal_map_coat() -> microfacet::CoatAt {
     static COAT: std::sync::OnceLock<microfacet::CoatAt> = std::sync::OnceLock::new();
-    *COAT.get_or_init(|| microfacet::CoatAt::new(1.5, microfacet::MIN_ALPHA))
+    *COAT.get_or_init(|| microfacet::CoatAt::new(1.5, microfacet::Alpha::ggx(microfacet::MIN_ALPHA)))
 }
 
 /// A BSDF sample whose pdf came out zero (see [`Bsdf::sample_checked`]).
@@ -281,6 +286,7 @@ impl SurfaceFrame {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::microfacet::Alpha;
 
     #[test]
     fn a_roughness_map_sets_alpha_within_the_photon_class() {
@@ -291,21 +297,29 @@ mod tests {
             ..Material::new("m", bsdf, Vec3::ZERO)
         };
         let uv = Vec2::splat(0.5);
-        let Bsdf::RoughPlastic { alpha, .. } = rough(Bsdf::rough_plastic(Vec3::ONE, 1.5, 0.5), 0.6).bsdf_at(uv) else {
-            panic!()
-        };
-        assert!((alpha - 0.36).abs() < 1e-6);
-        // A conductor whose photons are stored (α ≥ 0.09) stays there, and one whose photons pass stays below.
-        let stored = rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.25, eta_k: None }, 0.1).bsdf_at(uv);
-        assert_eq!(stored, Bsdf::RoughConductor { ks: Vec3::ONE, alpha: PHOTON_SPECULAR_ALPHA, eta_k: None });
-        let passed = rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.01, eta_k: None }, 0.9).bsdf_at(uv);
-        assert!(passed.photon_specular(), "{passed:?}");
-        let Bsdf::RoughConductor { alpha, .. } =
-            rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: 0.01, eta_k: None }, 0.2).bsdf_at(uv)
+        let Bsdf::RoughPlastic { alpha, .. } =
+            rough(Bsdf::rough_plastic(Vec3::ONE, 1.5, Alpha::beckmann(0.5)), 0.6).bsdf_at(uv)
         else {
             panic!()
         };
-        assert!((alpha - 0.04).abs() < 1e-6);
+        // The texture sets the width, the distribution stays.
+        assert_eq!(alpha, Alpha::beckmann(0.36));
+        // A conductor whose photons are stored (α ≥ 0.09) stays there, and one whose photons pass stays below.
+        let stored =
+            rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: Alpha::ggx(0.25), eta_k: None }, 0.1).bsdf_at(uv);
+        assert_eq!(
+            stored,
+            Bsdf::RoughConductor { ks: Vec3::ONE, alpha: Alpha::ggx(PHOTON_SPECULAR_ALPHA), eta_k: None }
+        );
+        let passed =
+            rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: Alpha::ggx(0.01), eta_k: None }, 0.9).bsdf_at(uv);
+        assert!(passed.photon_specular(), "{passed:?}");
+        let Bsdf::RoughConductor { alpha, .. } =
+            rough(Bsdf::RoughConductor { ks: Vec3::ONE, alpha: Alpha::ggx(0.01), eta_k: None }, 0.2).bsdf_at(uv)
+        else {
+            panic!()
+        };
+        assert!((alpha.u - 0.04).abs() < 1e-6 && alpha.u == alpha.v);
     }
 
     #[test]
@@ -314,14 +328,18 @@ mod tests {
             Some(Arc::new(Texture::new(std::path::Path::new("m.png"), 2, 1, vec![Vec3::ZERO, Vec3::ONE]).unwrap()));
         let m = Material {
             maps: Maps { metallic: two, ..Maps::default() },
-            ..Material::new("m", Bsdf::rough_plastic(Vec3::new(0.9, 0.5, 0.1), 1.4, 0.04), Vec3::ZERO)
+            ..Material::new("m", Bsdf::rough_plastic(Vec3::new(0.9, 0.5, 0.1), 1.4, Alpha::ggx(0.04)), Vec3::ZERO)
         };
         let Bsdf::RoughPlastic { kd, alpha, coat, .. } = m.bsdf_at(Vec2::new(0.25, 0.5)) else { panic!() };
-        assert_eq!((kd, alpha, coat.eta), (Vec3::new(0.9, 0.5, 0.1), 0.04, 1.4));
+        assert_eq!((kd, alpha, coat.eta), (Vec3::new(0.9, 0.5, 0.1), Alpha::ggx(0.04), 1.4));
         let metal = m.bsdf_at(Vec2::new(0.75, 0.5));
         assert_eq!(
             metal,
-            Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.5, 0.1), alpha: PHOTON_SPECULAR_ALPHA, eta_k: None }
+            Bsdf::RoughConductor {
+                ks: Vec3::new(0.9, 0.5, 0.1),
+                alpha: Alpha::ggx(PHOTON_SPECULAR_ALPHA),
+                eta_k: None
+            }
         );
         assert!(!metal.photon_specular(), "metal parts store photons, as the plastic does");
     }

@@ -14,11 +14,12 @@
 //! jump. The table holds T(μ, η); F_dr = 2 · mean over the 64 table cosines of μ·R(μ, 1/η)
 //! (Mitsuba's own discretisation, kept so that the base matches it).
 //!
-//! Reads η and α; writes [`Coat`]s, built once per (η, α) and shared for the process's life
-//! ([`Coat::get`]): a scene has a handful, a roughness texture at most [`ROUGHNESS_LEVELS`] per η
+//! Reads η and the microfacets; writes [`Coat`]s, built once per (η, distribution, α) and shared for the process's life
+//! ([`Coat::get`]): a scene has a handful, a roughness texture at most [`ROUGHNESS_LEVELS`] per η and
+//! distribution
 //! ([`CoatAt::at`]).
 
-use super::{g1, sample_visible_normal, MIN_ALPHA};
+use super::{Alpha, Distribution, MIN_ALPHA};
 use crate::optics::{fresnel_dielectric, refract};
 use glam::Vec3;
 use std::collections::HashMap;
@@ -36,8 +37,8 @@ pub const ROUGHNESS_LEVELS: u32 = 64;
 pub struct Coat {
     /// η(inside) / η(outside).
     pub eta: f32,
-    /// GGX width.
-    pub alpha: f32,
+    /// The coat's microfacets (isotropic).
+    pub alpha: Alpha,
     /// T(μ) at μ = i / 63 (μ = 0 taken as 10⁻⁶).
     pub transmittance: [f32; TRANSMITTANCE_RES],
     /// F_dr: the share of the base's (cosine-distributed) light the coat sends back down.
@@ -45,10 +46,9 @@ pub struct Coat {
 }
 
 impl Coat {
-    /// Computes the tables for relative index `eta` (> 0) and width `alpha`.
+    /// Computes the tables for relative index `eta` (> 0) and microfacets `alpha`.
     #[must_use]
-    pub fn new(eta: f32, alpha: f32) -> Coat {
-        let alpha = alpha.max(MIN_ALPHA);
+    pub fn new(eta: f32, alpha: Alpha) -> Coat {
         let mu = |i: usize| (i as f32 / (TRANSMITTANCE_RES - 1) as f32).max(1e-6);
         let outside = GaussLegendre::new(if eta > 1.0 { 32 } else { 128 });
         let inside = GaussLegendre::new(if 1.0 / eta > 1.0 { 32 } else { 128 });
@@ -61,11 +61,12 @@ impl Coat {
     }
 
     /// The coat for (`eta`, `alpha`), computed on first use and kept: every material and every
-    /// point of one (η, α) shares it.
+    /// point of one (η, distribution, α) shares it.
     #[must_use]
-    pub fn get(eta: f32, alpha: f32) -> &'static Coat {
-        static COATS: OnceLock<RwLock<HashMap<(u32, u32), &'static Coat>>> = OnceLock::new();
-        let key = (eta.to_bits(), alpha.to_bits());
+    pub fn get(eta: f32, alpha: Alpha) -> &'static Coat {
+        type Key = (u32, Distribution, u32, u32);
+        static COATS: OnceLock<RwLock<HashMap<Key, &'static Coat>>> = OnceLock::new();
+        let key = (eta.to_bits(), alpha.distribution, alpha.u.to_bits(), alpha.v.to_bits());
         let coats = COATS.get_or_init(Default::default);
         if let Some(c) = coats.read().unwrap_or_else(std::sync::PoisonError::into_inner).get(&key) {
             return c;
@@ -85,11 +86,12 @@ impl Coat {
     }
 }
 
-/// The [`ROUGHNESS_LEVELS`] coats of one η, each computed on its first use: found once per
+/// The [`ROUGHNESS_LEVELS`] coats of one η and distribution, each computed on its first use: found once per
 /// material ([`CoatAt::new`]), so that a textured point reads them without the shared map's lock.
 #[derive(Debug)]
 pub struct Levels {
     eta: f32,
+    distribution: Distribution,
     coats: [OnceLock<&'static Coat>; ROUGHNESS_LEVELS as usize],
 }
 
@@ -101,22 +103,25 @@ impl PartialEq for Levels {
 }
 
 impl Levels {
-    /// The levels of `eta`, made on first use and kept.
-    fn of(eta: f32) -> &'static Levels {
-        static LEVELS: OnceLock<RwLock<HashMap<u32, &'static Levels>>> = OnceLock::new();
+    /// The levels of `eta` and `distribution`, made on first use and kept.
+    fn of(eta: f32, distribution: Distribution) -> &'static Levels {
+        static LEVELS: OnceLock<RwLock<HashMap<(u32, Distribution), &'static Levels>>> = OnceLock::new();
         let all = LEVELS.get_or_init(Default::default);
-        if let Some(l) = all.read().unwrap_or_else(std::sync::PoisonError::into_inner).get(&eta.to_bits()) {
+        let key = (eta.to_bits(), distribution);
+        if let Some(l) = all.read().unwrap_or_else(std::sync::PoisonError::into_inner).get(&key) {
             return l;
         }
         let mut all = all.write().unwrap_or_else(std::sync::PoisonError::into_inner);
-        all.entry(eta.to_bits())
-            .or_insert_with(|| Box::leak(Box::new(Levels { eta, coats: std::array::from_fn(|_| OnceLock::new()) })))
+        all.entry(key).or_insert_with(|| {
+            Box::leak(Box::new(Levels { eta, distribution, coats: std::array::from_fn(|_| OnceLock::new()) }))
+        })
     }
 
     /// Level `k`: the coat of α = (k / (levels − 1))².
     fn level(&self, k: u32) -> &'static Coat {
         let steps = (ROUGHNESS_LEVELS - 1) as f32;
-        self.coats[k as usize].get_or_init(|| Coat::get(self.eta, ((k as f32 / steps).powi(2)).max(MIN_ALPHA)))
+        self.coats[k as usize]
+            .get_or_init(|| Coat::get(self.eta, Alpha::new(self.distribution, (k as f32 / steps).powi(2))))
     }
 }
 
@@ -135,13 +140,14 @@ pub struct CoatAt {
 impl CoatAt {
     /// The coat of exactly (`eta`, `alpha`) ([`Coat::get`]).
     #[must_use]
-    pub fn new(eta: f32, alpha: f32) -> CoatAt {
+    pub fn new(eta: f32, alpha: Alpha) -> CoatAt {
         let c = Coat::get(eta, alpha);
-        CoatAt { eta, lower: c, upper: c, blend: 0.0, levels: Levels::of(eta) }
+        CoatAt { eta, lower: c, upper: c, blend: 0.0, levels: Levels::of(eta, alpha.distribution) }
     }
 
-    /// This coat's η at a point whose roughness a texture sets: the [`ROUGHNESS_LEVELS`] levels
-    /// on either side of √`alpha`, so that a texture needs at most that many tables per η.
+    /// This coat's η and distribution at a point whose roughness a texture sets: the
+    /// [`ROUGHNESS_LEVELS`] levels on either side of √`alpha`, so that a texture needs at most
+    /// that many tables per η and distribution.
     #[must_use]
     pub fn at(&self, alpha: f32) -> CoatAt {
         let steps = (ROUGHNESS_LEVELS - 1) as f32;
@@ -221,12 +227,12 @@ impl GaussLegendre {
 
 /// E_m[scattered(wo, m)] over the normals visible from the direction at cos θ = μ: the
 /// quadrature `q` over the sampler's unit square.
-fn visible_mean(mu: f32, alpha: f32, q: &GaussLegendre, scattered: impl Fn(Vec3, Vec3) -> f32) -> f32 {
+fn visible_mean(mu: f32, alpha: Alpha, q: &GaussLegendre, scattered: impl Fn(Vec3, Vec3) -> f32) -> f32 {
     let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let mut sum = 0.0f64;
     for (&u, &wu) in q.nodes.iter().zip(&q.weights) {
         for (&v, &wv) in q.nodes.iter().zip(&q.weights) {
-            let m = sample_visible_normal(wo, alpha, [u, v]);
+            let m = alpha.sample_visible_normal(wo, [u, v]);
             sum += f64::from(scattered(wo, m) * wu * wv);
         }
     }
@@ -234,20 +240,20 @@ fn visible_mean(mu: f32, alpha: f32, q: &GaussLegendre, scattered: impl Fn(Vec3,
 }
 
 /// R(μ, η): the rough interface's single-scattering reflectance (see the module doc).
-fn rough_reflectance(mu: f32, eta: f32, alpha: f32, q: &GaussLegendre) -> f32 {
+fn rough_reflectance(mu: f32, eta: f32, alpha: Alpha, q: &GaussLegendre) -> f32 {
     visible_mean(mu, alpha, q, |wo, m| {
         let wr = 2.0 * wo.dot(m) * m - wo;
         if wr.z <= 0.0 {
             return 0.0;
         }
-        fresnel_dielectric(wo.dot(m), eta) * g1(wr, alpha)
+        fresnel_dielectric(wo.dot(m), eta) * alpha.g1(wr)
     })
 }
 
 /// T(μ, η): the rough interface's single-scattering transmittance (see the module doc).
-fn rough_transmittance(mu: f32, eta: f32, alpha: f32, q: &GaussLegendre) -> f32 {
+fn rough_transmittance(mu: f32, eta: f32, alpha: Alpha, q: &GaussLegendre) -> f32 {
     visible_mean(mu, alpha, q, |wo, m| match refract(wo, m, eta) {
-        Some(wt) if wt.z < 0.0 => (1.0 - fresnel_dielectric(wo.dot(m), eta)) * g1(wt, alpha),
+        Some(wt) if wt.z < 0.0 => (1.0 - fresnel_dielectric(wo.dot(m), eta)) * alpha.g1(-wt),
         _ => 0.0,
     })
 }
@@ -271,7 +277,7 @@ mod tests {
         // At α = 10⁻³ the coat is a smooth interface: T(μ) = 1 − F(μ), and F_dr is the smooth
         // interface's internal diffuse reflectance for η = 1.5 (0.596 by 2∫ F(μ, 1/η) μ dμ; the
         // 64-point mean Mitsuba uses puts it within 0.01).
-        let coat = Coat::new(1.5, MIN_ALPHA);
+        let coat = Coat::new(1.5, Alpha::ggx(MIN_ALPHA));
         for i in [8, 32, 63] {
             let mu = i as f32 / 63.0;
             let want = 1.0 - fresnel_dielectric(mu, 1.5);
@@ -288,7 +294,7 @@ mod tests {
         let mut worst = 0.0f32;
         for k in [3u32, 12, 30, 50] {
             let r = (k as f32 + 0.5) / steps;
-            let (exact, blended) = (Coat::new(1.5, r * r), CoatAt::new(1.5, 0.1).at(r * r));
+            let (exact, blended) = (Coat::new(1.5, Alpha::ggx(r * r)), CoatAt::new(1.5, Alpha::ggx(0.1)).at(r * r));
             for i in 1..TRANSMITTANCE_RES {
                 let mu = i as f32 / steps;
                 worst = worst.max((exact.transmittance(mu) - blended.transmittance(mu)).abs());

@@ -71,6 +71,64 @@ def configs():
             )
 
 
+
+def distributions():
+    """Beckmann (Mitsuba's default distribution) for each rough BSDF, and anisotropic widths of
+    both distributions for the conductor and the dielectric (x and y along the frame's s and t,
+    which for the normal +z both sides build as the world's x and y)."""
+    for alpha in [0.05, 0.2, 0.6]:
+        yield (
+            "roughconductor",
+            {"alpha": alpha, "distribution": "beckmann"},
+            {"type": "roughconductor", "distribution": "beckmann", "alpha": alpha, "material": "none"},
+        )
+    yield (
+        "roughconductor",
+        {"alpha": 0.1, "distribution": "beckmann", "metal": "Cu"},
+        {"type": "roughconductor", "distribution": "beckmann", "alpha": 0.1, "material": "Cu"},
+    )
+    for dist, (u, v) in [("ggx", (0.05, 0.3)), ("beckmann", (0.3, 0.1))]:
+        yield (
+            "roughconductor",
+            {"alpha": (u * v) ** 0.5, "distribution": dist, "alpha_u": u, "alpha_v": v},
+            {"type": "roughconductor", "distribution": dist, "alpha_u": u, "alpha_v": v, "material": "none"},
+        )
+    for alpha in [0.1, 0.4]:
+        yield (
+            "roughdielectric",
+            {"alpha": alpha, "ior": 1.5, "distribution": "beckmann"},
+            {"type": "roughdielectric", "distribution": "beckmann", "alpha": alpha, "int_ior": 1.5, "ext_ior": 1.0},
+        )
+    for dist, (u, v) in [("ggx", (0.1, 0.3)), ("beckmann", (0.2, 0.05))]:
+        yield (
+            "roughdielectric",
+            {"alpha": (u * v) ** 0.5, "ior": 1.5, "distribution": dist, "alpha_u": u, "alpha_v": v},
+            {
+                "type": "roughdielectric",
+                "distribution": dist,
+                "alpha_u": u,
+                "alpha_v": v,
+                "int_ior": 1.5,
+                "ext_ior": 1.0,
+            },
+        )
+    for alpha in [0.1, 0.3]:
+        for nonlinear in [False, True]:
+            yield (
+                "roughplastic",
+                {"alpha": alpha, "ior": 1.5, "kd": KD, "nonlinear": nonlinear, "ks": [1.0, 1.0, 1.0], "distribution": "beckmann"},
+                {
+                    "type": "roughplastic",
+                    "distribution": "beckmann",
+                    "alpha": alpha,
+                    "int_ior": 1.5,
+                    "ext_ior": 1.0,
+                    "nonlinear": nonlinear,
+                    "diffuse_reflectance": {"type": "rgb", "value": KD},
+                },
+            )
+
+
 def smooth():
     """The smooth conductor: its sample's weight is its Fresnel reflectance."""
     for metal in ["none", "Ag", "Al", "Au", "Cr", "Cu", "W"]:
@@ -133,7 +191,7 @@ def main():
     si.sh_frame = mi.Frame3f(si.n)
     si.uv = mi.Point2f(0.5, 0.5)
     rows = []
-    for name, ours, theirs in list(configs()) + list(scaled()) + list(smooth()):
+    for name, ours, theirs in list(configs()) + list(scaled()) + list(distributions()) + list(smooth()):
         bsdf = mi.load_dict(theirs)
         params = ";".join(f"{k}={','.join(map(str, v)) if isinstance(v, list) else v}" for k, v in ours.items())
         if name in ("conductor", "thindielectric"):

@@ -19,7 +19,7 @@
 use super::Sources;
 use crate::error::Result;
 use crate::material::{Bsdf, Maps, Material, PHOTON_SPECULAR_ALPHA};
-use crate::microfacet::alpha_of;
+use crate::microfacet::{alpha_of, Alpha};
 use crate::texture::{Encoding, Texture};
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
@@ -114,7 +114,7 @@ pub(super) fn convert(
     }
     let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
     let ior = m.ior().filter(|i| i.is_finite() && *i >= 1.0).unwrap_or(1.5);
-    let alpha = alpha_of(roughness);
+    let alpha = Alpha::ggx(alpha_of(roughness));
     let mut maps = Maps::default();
     let bsdf = if transmission >= 0.5 {
         if base.min_element() < 0.999 || base_map.is_some() {
@@ -147,7 +147,7 @@ pub(super) fn convert(
             maps.metallic = Some(derived(t, Vec3::splat(metallic), Some(2)));
             maps.kd = base_map.as_ref().map(|t| derived(t, base, None));
             // One photon class for the material (metal parts at least PHOTON_SPECULAR_ALPHA).
-            Bsdf::rough_plastic(base, 1.5, alpha.max(PHOTON_SPECULAR_ALPHA))
+            Bsdf::rough_plastic(base, 1.5, alpha.with_width(alpha.width().max(PHOTON_SPECULAR_ALPHA)))
         } else if metallic >= 0.5 {
             maps.ks = base_map.as_ref().map(|t| derived(t, base, None));
             if roughness < SMOOTH {

@@ -6,22 +6,23 @@
 //! | `twosided` | its inner BSDF (photonwave's opaque materials are two-sided already) |
 //! | `dielectric` | smooth glass of index `int_ior` / `ext_ior` (numbers or Mitsuba's names) |
 //! | `thindielectric` | a thin sheet: straight through or reflected with the slab's reflectance |
-//! | `roughdielectric` | GGX rough dielectric of width `alpha` |
-//! | `conductor`, `roughconductor` | mirror or GGX rough conductor, the exact Fresnel of `eta`, `k` or the named `material` ([`crate::optics::METALS`]), times `specular_reflectance` |
+//! | `roughdielectric` | rough dielectric of `distribution` (Beckmann unless `ggx`) and `alpha` |
+//! | `conductor`, `roughconductor` | mirror or rough conductor (Beckmann unless `ggx`), the exact Fresnel of `eta`, `k` or the named `material` ([`crate::optics::METALS`]), times `specular_reflectance` |
 //! | `plastic`, `roughplastic` | Mitsuba's rough plastic over `diffuse_reflectance`, with `nonlinear` and `specular_reflectance` (a texture as its mean, warned of); a smooth coat as α = 0.01, warned of |
 //! | `phong` | normalised Phong (`diffuse_reflectance`, `specular_reflectance`, `exponent`) |
 //! | `bumpmap`, `normalmap`, `mask`, `coating`, `roughcoating`, `blendbsdf`, `mixturebsdf` | the (first) inner BSDF, warned of by name |
 //! | anything else | grey Lambertian (0.5), warned of with its line |
 //!
-//! `diffuse`, `roughconductor` (GGX), `roughdielectric` (GGX) and `roughplastic` (GGX) evaluate
+//! `diffuse`, `roughconductor`, `roughdielectric` and `roughplastic` (GGX and Beckmann) evaluate
 //! as Mitsuba 3 does: `tests/mitsuba_bsdfs.rs` holds their f and pdf to a table written through
 //! Mitsuba's own Python API (`tests/data/mitsuba-bsdfs.py`). Not in it: `phong` (Mitsuba 3 has
 //! none), the smooth `conductor` and `dielectric` (delta lobes, no eval or pdf; their Fresnel is the
 //! same function; `thindielectric`'s directions and reflectance are in the table as its sample's),
 //! the smooth `plastic` (warned of).
 //!
-//! Beckmann and Phong microfacet distributions are rendered as GGX of the same α, anisotropic
-//! `alpha_u`/`alpha_v` as their mean; each is warned of. Textures: `bitmap` (`filename`, sRGB for
+//! Mitsuba 0.5's Phong and Ashikhmin–Shirley microfacet distributions are rendered as Beckmann
+//! of the same α, anisotropic `alpha_u`/`alpha_v` as their mean (hits carry no texture-space
+//! tangent to orient them); each is warned of. Textures: `bitmap` (`filename`, sRGB for
 //! colours) and `checkerboard` (`color0`, `color1`, drawn into a 256² image), with `uvscale`,
 //! `uoffset`, `voffset` (0.5) or a `to_uv` scale and translation (3.x), applied to the shape's
 //! texture coordinates.
@@ -29,7 +30,7 @@
 use super::Ctx;
 use crate::error::Result;
 use crate::material::{Bsdf, Maps, Material};
-use crate::microfacet::MIN_ALPHA;
+use crate::microfacet::{Alpha, Distribution, MIN_ALPHA};
 use crate::optics::{named_metal, ComplexIor};
 use crate::texture::{Encoding, Texture};
 use glam::{Vec2, Vec3};
@@ -163,9 +164,24 @@ impl Ctx<'_> {
         Ok((map != UvMap { scale: Vec2::ONE, offset: Vec2::ZERO }).then_some(map))
     }
 
-    /// A GGX α from `alpha` (or `alpha_u`/`alpha_v`), warning of another distribution.
-    fn alpha(&mut self, node: Node, what: &str) -> Result<f32> {
+    /// The microfacets of `distribution` (Beckmann when absent, as in Mitsuba) and `alpha` (or
+    /// `alpha_u`/`alpha_v`, rendered as their mean and warned of); Mitsuba 0.5's `phong` and `as`
+    /// are rendered as Beckmann and warned of, any other name is an error.
+    fn alpha(&mut self, node: Node, what: &str) -> Result<Alpha> {
         let dist = self.r.string(node, "distribution")?.unwrap_or_else(|| "beckmann".into());
+        let distribution = match dist.as_str() {
+            "ggx" => Distribution::Ggx,
+            "beckmann" => Distribution::Beckmann,
+            "phong" | "as" => {
+                self.warn(node, format!("{what}: the {dist} distribution is rendered as Beckmann of the same α"));
+                Distribution::Beckmann
+            }
+            other => {
+                return Err(self
+                    .r
+                    .error(node, format!("{what}: unknown microfacet distribution `{other}` (known: beckmann, ggx)")))
+            }
+        };
         let a = if self.r.prop(node, "alpha_u").is_some() {
             let (u, v) = (self.r.float(node, "alpha_u", 0.1)?, self.r.float(node, "alpha_v", 0.1)?);
             if u != v {
@@ -178,10 +194,7 @@ impl Ctx<'_> {
         } else {
             self.r.float(node, "alpha", 0.1)?
         };
-        if dist != "ggx" {
-            self.warn(node, format!("{what}: the {dist} distribution is rendered as GGX of the same α"));
-        }
-        Ok(a.clamp(MIN_ALPHA, 1.0))
+        Ok(Alpha::new(distribution, a.clamp(MIN_ALPHA, 1.0)))
     }
 
     /// The material of `<bsdf>` element `node`, called `name`, and the texture coordinate map its
@@ -267,7 +280,7 @@ impl Ctx<'_> {
                         node,
                         format!("plastic's smooth coat is rendered as a rough one of α = {SMOOTH_COAT_ALPHA}"),
                     );
-                    SMOOTH_COAT_ALPHA
+                    Alpha::ggx(SMOOTH_COAT_ALPHA)
                 } else {
                     self.alpha(node, kind)?
                 };

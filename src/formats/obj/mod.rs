@@ -165,7 +165,7 @@ pub fn load_obj(
         // the photon threshold's roughness): one photon class per material.
         if material.maps.metallic.is_some() {
             if let Bsdf::RoughConductor { alpha, .. } = &mut material.bsdf {
-                *alpha = alpha.max(crate::material::PHOTON_SPECULAR_ALPHA);
+                *alpha = alpha.with_width(alpha.width().max(crate::material::PHOTON_SPECULAR_ALPHA));
             }
         }
         ids.push(table.insert(file, material, warnings));

@@ -22,7 +22,7 @@
 use super::validate::number;
 use crate::error::{Error, Result};
 use crate::material::{Bsdf, Material};
-use crate::microfacet::alpha_of;
+use crate::microfacet::{alpha_of, Alpha};
 use glam::Vec3;
 use std::path::Path;
 
@@ -189,7 +189,7 @@ pub fn material_from_mtl(m: &MtlMaterial, file: &Path, warnings: &mut Vec<String
     let ks = m.ks.unwrap_or(if ks_map { Vec3::ONE } else { Vec3::ZERO });
     // A `map_Ke` makes an emitter even without `Ke`; its texels replace the emission.
     let emission = m.ke.unwrap_or(if m.map("map_Ke").is_some() { Vec3::ONE } else { Vec3::ZERO });
-    let rough = m.pr.filter(|&r| r > 0.0).map(alpha_of);
+    let rough = m.pr.filter(|&r| r > 0.0).map(|r| Alpha::ggx(alpha_of(r)));
     let metal = m.pm.is_some_and(|p| p >= 0.5);
     let bsdf = match (m.illum.unwrap_or(2), rough) {
         (3 | 5 | 8, None) => Bsdf::Mirror { ks: m.ks.unwrap_or(Vec3::ONE).min(Vec3::ONE), eta_k: None },
@@ -405,11 +405,14 @@ mod tests {
         let m = m.unwrap();
         let mut w2 = Vec::new();
         let b: Vec<Bsdf> = m.iter().map(|x| material_from_mtl(x, Path::new("t.mtl"), &mut w2).bsdf).collect();
-        assert_eq!(b[0], Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.6, 0.3), alpha: alpha_of(0.4), eta_k: None });
+        assert_eq!(
+            b[0],
+            Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.6, 0.3), alpha: Alpha::ggx(alpha_of(0.4)), eta_k: None }
+        );
         assert!(m[0].map("map_Pr").is_some(), "map_Pr before Pr is kept");
-        assert_eq!(b[1], Bsdf::RoughDielectric { ior: 1.4, alpha: alpha_of(0.5) });
+        assert_eq!(b[1], Bsdf::RoughDielectric { ior: 1.4, alpha: Alpha::ggx(alpha_of(0.5)) });
         assert_eq!(b[2], Bsdf::Mirror { ks: Vec3::splat(0.8), eta_k: None });
-        assert_eq!(b[3], Bsdf::rough_plastic(Vec3::splat(0.5), 1.5, alpha_of(0.3)));
+        assert_eq!(b[3], Bsdf::rough_plastic(Vec3::splat(0.5), 1.5, Alpha::ggx(alpha_of(0.3))));
         assert!(w.is_empty(), "{w:?}");
         for bad in ["Pr 1.5", "Pr -0.1", "Pm 2"] {
             let e = parse(&format!("newmtl a\n{bad}\n")).0.unwrap_err().to_string();

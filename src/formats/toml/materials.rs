@@ -111,10 +111,10 @@ pub(super) fn colour(field: &str, v: [f32; 3]) -> Result<Vec3> {
     }
 }
 
-/// GGX α of a `roughness` in (0, 1] (α = roughness²; 0 is the smooth `mirror` or `glass`).
-fn roughness_alpha(field: &str, roughness: f32) -> Result<f32> {
+/// GGX of α = `roughness`² for a roughness in (0, 1] (0 is the smooth `mirror` or `glass`).
+fn roughness_alpha(field: &str, roughness: f32) -> Result<crate::microfacet::Alpha> {
     if roughness > 0.0 && roughness <= 1.0 {
-        Ok(crate::microfacet::alpha_of(roughness))
+        Ok(crate::microfacet::Alpha::ggx(crate::microfacet::alpha_of(roughness)))
     } else {
         Err(Error::setting(
             field,
