@@ -79,6 +79,11 @@ impl Effects {
         } else {
             Part::new(false, "no diffuse or glossy surface to light directly")
         };
-        Effects { caustic_map, global_map, final_gather, refraction, shadow_rays }
+        let absorption = if scene.has_absorbing_interiors() {
+            Part::new(true, "a dielectric encloses an absorbing interior (Beer–Lambert along the rays inside it)")
+        } else {
+            Part::new(false, "no dielectric with an absorbing interior")
+        };
+        Effects { caustic_map, global_map, final_gather, refraction, shadow_rays, absorption }
     }
 }

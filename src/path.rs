@@ -105,6 +105,7 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
             }
             break;
         };
+        beta *= scene.interior_transmittance(&hit, d);
         let sp = scene.surface(&hit);
         let bsdf = scene.bsdf(&sp);
         let wo = -d;

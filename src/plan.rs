@@ -19,6 +19,11 @@ impl Part {
     pub(crate) fn new(on: bool, reason: impl Into<String>) -> Self {
         Part { on, reason: reason.into() }
     }
+
+    /// An off part that a plan written by an older photonwave did not record.
+    fn not_recorded() -> Self {
+        Part::new(false, "not recorded in this plan")
+    }
 }
 
 /// What to simulate.
@@ -34,6 +39,10 @@ pub struct Effects {
     pub refraction: Part,
     /// Shadow rays toward lights (direct light).
     pub shadow_rays: Part,
+    /// Beer–Lambert absorption inside dielectrics with an absorbing interior (absent from plans
+    /// written before it existed: read as off).
+    #[serde(default = "Part::not_recorded")]
+    pub absorption: Part,
 }
 
 impl Effects {
@@ -65,6 +74,7 @@ impl Effects {
             line("final gather", &self.final_gather),
             line("refraction", &self.refraction),
             line("shadow rays", &self.shadow_rays),
+            line("absorption", &self.absorption),
         ]
         .concat()
     }

@@ -108,6 +108,12 @@ pub struct Material {
     pub emission: Vec3,
     /// Image textures that replace the constant colours where the surface has them.
     pub maps: Maps,
+    /// The absorption coefficient σ_a (per scene unit, per channel) of what a dielectric
+    /// encloses, the side its geometric normal points away from: light crossing a length d of
+    /// it keeps exp(−σ_a·d) (Beer–Lambert; Mitsuba's interior `homogeneous` medium, glTF's
+    /// `KHR_materials_volume` attenuation). Zero for a clear interior and for every material
+    /// that is not a dielectric.
+    pub interior: Vec3,
 }
 
 /// A material's image textures: each, when present, replaces its constant colour at every
@@ -144,7 +150,7 @@ impl Material {
     /// A material without textures.
     #[must_use]
     pub fn new(name: impl Into<String>, bsdf: Bsdf, emission: Vec3) -> Material {
-        Material { name: name.into(), bsdf, emission, maps: Maps::default() }
+        Material { name: name.into(), bsdf, emission, maps: Maps::default(), interior: Vec3::ZERO }
     }
 
     /// The radiance emitted at texture coordinates `uv` from the front face: the constant

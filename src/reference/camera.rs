@@ -69,6 +69,7 @@ pub fn trace_camera_path(
             }
             break;
         };
+        beta *= scene.interior_transmittance(&hit, d);
         let sp = scene.surface(&hit);
         let bsdf = scene.bsdf(&sp);
         let wo = -d;

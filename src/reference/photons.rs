@@ -74,6 +74,7 @@ pub fn trace_path(scene: &Scene, job: &Job, domain: Domain, index: u64, out: &mu
             }
             return counts;
         };
+        photon.power *= scene.interior_transmittance(&hit, photon.dir);
         let sp = scene.surface(&hit);
         let bsdf = scene.bsdf(&sp);
         if !bsdf.is_delta() && !deposit_photon(domain, &sp, &bsdf, &photon, bounce, out) {

@@ -108,7 +108,7 @@ impl Scene {
             encloses_lights: false,
             warnings,
             bvh,
-            kinds: (false, false, false),
+            kinds: (false, false, false, false),
             open_edges: open_edges::OpenEdges::default(),
             caustic_targets: Vec::new(),
         };
@@ -122,7 +122,7 @@ impl Scene {
     }
 
     /// Which kinds of material the scene's triangles use: (any passed as specular by photons,
-    /// any glass, any non-delta).
+    /// any glass, any non-delta, any absorbing interior).
     fn find_kinds(&mut self) {
         let mut used = vec![false; self.materials.len()];
         for &m in &self.material {
@@ -132,6 +132,7 @@ impl Scene {
             self.kinds.0 |= m.bsdf.photon_specular();
             self.kinds.1 |= matches!(m.bsdf, Bsdf::Glass { .. } | Bsdf::ThinGlass { .. });
             self.kinds.2 |= !m.bsdf.is_delta();
+            self.kinds.3 |= m.interior != Vec3::ZERO;
         }
     }
 

@@ -138,8 +138,9 @@ pub struct Scene {
     /// aimed.
     pub caustic_targets: Vec<targets::Target>,
     bvh: Bvh,
-    /// (any delta, any glass, any non-delta) material on a triangle, computed once.
-    kinds: (bool, bool, bool),
+    /// (any delta, any glass, any non-delta, any absorbing interior) material on a triangle,
+    /// computed once.
+    kinds: (bool, bool, bool, bool),
 }
 
 impl Scene {
@@ -439,5 +440,26 @@ impl Scene {
     #[must_use]
     pub fn has_diffuse_surfaces(&self) -> bool {
         self.kinds.2
+    }
+
+    /// True if any triangle's dielectric encloses an absorbing interior ([`Material::interior`]).
+    #[must_use]
+    pub fn has_absorbing_interiors(&self) -> bool {
+        self.kinds.3
+    }
+
+    /// The share of light a ray along `d` keeps on its way to `hit` when it reaches a
+    /// dielectric's back face, having crossed its absorbing interior: exp(−σ_a·distance)
+    /// (Beer–Lambert, [`Material::interior`]); 1 at a front face or a clear interior. Every
+    /// engine's camera, gather, glossy and photon rays take it at each hit.
+    #[must_use]
+    #[inline]
+    pub fn interior_transmittance(&self, hit: &Hit, d: Vec3) -> Vec3 {
+        let tri = hit.tri as usize;
+        let sigma = self.materials[self.material[tri] as usize].interior;
+        if sigma == Vec3::ZERO || d.dot(self.ng[tri]) <= 0.0 {
+            return Vec3::ONE;
+        }
+        (-sigma * (hit.t * d.length())).exp()
     }
 }

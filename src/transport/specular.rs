@@ -108,6 +108,7 @@ pub fn first_non_specular(
     for depth in 0..=ctx.settings.max_depth {
         rays.gather += 1;
         let hit = scene.intersect(o, d, f32::INFINITY)?;
+        beta *= scene.interior_transmittance(&hit, d);
         let sp = scene.surface(&hit);
         let bsdf = &scene.bsdf(&sp);
         if !(bsdf.is_delta() || bsdf.photon_specular()) {

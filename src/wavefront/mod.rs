@@ -27,6 +27,7 @@
 //! (tiles of samples, each through the camera schedule on one worker's own world), and one file
 //! per stage.
 
+pub mod absorb;
 pub mod camera_pass;
 pub mod classify;
 pub mod deposit;

@@ -3,7 +3,7 @@
 //! run a bounce schedule until its queues are empty.
 
 use super::resources::{CameraWork, PhotonWork, Shared};
-use super::{classify, deposit, emit, gather, intersect, shade, Stage};
+use super::{absorb, classify, deposit, emit, gather, intersect, shade, Stage};
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{ExecutorKind, ScheduleLabel};
 
@@ -33,6 +33,9 @@ fn final_gather_on(s: Res<Shared>) -> bool {
 }
 fn refraction_on(s: Res<Shared>) -> bool {
     s.job.plan.refraction.on
+}
+fn absorption_on(s: Res<Shared>) -> bool {
+    s.job.plan.absorption.on
 }
 fn shadow_rays_on(s: Res<Shared>) -> bool {
     s.job.plan.shadow_rays.on
@@ -88,7 +91,7 @@ pub fn photon_schedules() -> [Schedule; 2] {
     photon_bounce.configure_sets(STAGES.chain());
     photon_bounce.add_systems((
         intersect::intersect_photons.in_set(Stage::Intersect),
-        classify::classify_photons.in_set(Stage::Classify),
+        (classify::classify_photons, absorb::absorb_photons.run_if(absorption_on)).chain().in_set(Stage::Classify),
         deposit::deposit_photons.in_set(Stage::Deposit),
         (shade::scatter_photons, shade::refract_photons.run_if(refraction_on)).chain().in_set(Stage::Shade),
     ));
@@ -106,7 +109,13 @@ pub fn camera_schedules() -> [Schedule; 2] {
     camera_bounce.configure_sets(STAGES.chain());
     camera_bounce.add_systems((
         (intersect::trace_shadow_rays, intersect::intersect_paths).chain().in_set(Stage::Intersect),
-        (classify::classify_paths, classify::mark_near_gathers.run_if(final_gather_on)).chain().in_set(Stage::Classify),
+        (
+            classify::classify_paths,
+            classify::mark_near_gathers.run_if(final_gather_on),
+            absorb::absorb_paths.run_if(absorption_on),
+        )
+            .chain()
+            .in_set(Stage::Classify),
         deposit::deposit_emission.in_set(Stage::Deposit),
         (gather::gather_caustics.run_if(caustics_on), gather::gather_global.run_if(global_on))
             .chain()

@@ -72,6 +72,44 @@ pub fn assert_terms_agree(a: &Film, b: &Film, tol: f32) {
     }
 }
 
+/// The bundled Mitsuba gallery room (`scenes/interchange/cornell-shapes.xml`, copied with its
+/// PLY meshes into `dir`) with the shapes `extra` added, loaded.
+pub fn gallery_with(dir: &std::path::Path, extra: &str) -> LoadedScene {
+    let src = std::fs::read_to_string(bundled("interchange/cornell-shapes.xml")).unwrap();
+    for ply in ["white-room.ply", "red.ply", "green.ply"] {
+        std::fs::copy(bundled(&format!("interchange/{ply}")), dir.join(ply)).unwrap();
+    }
+    let path = dir.join("shapes.xml");
+    std::fs::write(&path, src.replace("</scene>", &format!("{extra}\n</scene>"))).unwrap();
+    load_scene(&path).unwrap()
+}
+
+/// Renders `loaded` (20², 2 spp, 4 gather rays, small maps) with the reference engine and with
+/// the wavefront engine at one and two threads; asserts that the wavefront engine is
+/// bit-identical across thread counts and that the engines agree per pixel in every term
+/// (1e-6, as tests/wavefront.rs holds them). Returns the reference engine's film.
+pub fn assert_engines_agree(loaded: LoadedScene) -> Film {
+    use photonwave::engine::{render, Engine};
+    let s = Settings {
+        width: 20,
+        height: 20,
+        spp: 2,
+        photons: 4000,
+        caustic_photons: 2000,
+        gather_rays: 4,
+        ..Settings::default()
+    };
+    let rays = loaded.camera.unwrap().prepare(s.width, s.height).unwrap();
+    let scene = std::sync::Arc::new(loaded.scene);
+    let film = |engine, threads| {
+        render(&scene, &rays, &Settings { threads, ..s.clone() }, engine, None, &NoProgress).unwrap().0
+    };
+    let (a, b1, b2) = (film(Engine::Reference, 2), film(Engine::Wavefront, 1), film(Engine::Wavefront, 2));
+    assert_eq!(b1.pixels, b2.pixels, "the wavefront engine is bit-identical across thread counts");
+    assert_terms_agree(&a, &b1, 1e-6);
+    a
+}
+
 /// A point of a floor facing +y at `p` (material and triangle 0).
 pub fn floor_point(p: Vec3) -> photonwave::scene::SurfacePoint {
     photonwave::scene::SurfacePoint {

@@ -6,7 +6,8 @@
 //!   default): with `KHR_materials_volume` of a non-zero thickness the boundary of a solid —
 //!   smooth glass (r < 0.05) or a GGX rough dielectric of α = r²; without it thin-walled, as the
 //!   spec has it — a thin sheet (light passes unbent) when smooth, a rough dielectric (warned of)
-//!   when rough; clear: a tint or a volume's attenuation is warned of, not rendered;
+//!   when rough; a solid's volume attenuation absorbs inside it (σ_a = −ln(colour)/distance,
+//!   Beer–Lambert), a tint by the base colour is warned of, not rendered;
 //! - m ≥ ½: a mirror of reflectance b (r < 0.05) or a GGX rough conductor (Schlick from b);
 //! - otherwise a rough plastic (GGX coat of index 1.5 over a Lambertian base b), or Lambertian b
 //!   where r ≥ 0.95 (the 4 % coat at that roughness scatters nearly diffusely itself);
@@ -116,18 +117,28 @@ pub(super) fn convert(
     let ior = m.ior().filter(|i| i.is_finite() && *i >= 1.0).unwrap_or(1.5);
     let alpha = Alpha::ggx(alpha_of(roughness));
     let mut maps = Maps::default();
+    let mut interior = Vec3::ZERO;
     let bsdf = if transmission >= 0.5 {
         if base.min_element() < 0.999 || base_map.is_some() {
             warn(
                 "its glass is tinted by its base colour; photonwave's glass is clear (the tint is not rendered)".into(),
             );
         }
-        if m.volume().is_some_and(|v| v.attenuation_distance().is_finite()) {
-            warn("KHR_materials_volume attenuation (absorption inside the glass) is not rendered yet".into());
-        }
         // The spec's rule: without KHR_materials_volume (or with a zero thickness) the surface
-        // is thin-walled — light passes through unbent — and with it the boundary of a solid.
+        // is thin-walled — light passes through unbent — and with it the boundary of a solid,
+        // whose attenuation colour c is what remains after `attenuationDistance` d inside:
+        // σ_a = −ln(c)/d per channel.
         let solid = m.volume().is_some_and(|v| v.thickness_factor() > 0.0);
+        if let Some(v) = m.volume().filter(|v| solid && v.attenuation_distance().is_finite()) {
+            let (c, d) = (Vec3::from_array(v.attenuation_color()), v.attenuation_distance());
+            if d > 0.0 && c.is_finite() {
+                interior = -c.clamp(Vec3::splat(1e-6), Vec3::ONE).ln() / d;
+            } else {
+                warn(format!(
+                    "KHR_materials_volume attenuation (distance {d}, colour {c}) is not valid: the glass is clear"
+                ));
+            }
+        }
         match (roughness < SMOOTH, solid) {
             (true, true) => Bsdf::Glass { ior },
             (true, false) => Bsdf::ThinGlass { ior },
@@ -183,5 +194,5 @@ pub(super) fn convert(
         mode => warn(format!("alphaMode {mode:?} is not rendered yet: the surface is opaque")),
     }
     let emission = if emission.is_finite() { emission } else { Vec3::ZERO };
-    Ok(Converted { material: Material { name: name.to_string(), bsdf, emission, maps }, uv: uv.flatten() })
+    Ok(Converted { material: Material { name: name.to_string(), bsdf, emission, maps, interior }, uv: uv.flatten() })
 }

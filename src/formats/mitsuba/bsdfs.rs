@@ -311,6 +311,6 @@ impl Ctx<'_> {
                 (Bsdf::Lambert { kd: Vec3::splat(0.5) }, Maps::default(), None)
             }
         };
-        Ok((Material { name: name.to_string(), bsdf, emission: Vec3::ZERO, maps }, uv))
+        Ok((Material { name: name.to_string(), bsdf, emission: Vec3::ZERO, maps, interior: Vec3::ZERO }, uv))
     }
 }

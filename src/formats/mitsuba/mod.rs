@@ -6,7 +6,8 @@
 //!
 //! Writes the meshes, materials (into the [`MaterialTable`]), lights, environment, camera and
 //! image size of a [`crate::formats::LoadedScene`]. Everything not understood is warned of with its
-//! line (`integrator`, `sampler`, `medium`, `sun`, …); what cannot be rendered honestly (a
+//! line (`integrator`, `sampler`, media that are no shape's interior, `sun`, …); a shape's
+//! interior `homogeneous` medium absorbs inside its dielectric (`media`); what cannot be rendered honestly (a
 //! metal without data, a shape file that cannot be read) is an error naming file and line.
 //!
 //! Mitsuba's camera looks down its local +z with +y up; its lat-long maps put u = atan2(x, −z)/2π
@@ -14,6 +15,7 @@
 //! photonwave's convention.
 
 mod bsdfs;
+mod media;
 mod props;
 
 use crate::error::{Error, Result};
@@ -61,6 +63,8 @@ pub(super) struct Ctx<'a> {
     warnings: &'a mut Vec<String>,
     inputs: &'a mut Vec<PathBuf>,
     materials: HashMap<NodeId, (u32, Option<UvMap>)>,
+    /// The `<medium>` elements shapes named (the others are warned of).
+    used_media: std::collections::HashSet<NodeId>,
     /// How deep the BSDF being read is nested in wrappers.
     depth: usize,
 }
@@ -131,6 +135,13 @@ impl<'a> Ctx<'a> {
                 (self.table.insert(Path::new(""), grey, &mut Vec::new()), None)
             }
         };
+        let bsdf_kind = self.table.materials[material as usize].bsdf;
+        if let Some(sigma) = self.interior(node, &bsdf_kind)? {
+            let mut inside = self.table.materials[material as usize].clone();
+            inside.name = format!("{} (interior medium of the shape at line {})", inside.name, self.r.line(node));
+            inside.interior = sigma;
+            material = self.table.insert(self.r.path, inside, self.warnings);
+        }
         if let Some(e) = node.children().find(|c| c.is_element() && c.tag_name().name() == "emitter") {
             if e.attribute("type") != Some("area") {
                 self.warn(
@@ -381,12 +392,22 @@ pub fn load_mitsuba(
         .filter_map(|n| n.attribute("id").map(|id| (id.to_string(), n)))
         .collect();
     let r = Reader { path, doc: &doc, params, read: Default::default(), visited: Default::default() };
-    let mut cx = Ctx { r, version, ids, table, warnings, inputs, materials: HashMap::new(), depth: 0 };
+    let mut cx = Ctx {
+        r,
+        version,
+        ids,
+        table,
+        warnings,
+        inputs,
+        materials: HashMap::new(),
+        used_media: Default::default(),
+        depth: 0,
+    };
     let mut scene =
         MitsubaScene { meshes: Vec::new(), lights: Vec::new(), environment: None, camera: None, size: None };
     for node in root.children().filter(Node::is_element) {
         match node.tag_name().name() {
-            "default" | "bsdf" | "texture" => {}
+            "default" | "bsdf" | "texture" | "medium" => {}
             "integrator" => cx.warn(
                 node,
                 format!("integrator `{}` is replaced by photon mapping", node.attribute("type").unwrap_or("")),
@@ -396,6 +417,11 @@ pub fn load_mitsuba(
             "emitter" => cx.emitter(node, &mut scene)?,
             other => cx.warn(node, format!("<{other}> is not read; it is left out")),
         }
+    }
+    let unused: Vec<Node> =
+        root.descendants().filter(|n| n.tag_name().name() == "medium" && !cx.used_media.contains(&n.id())).collect();
+    for m in unused {
+        cx.warn(m, "this <medium> is no shape's interior: it is not read (participating media are issue 59's)".into());
     }
     for (line, name, element) in cx.r.unread() {
         cx.warnings.push(format!("{}:{line}: `{name}` of {element} is not read", path.display()));

@@ -83,7 +83,7 @@ impl Reader<'_> {
                 let Some(name) = p.attribute("name") else { continue };
                 if matches!(
                     p.tag_name().name(),
-                    "bsdf" | "texture" | "ref" | "emitter" | "rfilter" | "sampler" | "film"
+                    "bsdf" | "texture" | "ref" | "emitter" | "rfilter" | "sampler" | "film" | "medium"
                 ) {
                     continue;
                 }

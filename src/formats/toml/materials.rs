@@ -57,6 +57,9 @@ pub(super) enum MaterialEntry {
         #[serde(default = "one")]
         outside_ior: f32,
         roughness: f32,
+        /// σ_a of the interior, per scene unit (Beer–Lambert; clear when absent).
+        #[serde(default)]
+        absorption: Option<[f32; 3]>,
         #[serde(default)]
         emission: Option<[f32; 3]>,
     },
@@ -81,6 +84,10 @@ pub(super) enum MaterialEntry {
         /// one face with `ior` and `outside_ior` is the boundary between two dielectrics.
         #[serde(default = "one")]
         outside_ior: f32,
+        /// σ_a of the interior (the side the normal points away from), per scene unit
+        /// (Beer–Lambert; clear when absent).
+        #[serde(default)]
+        absorption: Option<[f32; 3]>,
         #[serde(default)]
         emission: Option<[f32; 3]>,
     },
@@ -162,7 +169,7 @@ impl MaterialEntry {
                 }
                 (Bsdf::rough_plastic(albedo(&f("kd"), kd)?, ior, alpha), emission)
             }
-            MaterialEntry::RoughDielectric { ior, outside_ior, roughness, emission } => {
+            MaterialEntry::RoughDielectric { ior, outside_ior, roughness, emission, .. } => {
                 let alpha = roughness_alpha(&f("roughness"), roughness)?;
                 if !(ior > 0.0 && ior.is_finite() && outside_ior > 0.0 && outside_ior.is_finite()) {
                     return Err(Error::setting(f("ior"), "`ior` and `outside_ior` must be positive numbers"));
@@ -196,7 +203,7 @@ impl MaterialEntry {
                     (Bsdf::RoughConductor { ks, alpha, eta_k }, emission)
                 }
             }
-            MaterialEntry::Glass { ior, outside_ior, emission } => {
+            MaterialEntry::Glass { ior, outside_ior, emission, .. } => {
                 if !(ior > 0.0 && ior.is_finite()) {
                     return Err(Error::setting(f("ior"), "must be a positive number"));
                 }
@@ -210,7 +217,12 @@ impl MaterialEntry {
             Some(e) => colour(&f("emission"), e)?,
             None => Vec3::ZERO,
         };
-        Ok(Material::new(name, bsdf, emission))
+        let interior = match *self {
+            MaterialEntry::Glass { absorption: Some(a), .. }
+            | MaterialEntry::RoughDielectric { absorption: Some(a), .. } => colour(&f("absorption"), a)?,
+            _ => Vec3::ZERO,
+        };
+        Ok(Material { interior, ..Material::new(name, bsdf, emission) })
     }
 }
 
