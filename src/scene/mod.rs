@@ -455,6 +455,9 @@ impl Scene {
     #[must_use]
     #[inline]
     pub fn interior_transmittance(&self, hit: &Hit, d: Vec3) -> Vec3 {
+        if !self.kinds.3 {
+            return Vec3::ONE;
+        }
         let tri = hit.tri as usize;
         let sigma = self.materials[self.material[tri] as usize].interior;
         if sigma == Vec3::ZERO || d.dot(self.ng[tri]) <= 0.0 {
