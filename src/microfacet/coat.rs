@@ -52,10 +52,17 @@ impl Coat {
         let mu = |i: usize| (i as f32 / (TRANSMITTANCE_RES - 1) as f32).max(1e-6);
         let outside = GaussLegendre::new(if eta > 1.0 { 32 } else { 128 });
         let inside = GaussLegendre::new(if 1.0 / eta > 1.0 { 32 } else { 128 });
-        let transmittance = std::array::from_fn(|i| rough_transmittance(mu(i), eta, alpha, &outside));
-        let sum: f64 = (0..TRANSMITTANCE_RES)
-            .map(|i| f64::from(rough_reflectance(mu(i), 1.0 / eta, alpha, &inside) * mu(i)))
-            .sum();
+        // Each cosine's two integrals, on a few threads (a Beckmann coat's sampler inverts its
+        // slope distribution by Newton's method: a million of them take half a second on one
+        // core); summed in cosine order whatever the threads.
+        let rows = per_cosine(|i| {
+            (
+                rough_transmittance(mu(i), eta, alpha, &outside),
+                rough_reflectance(mu(i), 1.0 / eta, alpha, &inside) * mu(i),
+            )
+        });
+        let transmittance = std::array::from_fn(|i| rows[i].0);
+        let sum: f64 = rows.iter().map(|r| f64::from(r.1)).sum();
         let internal_reflectance = (2.0 * sum / TRANSMITTANCE_RES as f64) as f32;
         Coat { eta, alpha, transmittance, internal_reflectance }
     }
@@ -188,6 +195,23 @@ impl CoatAt {
         let back = if nonlinear { kd * f_dr } else { Vec3::splat(f_dr) };
         kd / (Vec3::ONE - back)
     }
+}
+
+/// `row(i)` for each table cosine i, in order, computed on up to 8 scoped threads (fresh ones:
+/// a coat may be built inside a render's worker, where the pool is busy).
+fn per_cosine(row: impl Fn(usize) -> (f32, f32) + Sync) -> Vec<(f32, f32)> {
+    let threads = std::thread::available_parallelism().map_or(1, std::num::NonZero::get).clamp(1, 8);
+    let chunk = TRANSMITTANCE_RES.div_ceil(threads);
+    let row = &row;
+    std::thread::scope(|scope| {
+        let parts: Vec<_> = (0..TRANSMITTANCE_RES)
+            .step_by(chunk)
+            .map(|start| {
+                scope.spawn(move || (start..(start + chunk).min(TRANSMITTANCE_RES)).map(row).collect::<Vec<_>>())
+            })
+            .collect();
+        parts.into_iter().flat_map(|p| p.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
+    })
 }
 
 /// Gauss–Legendre nodes and weights on [0, 1].
