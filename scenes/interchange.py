@@ -262,16 +262,21 @@ xml += ['\t<shape type="cube">',
 with open("interchange/cornell-shapes.xml", "w") as f:
     f.write("\n".join(xml) + "\n")
 
-# The same room as Mitsuba's defaults would have it and with an absorbing interior: the cube and
-# the sphere without a `distribution` (Beckmann, Mitsuba's default), and a block of tinted glass
-# (a `homogeneous` interior medium of albedo 0, σ_t = 12·(1, ⅓, ⅔) per metre) standing in front.
+# The same room as Mitsuba's defaults would have it, with an absorbing interior and a smooth
+# plastic: the cube and the sphere without a `distribution` (Beckmann, Mitsuba's default), a
+# block of tinted glass (a `homogeneous` interior medium of albedo 0, σ_t = 12·(1, ⅓, ⅔) per
+# metre) standing in front, and a smooth `plastic` ball hanging by the red wall.
 media = [line.replace('<string name="distribution" value="ggx"/>', "") for line in xml[:-1]]
-media[1] = "<!-- The gallery room with Beckmann microfacets and absorbing glass, written by scenes/interchange.py. -->"
+media[1] = "<!-- The gallery room with Beckmann microfacets, absorbing glass and smooth plastic, written by scenes/interchange.py. -->"
 media += ['\t<shape type="cube">',
           '\t\t<transform name="to_world"><scale x="0.07" y="0.09" z="0.04"/><rotate y="1" angle="-20"/><translate y="0.095" z="0.2"/></transform>',
           '\t\t<bsdf type="dielectric"/>',
           '\t\t<medium name="interior" type="homogeneous"><rgb name="sigma_t" value="1, 0.3333333, 0.6666667"/>'
           '<float name="scale" value="12"/><float name="albedo" value="0"/></medium>',
+          "\t</shape>",
+          '\t<shape type="sphere">',
+          '\t\t<point name="center" x="-0.16" y="0.32" z="0.02"/><float name="radius" value="0.07"/>',
+          '\t\t<bsdf type="plastic"><rgb name="diffuse_reflectance" value="0.7, 0.6, 0.15"/><boolean name="nonlinear" value="true"/></bsdf>',
           "\t</shape>",
           "</scene>"]
 with open("interchange/cornell-media.xml", "w") as f:

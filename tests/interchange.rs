@@ -711,16 +711,19 @@ fn a_thin_sheet_passes_one_minus_its_reflectance_straight_through() {
 }
 
 /// The Mitsuba gallery scene — Mitsuba's rough plastic (its coat tables), a copper rough
-/// conductor by its complex index — with a thin sheet across the room: the two photon-mapping
-/// engines agree per pixel in every term (1e-6, as tests/wavefront.rs holds them), and the
-/// wavefront engine is bit-identical at one and two threads.
+/// conductor by its complex index — with a thin sheet across the room and a smooth plastic ball
+/// (its coat a delta lobe beside a diffuse base): the two photon-mapping engines agree per pixel
+/// in every term (1e-6, as tests/wavefront.rs holds them), and the wavefront engine is
+/// bit-identical at one and two threads.
 #[test]
-fn engines_agree_on_mitsuba_plastic_conductors_and_a_thin_sheet() {
+fn engines_agree_on_mitsuba_plastics_conductors_and_a_thin_sheet() {
     let pane = "<shape type=\"rectangle\"><transform name=\"to_world\"><scale x=\"0.12\" y=\"0.1\"/><translate x=\"0.08\" y=\"0.25\" z=\"0.12\"/></transform>\
-<bsdf type=\"thindielectric\"/></shape>";
+<bsdf type=\"thindielectric\"/></shape>\n<shape type=\"sphere\"><point name=\"center\" x=\"-0.16\" y=\"0.32\" z=\"0.02\"/>\
+<float name=\"radius\" value=\"0.07\"/><bsdf type=\"plastic\"><rgb name=\"diffuse_reflectance\" value=\"0.7, 0.6, 0.15\"/></bsdf></shape>";
     let loaded = gallery_with(&scratch_dir("mitsuba-engines"), pane);
     let kinds = |f: fn(&Bsdf) -> bool| loaded.scene.materials.iter().any(|m| f(&m.bsdf));
     assert!(kinds(|b| matches!(b, Bsdf::RoughPlastic { .. })) && kinds(|b| matches!(b, Bsdf::ThinGlass { .. })));
+    assert!(kinds(|b| matches!(b, Bsdf::Plastic { .. })));
     assert!(kinds(|b| matches!(b, Bsdf::RoughConductor { eta_k: Some(_), .. })));
     let a = assert_engines_agree(loaded);
     // The camera sees the room through the sheet (the only delta surface): a specular term.

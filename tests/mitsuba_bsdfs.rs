@@ -2,7 +2,7 @@
 //! `tests/data/mitsuba-bsdfs.py` through Mitsuba's Python API, holds f and the sampling pdf of
 //! every BSDF photonwave renders as Mitsuba does, over a grid of parameters and direction pairs
 //! (conductors by Mitsuba's named metals and by η, k with a `specular_reflectance`; for the
-//! smooth `conductor` and the `thindielectric`, delta lobes, a sample's direction and weight and
+//! smooth `conductor`, the `thindielectric` and the smooth `plastic`'s coat, delta lobes, a sample's direction and weight and
 //! the probability of its lobe); photonwave's must match.
 //!
 //! Tolerance, derived. The analytic BSDFs (diffuse, conductors, rough dielectric) are the
@@ -126,6 +126,12 @@ fn ours(bsdf: &str, params: &str) -> Bsdf {
             .with_nonlinear(param(params, "nonlinear")[0] == 1.0)
             .with_coat_scale(v3(param(params, "ks"))),
         "thindielectric" => Bsdf::ThinGlass { ior: param(params, "ior")[0] },
+        "plastic" | "plastic-coat" => Bsdf::Plastic {
+            kd: v3(param(params, "kd")),
+            ks: v3(param(params, "ks")),
+            eta: param(params, "ior")[0],
+            nonlinear: param(params, "nonlinear")[0] == 1.0,
+        },
         other => panic!("no mapping for {other}"),
     }
 }
@@ -178,7 +184,13 @@ fn every_bsdf_evaluates_as_mitsuba_3_does() {
     assert!(all.len() > 1000, "the table has {} rows", all.len());
     for r in &all {
         let b = ours(&r.bsdf, &r.params);
-        let (f, pdf) = if b.is_delta() {
+        let (f, pdf) = if r.bsdf == "plastic-coat" {
+            // The smooth plastic's coat: its sample (u = 0 picks it), weight F·ks over its
+            // probability, and that probability.
+            let s = b.sample(&frame, r.wo, [0.5, 0.5, 0.0], Transport::Radiance).expect("the coat reflects");
+            assert!(s.delta && (s.wi - r.wi).length() < 1e-6, "{}: {:?} against {:?}", r.params, s.wi, r.wi);
+            (s.weight, b.smooth_plastic().expect("a smooth plastic").coat_probability(r.wo))
+        } else if b.is_delta() {
             // A delta lobe: the sample's direction and weight, and the chosen lobe's probability
             // (the sheet's reflectance R′ or 1 − R′; 1 for the mirror).
             let reflects = r.wi.z * r.wo.z > 0.0;

@@ -5,7 +5,7 @@
 //! Reads a [`SurfaceFrame`] and directions (world space, away from the surface); writes
 //! [`BsdfSample`]s and values. The materials themselves are in the parent module.
 
-use super::{Bsdf, BsdfSample, SurfaceFrame, Transport, ZeroPdf, PHOTON_SPECULAR_ALPHA};
+use super::{Bsdf, BsdfSample, SmoothPlastic, SurfaceFrame, Transport, ZeroPdf, PHOTON_SPECULAR_ALPHA};
 use crate::microfacet;
 use crate::optics::{conductor_reflectance, fresnel_dielectric, reflect, refract, thin_slab_reflectance};
 use crate::sampling::{cosine_hemisphere, Frame};
@@ -38,7 +38,8 @@ impl Bsdf {
     }
 
     /// True for materials with a lobe that camera paths follow with one traced ray (the glossy
-    /// reflection): Phong glossy and the rough materials.
+    /// reflection): Phong glossy, the rough materials and the smooth plastic's coat (a delta lobe
+    /// beside its diffuse base).
     #[must_use]
     pub fn has_glossy_lobe(&self) -> bool {
         matches!(
@@ -47,28 +48,45 @@ impl Bsdf {
                 | Bsdf::RoughConductor { .. }
                 | Bsdf::RoughDielectric { .. }
                 | Bsdf::RoughPlastic { .. }
+                | Bsdf::Plastic { .. }
         )
     }
 
     /// Whether a final-gather ray's weight depends on its direction ([`Bsdf::gather_weight`]):
-    /// only for the rough plastic, whose base is seen through its coat.
+    /// only for the plastics, whose base is seen through their coat.
     #[must_use]
     pub fn gather_varies(&self) -> bool {
-        matches!(self, Bsdf::RoughPlastic { .. })
+        matches!(self, Bsdf::RoughPlastic { .. } | Bsdf::Plastic { .. })
     }
 
     /// The weight of a cosine-sampled final-gather ray `wi` from the diffuse part: `kd` for
     /// Lambertian and glossy materials (the 1/π and the cosine cancel), the base's
-    /// kd′·T(wo)·T(wi)/η² for the rough plastic ([`microfacet::Plastic::base`]).
+    /// kd′·T(wo)·T(wi)/η² for the rough plastic ([`microfacet::Plastic::base`]), and the smooth
+    /// plastic's kd′·(1 − F(wo))·(1 − F(wi))/η² ([`SmoothPlastic::base`]).
     #[must_use]
     pub fn gather_weight(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Vec3 {
-        match self.plastic() {
-            Some(p) => {
-                let (_, ns) = frame.oriented(wo);
-                let f = Frame::new(ns);
-                p.base(f.to_local(wo), f.to_local(wi))
-            }
-            None => self.diffuse(),
+        let local = || {
+            let (_, ns) = frame.oriented(wo);
+            let f = Frame::new(ns);
+            (f.to_local(wo), f.to_local(wi))
+        };
+        if let Some(p) = self.plastic() {
+            let (lo, li) = local();
+            return p.base(lo, li);
+        }
+        if let Some(p) = self.smooth_plastic() {
+            let (lo, li) = local();
+            return p.base(lo, li);
+        }
+        self.diffuse()
+    }
+
+    /// A smooth plastic's model ([`SmoothPlastic`]); `None` for the other materials.
+    #[must_use]
+    pub fn smooth_plastic(&self) -> Option<SmoothPlastic> {
+        match *self {
+            Bsdf::Plastic { kd, ks, eta, nonlinear } => Some(SmoothPlastic { kd, ks, eta, nonlinear }),
+            _ => None,
         }
     }
 
@@ -84,10 +102,10 @@ impl Bsdf {
     }
 
     /// Whether the material has a part its glossy ray does not sample (a Lambertian, a Phong
-    /// material's kd, a rough plastic's base).
+    /// material's kd, a plastic's base).
     #[must_use]
     pub fn has_base(&self) -> bool {
-        matches!(self, Bsdf::Lambert { .. } | Bsdf::Glossy { .. } | Bsdf::RoughPlastic { .. })
+        matches!(self, Bsdf::Lambert { .. } | Bsdf::Glossy { .. } | Bsdf::RoughPlastic { .. } | Bsdf::Plastic { .. })
     }
 
     /// f(wo, wi) of that part alone: kd/π, or the rough plastic's base
@@ -108,6 +126,10 @@ impl Bsdf {
                     _ => Vec3::ZERO,
                 }
             }
+            Bsdf::Plastic { kd, ks, eta, nonlinear } => {
+                let f = Frame::new(ns);
+                SmoothPlastic { kd, ks, eta, nonlinear }.base(f.to_local(wo), f.to_local(wi)) / PI
+            }
             _ => Vec3::ZERO,
         }
     }
@@ -116,7 +138,10 @@ impl Bsdf {
     #[must_use]
     pub fn diffuse(&self) -> Vec3 {
         match *self {
-            Bsdf::Lambert { kd } | Bsdf::Glossy { kd, .. } | Bsdf::RoughPlastic { kd, .. } => kd,
+            Bsdf::Lambert { kd }
+            | Bsdf::Glossy { kd, .. }
+            | Bsdf::RoughPlastic { kd, .. }
+            | Bsdf::Plastic { kd, .. } => kd,
             _ => Vec3::ZERO,
         }
     }
@@ -142,6 +167,8 @@ impl Bsdf {
                 }
             }
             Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::ThinGlass { .. } => Vec3::ZERO,
+            // The coat is a delta lobe: only the base has a value.
+            Bsdf::Plastic { .. } => self.eval_base(frame, wo, wi),
             _ => self.eval_rough(frame, wo, wi).unwrap_or(Vec3::ZERO),
         }
     }
@@ -248,6 +275,15 @@ impl Bsdf {
                 (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight, delta: true })
             }
             Bsdf::Glass { ior } => sample_glass(frame, wo, ior, u[0], transport),
+            Bsdf::Plastic { kd, ks, eta, nonlinear } => {
+                let (ng, ns) = frame.oriented(wo);
+                let f = Frame::new(ns);
+                let Some(s) = (SmoothPlastic { kd, ks, eta, nonlinear }).sample(f.to_local(wo), u) else {
+                    return Ok(None);
+                };
+                let wi = f.to_world(s.sample.wi);
+                (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: s.sample.weight, delta: s.coat })
+            }
             Bsdf::ThinGlass { ior } => sample_thin_glass(frame, wo, ior, u[0]),
             Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } | Bsdf::RoughPlastic { .. } => {
                 self.sample_rough(frame, wo, u, transport == Transport::Radiance)
@@ -275,6 +311,18 @@ impl Bsdf {
     /// base is the final gather's). `None` for other materials.
     #[must_use]
     pub fn sample_glossy(&self, frame: &SurfaceFrame, wo: Vec3, u: [f32; 3]) -> Option<BsdfSample> {
+        if let Some(p) = self.smooth_plastic() {
+            // The coat's mirror reflection, weight F·ks: a delta lobe.
+            let (ng, ns) = frame.oriented(wo);
+            let f = Frame::new(ns);
+            let lo = f.to_local(wo);
+            if lo.z <= 0.0 {
+                return None;
+            }
+            let c = p.coat(lo);
+            let wi = f.to_world(c.wi);
+            return (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: c.weight, delta: true });
+        }
         if let Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } = self {
             return self.sample_rough(frame, wo, u, true);
         }
@@ -381,6 +429,14 @@ impl Bsdf {
                     return 0.0;
                 }
                 microfacet::dielectric_pdf(f.to_local(wo), li, eta, alpha)
+            }
+            Bsdf::Plastic { kd, ks, eta, nonlinear } => {
+                let (ng, ns) = frame.oriented(wo);
+                if wi.dot(ng) <= 0.0 {
+                    return 0.0;
+                }
+                let f = Frame::new(ns);
+                SmoothPlastic { kd, ks, eta, nonlinear }.pdf(f.to_local(wo), f.to_local(wi))
             }
             Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::ThinGlass { .. } => 0.0,
         }

@@ -14,6 +14,8 @@ use glam::{Vec2, Vec3};
 use std::sync::Arc;
 
 mod bsdf;
+mod plastic;
+pub use plastic::{fresnel_diffuse_reflectance, PlasticSample, SmoothPlastic};
 
 /// What flows along the path: radiance (camera paths) or power (photons). Refraction scales
 /// radiance by (η_wo / η_wi)², never power.
@@ -58,6 +60,11 @@ pub enum Bsdf {
     /// transmittance tables ([`Bsdf::rough_plastic`] builds it); `nonlinear` lets the base's
     /// bounces under the coat tint by kd.
     RoughPlastic { kd: Vec3, ks: Vec3, alpha: microfacet::Alpha, nonlinear: bool, coat: microfacet::CoatAt },
+    /// Smooth plastic, Mitsuba 3's `plastic` ([`SmoothPlastic`]): a smooth dielectric coat of
+    /// index ratio `eta` whose mirror reflection is scaled by `ks`, over a Lambertian base `kd`;
+    /// `nonlinear` as for [`Bsdf::RoughPlastic`]. Its coat is a delta lobe beside a diffuse
+    /// base: camera paths follow it with their glossy ray, photons are stored on it.
+    Plastic { kd: Vec3, ks: Vec3, eta: f32, nonlinear: bool },
 }
 
 impl Bsdf {
@@ -68,17 +75,18 @@ impl Bsdf {
         Bsdf::RoughPlastic { kd, ks: Vec3::ONE, alpha, nonlinear: false, coat: microfacet::CoatAt::new(ior, alpha) }
     }
 
-    /// A rough plastic whose base's bounces under the coat tint by kd (`nonlinear`, Mitsuba's
-    /// flag of that name); other materials unchanged.
+    /// A plastic (rough or smooth) whose base's bounces under the coat tint by kd (`nonlinear`,
+    /// Mitsuba's flag of that name); other materials unchanged.
     #[must_use]
     pub fn with_nonlinear(self, nonlinear: bool) -> Bsdf {
         match self {
             Bsdf::RoughPlastic { kd, ks, alpha, coat, .. } => Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat },
+            Bsdf::Plastic { kd, ks, eta, .. } => Bsdf::Plastic { kd, ks, eta, nonlinear },
             other => other,
         }
     }
 
-    /// A rough plastic whose coat's reflection is scaled by `ks` (Mitsuba's
+    /// A plastic (rough or smooth) whose coat's reflection is scaled by `ks` (Mitsuba's
     /// `specular_reflectance`); other materials unchanged.
     #[must_use]
     pub fn with_coat_scale(self, ks: Vec3) -> Bsdf {
@@ -86,6 +94,7 @@ impl Bsdf {
             Bsdf::RoughPlastic { kd, alpha, nonlinear, coat, .. } => {
                 Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat }
             }
+            Bsdf::Plastic { kd, eta, nonlinear, .. } => Bsdf::Plastic { kd, ks, eta, nonlinear },
             other => other,
         }
     }
@@ -236,6 +245,9 @@ impl Material {
                 }
             }
             Bsdf::RoughDielectric { ior, alpha } => Bsdf::RoughDielectric { ior, alpha: alpha_at(alpha) },
+            Bsdf::Plastic { kd, ks, eta, nonlinear } => {
+                Bsdf::Plastic { kd: kd_at(kd).min(Vec3::ONE), ks, eta, nonlinear }
+            }
             b @ (Bsdf::Glass { .. } | Bsdf::ThinGlass { .. }) => b,
         }
     }

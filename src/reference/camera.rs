@@ -23,7 +23,7 @@ use crate::stats::{Numerics, RayCounts};
 use crate::transport::camera::render_pixels;
 use crate::transport::direct::{delta_light, direct_light, weighted_direct_light};
 use crate::transport::estimate::{camera_indirect_estimate, caustic_estimate, indirect_estimate, map_radiance};
-use crate::transport::gather::{glossy_ray, lands_near, trace_gather_rays};
+use crate::transport::gather::{glossy_density, glossy_ray, lands_near, trace_gather_rays};
 use crate::transport::mis::{emission_found, Strategies};
 use crate::transport::specular::{continue_chain, emission_toward, first_non_specular, ChainEnd};
 use crate::transport::{streams, Context, PhotonMaps};
@@ -240,7 +240,7 @@ pub fn glossy_reflection(
     let rest = indirect_estimate(ctx, &y, b, -d, None, scratch).finish(ctx);
     let w = ray.weight * beta;
     let emission = if bounces == 0 {
-        w * emission_found(ctx, &hit, d, mis.glossy_density(sp, bsdf, wo, ray.dir))
+        w * emission_found(ctx, &hit, d, glossy_density(&ray, mis, sp, bsdf, wo))
     } else {
         Vec3::ZERO
     };

@@ -13,6 +13,7 @@
 //! maps where it lands, farther away. It is still the same sum over paths, only one bounce later
 //! read from the maps; LuxCore's PhotonGI does the same below its "usage threshold".
 
+use super::mis::Strategies;
 use super::specular::{first_non_specular, Bounce, ChainEnd};
 use super::{streams, Context};
 use crate::geometry::offset::offset_ray_origin;
@@ -62,7 +63,9 @@ pub fn trace_gather_rays(
 }
 
 /// The glossy lobe's ray at `sp` seen from `wo`, drawn from bounce 0 (dims 0–1) of `s`, with
-/// its weight; `None` for a material without a glossy lobe or a sample below the surface.
+/// its weight; `delta` for a smooth plastic's coat (a mirror direction, which light sampling
+/// never finds: [`glossy_density`]). `None` for a material without a glossy lobe or a sample
+/// below the surface.
 #[must_use]
 #[inline]
 pub fn glossy_ray(sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler) -> Option<Bounce> {
@@ -71,8 +74,21 @@ pub fn glossy_ray(sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler) -> Opti
         origin: offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, bs.wi),
         dir: bs.wi,
         weight: bs.weight,
-        delta: false,
+        delta: bs.delta,
     })
+}
+
+/// The density to weigh the emission a glossy ray `ray` finds against light sampling: the lobe's
+/// density toward it under `mis`, or for a delta lobe ∞ (light sampling never finds a mirror
+/// direction, so the ray counts all of it).
+#[must_use]
+#[inline]
+pub fn glossy_density(ray: &Bounce, mis: &Strategies, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3) -> f32 {
+    if ray.delta {
+        f32::INFINITY
+    } else {
+        mis.glossy_density(sp, bsdf, wo, ray.dir)
+    }
 }
 
 /// The distance below which a gather ray's hit takes the secondary gather, in scene units:

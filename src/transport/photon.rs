@@ -367,7 +367,9 @@ pub fn scatter_photon(s: &Sampler, sp: &SurfacePoint, bsdf: &Bsdf, photon: &Phot
         dir: bs.wi,
         power,
         emitted: photon.emitted,
-        specular_only: photon.specular_only && (bs.delta || bsdf.photon_specular()),
+        // A smooth plastic's coat reflects as a mirror but is no caustic maker: its photons go on
+        // as indirect light (for the global map and the final gather), as a rough coat's do.
+        specular_only: photon.specular_only && ((bs.delta && bsdf.is_delta()) || bsdf.photon_specular()),
     };
     match roulette(power, photon.emitted, s.get(bounce + 1, 3)) {
         Roulette::Absorbed => Scattered::Absorbed,

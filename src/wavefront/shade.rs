@@ -10,7 +10,7 @@ use super::{CameraWork, Maps, PhotonWork, Shared, StageClock, StageStats};
 use crate::film::Term;
 use crate::rng::{Domain, Sampler};
 use crate::transport::direct::{direct_light_rays, ShadowRay};
-use crate::transport::gather::{gather_rays, glossy_ray};
+use crate::transport::gather::{gather_rays, glossy_density, glossy_ray};
 use crate::transport::mis::Strategies;
 use crate::transport::photon::{scatter_photon, PathEnd, Scattered};
 use crate::transport::specular::continue_chain;
@@ -252,7 +252,7 @@ pub fn spawn_glossy_rays(
             beta: paths.beta[i] * ray.weight,
             term: Term::Specular,
             through_specular: paths.through_specular[i],
-            mis: mis.glossy_density(&sp, bsdf, wo, ray.dir),
+            mis: glossy_density(&ray, &mis, &sp, bsdf, wo),
         });
     }
     let count = next.len() - before;

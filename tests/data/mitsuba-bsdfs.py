@@ -129,6 +129,34 @@ def distributions():
             )
 
 
+def smooth_plastic():
+    """The smooth plastic: its base's f and pdf (eval, pdf), and its coat's sample."""
+    for nonlinear in [False, True]:
+        yield (
+            "plastic",
+            {"ior": 1.5, "kd": KD, "nonlinear": nonlinear, "ks": [1.0, 1.0, 1.0]},
+            {
+                "type": "plastic",
+                "int_ior": 1.5,
+                "ext_ior": 1.0,
+                "nonlinear": nonlinear,
+                "diffuse_reflectance": {"type": "rgb", "value": KD},
+            },
+        )
+    ks = [0.9, 0.6, 0.3]
+    yield (
+        "plastic",
+        {"ior": 1.33, "kd": KD, "nonlinear": False, "ks": ks},
+        {
+            "type": "plastic",
+            "int_ior": 1.33,
+            "ext_ior": 1.0,
+            "diffuse_reflectance": {"type": "rgb", "value": KD},
+            "specular_reflectance": {"type": "rgb", "value": ks},
+        },
+    )
+
+
 def smooth():
     """The smooth conductor: its sample's weight is its Fresnel reflectance."""
     for metal in ["none", "Ag", "Al", "Au", "Cr", "Cu", "W"]:
@@ -191,9 +219,28 @@ def main():
     si.sh_frame = mi.Frame3f(si.n)
     si.uv = mi.Point2f(0.5, 0.5)
     rows = []
-    for name, ours, theirs in list(configs()) + list(scaled()) + list(distributions()) + list(smooth()):
+    for name, ours, theirs in list(configs()) + list(scaled()) + list(distributions()) + list(smooth()) + list(smooth_plastic()):
         bsdf = mi.load_dict(theirs)
         params = ";".join(f"{k}={','.join(map(str, v)) if isinstance(v, list) else v}" for k, v in ours.items())
+        if name == "plastic":
+            # The base: f and pdf over direction pairs. The coat: a sample with sample1 = 0 (the
+            # coat whenever its probability is above 0) records the mirror direction, the
+            # weight (F·ks over the probability) and the probability, under the name
+            # "plastic-coat".
+            for wo, wi in pairs(0.0, False):
+                si.wi = mi.Vector3f(wo)
+                value = bsdf.eval(ctx, si, mi.Vector3f(wi))
+                pdf = bsdf.pdf(ctx, si, mi.Vector3f(wi))
+                f = [float(value[c]) / abs(wi[2]) for c in range(3)]
+                rows.append([name, params] + [f"{x:.9g}" for x in wo + wi + f] + [f"{float(pdf):.9g}"])
+            for theta in [0.0, 30.0, 60.0, 80.0, 89.0]:
+                wo = direction(theta, 10.0)
+                si.wi = mi.Vector3f(wo)
+                bs, weight = bsdf.sample(ctx, si, 0.0, mi.Point2f(0.5, 0.5))
+                wi = [float(bs.wo[c]) for c in range(3)]
+                f = [float(weight[c]) for c in range(3)]
+                rows.append(["plastic-coat", params] + [f"{x:.9g}" for x in wo + wi + f] + [f"{float(bs.pdf):.9g}"])
+            continue
         if name in ("conductor", "thindielectric"):
             # Delta lobes: a sample's direction and weight (f·cos/pdf) in f, and the probability
             # of the lobe it chose in pdf (1 for the mirror); the thin sheet's reflection

@@ -8,17 +8,17 @@
 //! | `thindielectric` | a thin sheet: straight through or reflected with the slab's reflectance |
 //! | `roughdielectric` | rough dielectric of `distribution` (Beckmann unless `ggx`) and `alpha` |
 //! | `conductor`, `roughconductor` | mirror or rough conductor (Beckmann unless `ggx`), the exact Fresnel of `eta`, `k` or the named `material` ([`crate::optics::METALS`]), times `specular_reflectance` |
-//! | `plastic`, `roughplastic` | Mitsuba's rough plastic over `diffuse_reflectance`, with `nonlinear` and `specular_reflectance` (a texture as its mean, warned of); a smooth coat as α = 0.01, warned of |
+//! | `plastic`, `roughplastic` | Mitsuba's smooth (a mirror coat) or rough plastic over `diffuse_reflectance`, with `nonlinear` and `specular_reflectance` (a texture as its mean, warned of) |
 //! | `phong` | normalised Phong (`diffuse_reflectance`, `specular_reflectance`, `exponent`) |
 //! | `bumpmap`, `normalmap`, `mask`, `coating`, `roughcoating`, `blendbsdf`, `mixturebsdf` | the (first) inner BSDF, warned of by name |
 //! | anything else | grey Lambertian (0.5), warned of with its line |
 //!
-//! `diffuse`, `roughconductor`, `roughdielectric` and `roughplastic` (GGX and Beckmann) evaluate
-//! as Mitsuba 3 does: `tests/mitsuba_bsdfs.rs` holds their f and pdf to a table written through
-//! Mitsuba's own Python API (`tests/data/mitsuba-bsdfs.py`). Not in it: `phong` (Mitsuba 3 has
-//! none), the smooth `conductor` and `dielectric` (delta lobes, no eval or pdf; their Fresnel is the
-//! same function; `thindielectric`'s directions and reflectance are in the table as its sample's),
-//! the smooth `plastic` (warned of).
+//! `diffuse`, `roughconductor`, `roughdielectric`, `roughplastic` (GGX and Beckmann) and
+//! `plastic` (its base's f and pdf; its coat's sample weight and probability) evaluate as
+//! Mitsuba 3 does: `tests/mitsuba_bsdfs.rs` holds them to a table written through Mitsuba's own
+//! Python API (`tests/data/mitsuba-bsdfs.py`). Not in it: `phong` (Mitsuba 3 has none), the
+//! smooth `dielectric` (delta lobes, no eval or pdf; its Fresnel is the same function;
+//! `conductor`'s and `thindielectric`'s directions and weights are in the table as samples).
 //!
 //! Mitsuba 0.5's Phong and Ashikhmin–Shirley microfacet distributions are rendered as Beckmann
 //! of the same α, anisotropic `alpha_u`/`alpha_v` as their mean (hits carry no texture-space
@@ -46,9 +46,6 @@ pub struct UvMap {
 
 /// How deep wrappers (`twosided`, `mask`, …) may nest.
 const MAX_NESTING: usize = 16;
-
-/// GGX α of a smooth `plastic` coat (photonwave has no smooth coated diffuse).
-const SMOOTH_COAT_ALPHA: f32 = 0.01;
 
 /// Mitsuba's named indices of refraction.
 const IORS: [(&str, f32); 22] = [
@@ -275,15 +272,7 @@ impl Ctx<'_> {
             "plastic" | "roughplastic" => {
                 let ior = self.ior_ratio(node, 1.49)?;
                 let c = self.coloured(node, "diffuse_reflectance", Vec3::splat(0.5), Encoding::Srgb)?;
-                let alpha = if kind == "plastic" {
-                    self.warn(
-                        node,
-                        format!("plastic's smooth coat is rendered as a rough one of α = {SMOOTH_COAT_ALPHA}"),
-                    );
-                    Alpha::ggx(SMOOTH_COAT_ALPHA)
-                } else {
-                    self.alpha(node, kind)?
-                };
+                let alpha = if kind == "plastic" { None } else { Some(self.alpha(node, kind)?) };
                 let nonlinear = self.r.boolean(node, "nonlinear", false)?;
                 let s = self.coloured(node, "specular_reflectance", Vec3::ONE, Encoding::Srgb)?;
                 let ks = match &s.map {
@@ -293,9 +282,13 @@ impl Ctx<'_> {
                     }
                     None => s.value,
                 };
-                let bsdf = Bsdf::rough_plastic(c.value.min(Vec3::ONE), ior, alpha)
-                    .with_nonlinear(nonlinear)
-                    .with_coat_scale(ks.min(Vec3::ONE));
+                let kd = c.value.min(Vec3::ONE);
+                let bsdf = match alpha {
+                    Some(alpha) => Bsdf::rough_plastic(kd, ior, alpha),
+                    None => Bsdf::Plastic { kd, ks: Vec3::ONE, eta: ior, nonlinear },
+                }
+                .with_nonlinear(nonlinear)
+                .with_coat_scale(ks.min(Vec3::ONE));
                 (bsdf, Maps { kd: c.map, ..Maps::default() }, c.uv)
             }
             "phong" => {
