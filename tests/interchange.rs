@@ -221,9 +221,14 @@ fn gltf_materials_map_onto_the_bsdfs_they_name() {
         "index": 0, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0], "scale": [2, 1]}}}}});
     let extra =
         json!({"extensionsUsed": ["KHR_texture_transform"], "textures": [{"source": 0}], "images": [{"uri": image}]});
-    let loaded = load_doc(&d, &gltf_doc(node, textured, extra)).unwrap();
+    let loaded = load_doc(&d, &gltf_doc(node.clone(), textured, extra.clone())).unwrap();
     let m = &loaded.scene.materials[loaded.scene.material[0] as usize];
     assert!(m.maps.kd.is_some());
+    // The same image as a normal texture: read as data, its scale kept, glTF's handedness.
+    let bumpy = json!({"normalTexture": {"index": 0, "scale": 0.5}, "pbrMetallicRoughness": {"metallicFactor": 0}});
+    let bumped = load_doc(&d, &gltf_doc(node, bumpy, extra)).unwrap();
+    let map = bumped.scene.materials[bumped.scene.material[0] as usize].normal_map.clone().expect("a normal map");
+    assert!(map.scale == 0.5 && map.handed && map.texture.texels[0] == Vec3::X, "{map:?}");
     // Corner (1, 0) in glTF coordinates: scaled to (2, 0), offset to (2.5, 0), v flipped to 1.
     let uvs: Vec<Vec2> = loaded.scene.uv[0].to_vec();
     assert!(uvs.iter().any(|uv| (*uv - Vec2::new(2.5, 1.0)).length() < 1e-6), "{uvs:?}");
@@ -239,16 +244,15 @@ fn gltf_bad_files_are_errors_naming_the_element() {
     let lambert = json!({"pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 1}});
     let images = json!({"extensionsUsed": ["KHR_materials_clearcoat"], "textures": [{"source": 0}],
                         "images": [{"uri": "data:image/png;base64,"}]});
-    // Normal textures are not read, so an empty image there is only warned of; as a base colour
-    // it is an error naming the image.
-    let masked =
-        json!({"alphaMode": "MASK", "normalTexture": {"index": 0}, "pbrMetallicRoughness": {"metallicFactor": 0}});
+    // What is not rendered is warned of; an empty image is an error naming what reads it, a
+    // normal texture as a base colour.
+    let masked = json!({"alphaMode": "MASK", "pbrMetallicRoughness": {"metallicFactor": 0}});
     let loaded = load_doc(&d, &gltf_doc(node.clone(), masked, images.clone())).unwrap();
     let w = loaded.scene.warnings.join("\n");
-    assert!(
-        w.contains("KHR_materials_clearcoat") && w.contains("alphaMode Mask") && w.contains("normal texture"),
-        "{w}"
-    );
+    assert!(w.contains("KHR_materials_clearcoat") && w.contains("alphaMode Mask"), "{w}");
+    let bumpy = json!({"normalTexture": {"index": 0}, "pbrMetallicRoughness": {"metallicFactor": 0}});
+    let e = load_doc(&d, &gltf_doc(node.clone(), bumpy, images.clone())).err().unwrap().to_string();
+    assert!(e.contains("the normal texture of material"), "{e}");
     let coloured = json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}});
     let e = load_doc(&d, &gltf_doc(node.clone(), coloured, images)).err().unwrap().to_string();
     assert!(e.contains("m.gltf") && e.contains("image 0"), "{e}");

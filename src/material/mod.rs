@@ -123,6 +123,23 @@ pub struct Material {
     /// `KHR_materials_volume` attenuation). Zero for a clear interior and for every material
     /// that is not a dielectric.
     pub interior: Vec3,
+    /// A tangent-space normal map that bends the shading normal ([`NormalMap`]).
+    pub normal_map: Option<NormalMap>,
+}
+
+/// A tangent-space normal map (Mitsuba's `normalmap`, glTF's `normalTexture`): each texel's RGB
+/// is a normal m = 2·rgb − 1 in the frame of the interpolated normal n, the texture's u
+/// direction s (dp/du made orthogonal to n) and t = n × s; the shading normal becomes
+/// s·m.x + t·m.y + n·m.z ([`crate::scene::Scene::surface`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NormalMap {
+    /// The map (linear data, not colour).
+    pub texture: Arc<Texture>,
+    /// Scale of m.x and m.y (glTF's `normalTexture.scale`; 1 elsewhere).
+    pub scale: f32,
+    /// Turn t where the texture coordinates are mirrored (glTF's bitangent, which follows the
+    /// handedness of (dp/du, dp/dv)); Mitsuba's frame does not.
+    pub handed: bool,
 }
 
 /// A material's image textures: each, when present, replaces its constant colour at every
@@ -159,7 +176,7 @@ impl Material {
     /// A material without textures.
     #[must_use]
     pub fn new(name: impl Into<String>, bsdf: Bsdf, emission: Vec3) -> Material {
-        Material { name: name.into(), bsdf, emission, maps: Maps::default(), interior: Vec3::ZERO }
+        Material { name: name.into(), bsdf, emission, maps: Maps::default(), interior: Vec3::ZERO, normal_map: None }
     }
 
     /// The radiance emitted at texture coordinates `uv` from the front face: the constant

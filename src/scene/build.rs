@@ -108,7 +108,7 @@ impl Scene {
             encloses_lights: false,
             warnings,
             bvh,
-            kinds: (false, false, false, false),
+            kinds: (false, false, false, false, false),
             open_edges: open_edges::OpenEdges::default(),
             caustic_targets: Vec::new(),
         };
@@ -122,7 +122,7 @@ impl Scene {
     }
 
     /// Which kinds of material the scene's triangles use: (any passed as specular by photons,
-    /// any glass, any non-delta, any absorbing interior).
+    /// any glass, any non-delta, any absorbing interior, any normal map).
     fn find_kinds(&mut self) {
         let mut used = vec![false; self.materials.len()];
         for &m in &self.material {
@@ -133,6 +133,7 @@ impl Scene {
             self.kinds.1 |= matches!(m.bsdf, Bsdf::Glass { .. } | Bsdf::ThinGlass { .. });
             self.kinds.2 |= !m.bsdf.is_delta();
             self.kinds.3 |= m.interior != Vec3::ZERO;
+            self.kinds.4 |= m.normal_map.is_some();
         }
     }
 
@@ -226,7 +227,7 @@ struct Triangles {
     vn: Vec<[Vec3; 3]>,
     mat: Vec<u32>,
     uv: Vec<[Vec2; 3]>,
-    /// Whether any material has a texture (then `uv` has a row per triangle).
+    /// Whether any material has a texture or a normal map (then `uv` has a row per triangle).
     textured: bool,
     /// Degenerate triangles skipped.
     dropped: usize,
@@ -237,7 +238,7 @@ impl Triangles {
     /// textured materials on meshes without texture coordinates; an emitter material whose every
     /// triangle is degenerate is an error.
     fn gather(meshes: &[MeshInput], materials: &[Material], warnings: &mut Vec<String>) -> Result<Triangles> {
-        let textured = materials.iter().any(|m| !m.maps.is_empty());
+        let textured = materials.iter().any(|m| !m.maps.is_empty() || m.normal_map.is_some());
         let mut t =
             Triangles { p0: vec![], p1: vec![], p2: vec![], vn: vec![], mat: vec![], uv: vec![], textured, dropped: 0 };
         let mut untextured_uses: Vec<String> = vec![];
@@ -279,7 +280,8 @@ impl Triangles {
                 if textured {
                     if m.texcoords.is_empty() {
                         let name = &materials[material as usize];
-                        if !name.maps.is_empty() && !untextured_uses.iter().any(|u| u.starts_with(&m.source)) {
+                        let mapped = !name.maps.is_empty() || name.normal_map.is_some();
+                        if mapped && !untextured_uses.iter().any(|u| u.starts_with(&m.source)) {
                             untextured_uses.push(format!(
                                 "{}: material `{}` has a texture but the mesh has no texture coordinates (`vt`); it \
                                  reads the texture at (0, 0) everywhere",

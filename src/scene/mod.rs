@@ -16,7 +16,7 @@ use crate::geometry::bvh::TriangleColumns;
 use crate::geometry::offset::barycentric_error;
 use crate::geometry::triangle::is_degenerate;
 use crate::geometry::{in_range, normal_and_area, Bvh, Hit, MAX_COORDINATE};
-use crate::material::{Bsdf, Material, SurfaceFrame};
+use crate::material::{Bsdf, Material, NormalMap, SurfaceFrame};
 use crate::sampling::Distribution1D;
 pub use camera::Camera;
 pub use environment::Environment;
@@ -138,9 +138,9 @@ pub struct Scene {
     /// aimed.
     pub caustic_targets: Vec<targets::Target>,
     bvh: Bvh,
-    /// (any delta, any glass, any non-delta, any absorbing interior) material on a triangle,
-    /// computed once.
-    kinds: (bool, bool, bool, bool),
+    /// (any delta, any glass, any non-delta, any absorbing interior, any normal map) material on
+    /// a triangle, computed once.
+    kinds: (bool, bool, bool, bool, bool),
 }
 
 impl Scene {
@@ -206,13 +206,18 @@ impl Scene {
         let (a, bb, c) = (self.p0[i], self.p1[i], self.p2[i]);
         let p = a * b[0] + bb * b[1] + c * b[2];
         let n = self.vn[i];
-        let ns = (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).try_normalize().unwrap_or(self.ng[i]);
+        let mut ns = (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).try_normalize().unwrap_or(self.ng[i]);
         let uv = if self.uv.is_empty() {
             Vec2::ZERO
         } else {
             let t = self.uv[i];
             t[0] * b[0] + t[1] * b[1] + t[2] * b[2]
         };
+        if self.kinds.4 && !self.uv.is_empty() {
+            if let Some(map) = &self.materials[self.material[i] as usize].normal_map {
+                ns = self.mapped_normal(i, ns, uv, map);
+            }
+        }
         SurfacePoint {
             p,
             p_error: barycentric_error(b, a, bb, c),
@@ -222,6 +227,31 @@ impl Scene {
             uv,
             flat: n == [self.ng[i]; 3],
         }
+    }
+
+    /// The shading normal of triangle `i` at texture coordinates `uv` under normal map `map`
+    /// ([`NormalMap`]), `n` the interpolated normal. Unchanged where the triangle's texture
+    /// coordinates are degenerate (no u direction) or the map's normal points into the surface.
+    fn mapped_normal(&self, i: usize, n: Vec3, uv: Vec2, map: &NormalMap) -> Vec3 {
+        let t = self.uv[i];
+        let (e1, e2) = (self.p1[i] - self.p0[i], self.p2[i] - self.p0[i]);
+        let (d1, d2) = (t[1] - t[0], t[2] - t[0]);
+        let det = d1.x * d2.y - d1.y * d2.x;
+        if det == 0.0 || !det.is_finite() {
+            return n;
+        }
+        let dpdu = (e1 * d2.y - e2 * d1.y) / det;
+        let dpdv = (e2 * d1.x - e1 * d2.x) / det;
+        let Some(s) = (dpdu - n * n.dot(dpdu)).try_normalize() else { return n };
+        let mut tangent_v = n.cross(s);
+        if map.handed && dpdu.cross(dpdv).dot(n) < 0.0 {
+            tangent_v = -tangent_v;
+        }
+        let m = map.texture.lookup(uv) * 2.0 - Vec3::ONE;
+        if !(m.z > 0.0) {
+            return n;
+        }
+        (s * (m.x * map.scale) + tangent_v * (m.y * map.scale) + n * m.z).try_normalize().unwrap_or(n)
     }
 
     /// The scattering at a surface point: its material's BSDF with any textures read at the

@@ -15,11 +15,12 @@
 //!
 //! Emission is `emissiveFactor` × `KHR_materials_emissive_strength` (radiance, taken as
 //! photonwave's units, as Blender imports it) times the emissive texture, from the front face.
-//! Normal and occlusion textures, alpha masks and blending are warned of by name.
+//! The normal texture bends the shading normal ([`NormalMap`], glTF's handedness); occlusion
+//! textures, alpha masks and blending are warned of by name.
 
 use super::Sources;
 use crate::error::Result;
-use crate::material::{Bsdf, Maps, Material, PHOTON_SPECULAR_ALPHA};
+use crate::material::{Bsdf, Maps, Material, NormalMap, PHOTON_SPECULAR_ALPHA};
 use crate::microfacet::{alpha_of, Alpha};
 use crate::texture::{Encoding, Texture};
 use glam::{Vec2, Vec3};
@@ -183,9 +184,23 @@ pub(super) fn convert(
     if emission.max_element() > 0.0 {
         maps.ke = ke_map;
     }
-    if m.normal_texture().is_some() {
-        warn("its normal texture is not rendered yet (shading uses the mesh's normals)".into());
-    }
+    // The normal texture, in the frame of the mesh's normal and its texture's u direction
+    // (with the handedness of its texture coordinates, as glTF's bitangent has it); read with
+    // TEXCOORD_0 and the first texture's transform, as the others.
+    let normal_map = match m.normal_texture() {
+        Some(nt) => {
+            if nt.tex_coord() != 0 {
+                warn(format!(
+                    "its normal texture reads TEXCOORD_{} (only TEXCOORD_0 is read; it is used instead)",
+                    nt.tex_coord()
+                ));
+            }
+            let what = format!("the normal texture of material `{name}`");
+            let texture = src.image(nt.texture().source().index(), Encoding::Linear, &what)?;
+            Some(NormalMap { texture, scale: nt.scale(), handed: true })
+        }
+        None => None,
+    };
     if m.occlusion_texture().is_some() {
         warn("its occlusion texture is ignored (a renderer computes occlusion; it is for rasterisers)".into());
     }
@@ -194,5 +209,8 @@ pub(super) fn convert(
         mode => warn(format!("alphaMode {mode:?} is not rendered yet: the surface is opaque")),
     }
     let emission = if emission.is_finite() { emission } else { Vec3::ZERO };
-    Ok(Converted { material: Material { name: name.to_string(), bsdf, emission, maps, interior }, uv: uv.flatten() })
+    Ok(Converted {
+        material: Material { name: name.to_string(), bsdf, emission, maps, interior, normal_map },
+        uv: uv.flatten(),
+    })
 }

@@ -10,7 +10,8 @@
 //! | `conductor`, `roughconductor` | mirror or rough conductor (Beckmann unless `ggx`), the exact Fresnel of `eta`, `k` or the named `material` ([`crate::optics::METALS`]), times `specular_reflectance` |
 //! | `plastic`, `roughplastic` | Mitsuba's smooth (a mirror coat) or rough plastic over `diffuse_reflectance`, with `nonlinear` and `specular_reflectance` (a texture as its mean, warned of) |
 //! | `phong` | normalised Phong (`diffuse_reflectance`, `specular_reflectance`, `exponent`) |
-//! | `bumpmap`, `normalmap`, `mask`, `coating`, `roughcoating`, `blendbsdf`, `mixturebsdf` | the (first) inner BSDF, warned of by name |
+//! | `normalmap` | its inner BSDF, its texture bending the shading normal ([`NormalMap`], Mitsuba's frame) |
+//! | `bumpmap`, `mask`, `coating`, `roughcoating`, `blendbsdf`, `mixturebsdf` | the (first) inner BSDF, warned of by name |
 //! | anything else | grey Lambertian (0.5), warned of with its line |
 //!
 //! `diffuse`, `roughconductor`, `roughdielectric`, `roughplastic` (GGX and Beckmann) and
@@ -29,7 +30,7 @@
 
 use super::Ctx;
 use crate::error::Result;
-use crate::material::{Bsdf, Maps, Material};
+use crate::material::{Bsdf, Maps, Material, NormalMap};
 use crate::microfacet::{Alpha, Distribution, MIN_ALPHA};
 use crate::optics::{named_metal, ComplexIor};
 use crate::texture::{Encoding, Texture};
@@ -222,8 +223,26 @@ impl Ctx<'_> {
         };
         let (bsdf, maps, uv) = match kind {
             "twosided" => return wrapper(self, None),
-            "bumpmap" | "normalmap" => {
-                return wrapper(self, Some("the bump or normal map is not rendered yet (the shape's normals are used)"))
+            "bumpmap" => return wrapper(self, Some("the bump map is not rendered yet (the shape's normals are used)")),
+            "normalmap" => {
+                // Its texture is data (Mitsuba reads it `raw`), a normal in the shading frame.
+                if let Some(t) = self.r.prop(node, "normalmap") {
+                    let t = if t.tag_name().name() == "ref" { self.referenced(t)? } else { t };
+                    self.r.boolean(t, "raw", true)?;
+                }
+                let map = self.coloured(node, "normalmap", Vec3::new(0.5, 0.5, 1.0), Encoding::Linear)?;
+                let (mut material, uv) = wrapper(self, None)?;
+                match map.map {
+                    Some(texture) => material.normal_map = Some(NormalMap { texture, scale: 1.0, handed: false }),
+                    None => self.warn(node, "bsdf `normalmap` without a texture: the shape's normals are used".into()),
+                }
+                if uv.is_some() && map.uv.is_some() && uv != map.uv {
+                    self.warn(
+                        node,
+                        "the normal map's texture transform differs from its BSDF's: the BSDF's is used".into(),
+                    );
+                }
+                return Ok((material, uv.or(map.uv)));
             }
             "mask" => return wrapper(self, Some("the opacity mask is not rendered yet: the surface is opaque")),
             "coating" | "roughcoating" => return wrapper(self, Some("the coating is not rendered: its base alone is")),
@@ -304,6 +323,16 @@ impl Ctx<'_> {
                 (Bsdf::Lambert { kd: Vec3::splat(0.5) }, Maps::default(), None)
             }
         };
-        Ok((Material { name: name.to_string(), bsdf, emission: Vec3::ZERO, maps, interior: Vec3::ZERO }, uv))
+        Ok((
+            Material {
+                name: name.to_string(),
+                bsdf,
+                emission: Vec3::ZERO,
+                maps,
+                interior: Vec3::ZERO,
+                normal_map: None,
+            },
+            uv,
+        ))
     }
 }
