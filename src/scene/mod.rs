@@ -232,6 +232,8 @@ impl Scene {
     /// The shading normal of triangle `i` at texture coordinates `uv` under normal map `map`
     /// ([`NormalMap`]), `n` the interpolated normal. Unchanged where the triangle's texture
     /// coordinates are degenerate (no u direction) or the map's normal points into the surface.
+    #[cold]
+    #[inline(never)]
     fn mapped_normal(&self, i: usize, n: Vec3, uv: Vec2, map: &NormalMap) -> Vec3 {
         let t = self.uv[i];
         let (e1, e2) = (self.p1[i] - self.p0[i], self.p2[i] - self.p0[i]);
