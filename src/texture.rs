@@ -77,6 +77,25 @@ impl Texture {
         top * (1.0 - fy) + bottom * fy
     }
 
+    /// The derivatives (∂/∂u, ∂/∂v) at `uv` of the bilinear value [`Texture::lookup`] returns:
+    /// constant across each cell between four texel centres (zero at a non-finite coordinate).
+    /// Rows run down the image as v falls, so ∂/∂v is the row difference times −height.
+    #[must_use]
+    pub fn gradient(&self, uv: Vec2) -> (Vec3, Vec3) {
+        let x = uv.x.fract() * self.width as f32 - 0.5;
+        let y = (1.0 - uv.y.fract()) * self.height as f32 - 0.5;
+        if !(x.is_finite() && y.is_finite()) {
+            return (Vec3::ZERO, Vec3::ZERO);
+        }
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (i, j) = (x0 as i64, y0 as i64);
+        let (a, b, c, d) = (self.texel(i, j), self.texel(i + 1, j), self.texel(i, j + 1), self.texel(i + 1, j + 1));
+        let dx = (b - a) * (1.0 - fy) + (d - c) * fy;
+        let dy = (c - a) * (1.0 - fx) + (d - b) * fx;
+        (dx * self.width as f32, dy * -(self.height as f32))
+    }
+
     /// The mean of every texel: what the texture reflects on average.
     #[must_use]
     pub fn mean(&self) -> Vec3 {
@@ -97,6 +116,25 @@ mod tests {
 
     fn centre(t: &Texture, i: u32, j: u32) -> Vec2 {
         Vec2::new((i as f32 + 0.5) / t.width as f32, 1.0 - (j as f32 + 0.5) / t.height as f32)
+    }
+
+    #[test]
+    fn the_gradient_is_the_bilinear_lookups_slope() {
+        // Central differences of `lookup` inside a cell against `gradient` (the ramp rises by 1
+        // per texel in x, so by 4 per unit of u; by 1 per row down, so by −2 per unit of v).
+        let t = ramp();
+        for uv in [Vec2::new(0.3, 0.4), Vec2::new(0.55, 0.35), Vec2::new(0.2, 0.6)] {
+            let (du, dv) = t.gradient(uv);
+            let h = 1e-3;
+            let cu = (t.lookup(uv + Vec2::new(h, 0.0)) - t.lookup(uv - Vec2::new(h, 0.0))) / (2.0 * h);
+            let cv = (t.lookup(uv + Vec2::new(0.0, h)) - t.lookup(uv - Vec2::new(0.0, h))) / (2.0 * h);
+            assert!(
+                (du - cu).abs().max_element() < 1e-2 && (dv - cv).abs().max_element() < 1e-2,
+                "{uv}: {du} {dv} against {cu} {cv}"
+            );
+        }
+        let (du, dv) = t.gradient(Vec2::new(0.3, 0.4));
+        assert!((du.x - 4.0).abs() < 1e-4 && (dv.y + 2.0).abs() < 1e-4, "{du} {dv}");
     }
 
     #[test]

@@ -127,19 +127,36 @@ pub struct Material {
     pub normal_map: Option<NormalMap>,
 }
 
-/// A tangent-space normal map (Mitsuba's `normalmap`, glTF's `normalTexture`): each texel's RGB
-/// is a normal m = 2·rgb − 1 in the frame of the interpolated normal n, the texture's u
-/// direction s (dp/du made orthogonal to n) and t = n × s; the shading normal becomes
-/// s·m.x + t·m.y + n·m.z ([`crate::scene::Scene::surface`]).
+/// A texture that bends the shading normal ([`crate::scene::Scene::surface`]):
+/// - normals ([`Relief::Normals`]; Mitsuba's `normalmap`, glTF's `normalTexture`): each texel's
+///   RGB is a normal m = 2·rgb − 1 in the frame of the interpolated normal n, the texture's u
+///   direction s (dp/du made orthogonal to n) and t = n × s; the shading normal becomes
+///   s·m.x + t·m.y + n·m.z;
+/// - heights ([`Relief::Heights`]; Mitsuba's `bumpmap`): the texel's luminance h is a height
+///   along n, so the surface's tangents become dp/du + n·(scale·∂h/∂u − n·dp/du) and the same in
+///   v (Mitsuba's form), and the shading normal their cross product, on the geometric normal's
+///   side.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NormalMap {
     /// The map (linear data, not colour).
     pub texture: Arc<Texture>,
-    /// Scale of m.x and m.y (glTF's `normalTexture.scale`; 1 elsewhere).
+    /// What its texels are.
+    pub relief: Relief,
+    /// Scale of m.x and m.y (glTF's `normalTexture.scale`; 1 elsewhere), or of the height
+    /// gradient (Mitsuba's `bumpmap` `scale`).
     pub scale: f32,
     /// Turn t where the texture coordinates are mirrored (glTF's bitangent, which follows the
     /// handedness of (dp/du, dp/dv)); Mitsuba's frame does not.
     pub handed: bool,
+}
+
+/// What a [`NormalMap`]'s texels hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Relief {
+    /// Tangent-space normals, 2·rgb − 1.
+    Normals,
+    /// Heights (the texel's luminance).
+    Heights,
 }
 
 /// A material's image textures: each, when present, replaces its constant colour at every

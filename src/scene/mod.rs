@@ -16,7 +16,7 @@ use crate::geometry::bvh::TriangleColumns;
 use crate::geometry::offset::barycentric_error;
 use crate::geometry::triangle::is_degenerate;
 use crate::geometry::{in_range, normal_and_area, Bvh, Hit, MAX_COORDINATE};
-use crate::material::{Bsdf, Material, NormalMap, SurfaceFrame};
+use crate::material::{Bsdf, Material, NormalMap, Relief, SurfaceFrame};
 use crate::sampling::Distribution1D;
 pub use camera::Camera;
 pub use environment::Environment;
@@ -248,6 +248,15 @@ impl Scene {
         let mut tangent_v = n.cross(s);
         if map.handed && dpdu.cross(dpdv).dot(n) < 0.0 {
             tangent_v = -tangent_v;
+        }
+        if map.relief == Relief::Heights {
+            // Luminance weights of the texture's linear RGB (Mitsuba's).
+            let luminance = |c: Vec3| c.dot(Vec3::new(0.212_671, 0.715_160, 0.072_169));
+            let (gu, gv) = map.texture.gradient(uv);
+            let du = dpdu + n * (map.scale * luminance(gu) - n.dot(dpdu));
+            let dv = dpdv + n * (map.scale * luminance(gv) - n.dot(dpdv));
+            let Some(bumped) = du.cross(dv).try_normalize() else { return n };
+            return if bumped.dot(self.ng[i]) < 0.0 { -bumped } else { bumped };
         }
         let m = map.texture.lookup(uv) * 2.0 - Vec3::ONE;
         if !(m.z > 0.0) {

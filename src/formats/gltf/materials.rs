@@ -20,7 +20,7 @@
 
 use super::Sources;
 use crate::error::Result;
-use crate::material::{Bsdf, Maps, Material, NormalMap, PHOTON_SPECULAR_ALPHA};
+use crate::material::{Bsdf, Maps, Material, NormalMap, Relief, PHOTON_SPECULAR_ALPHA};
 use crate::microfacet::{alpha_of, Alpha};
 use crate::texture::{Encoding, Texture};
 use glam::{Vec2, Vec3};
@@ -197,7 +197,7 @@ pub(super) fn convert(
             }
             let what = format!("the normal texture of material `{name}`");
             let texture = src.image(nt.texture().source().index(), Encoding::Linear, &what)?;
-            Some(NormalMap { texture, scale: nt.scale(), handed: true })
+            Some(NormalMap { texture, relief: Relief::Normals, scale: nt.scale(), handed: true })
         }
         None => None,
     };

@@ -11,7 +11,8 @@
 //! | `plastic`, `roughplastic` | Mitsuba's smooth (a mirror coat) or rough plastic over `diffuse_reflectance`, with `nonlinear` and `specular_reflectance` (a texture as its mean, warned of) |
 //! | `phong` | normalised Phong (`diffuse_reflectance`, `specular_reflectance`, `exponent`) |
 //! | `normalmap` | its inner BSDF, its texture bending the shading normal ([`NormalMap`], Mitsuba's frame) |
-//! | `bumpmap`, `mask`, `coating`, `roughcoating`, `blendbsdf`, `mixturebsdf` | the (first) inner BSDF, warned of by name |
+//! | `bumpmap` | its inner BSDF, its `bitmap` (in any `scale` textures) a height field that bends the shading normal ([`Relief::Heights`]) |
+//! | `mask`, `coating`, `roughcoating`, `blendbsdf`, `mixturebsdf` | the (first) inner BSDF, warned of by name |
 //! | anything else | grey Lambertian (0.5), warned of with its line |
 //!
 //! `diffuse`, `roughconductor`, `roughdielectric`, `roughplastic` (GGX and Beckmann) and
@@ -30,7 +31,7 @@
 
 use super::Ctx;
 use crate::error::Result;
-use crate::material::{Bsdf, Maps, Material, NormalMap};
+use crate::material::{Bsdf, Maps, Material, NormalMap, Relief};
 use crate::microfacet::{Alpha, Distribution, MIN_ALPHA};
 use crate::optics::{named_metal, ComplexIor};
 use crate::texture::{Encoding, Texture};
@@ -195,6 +196,54 @@ impl Ctx<'_> {
         Ok(Alpha::new(distribution, a.clamp(MIN_ALPHA, 1.0)))
     }
 
+    /// A `bumpmap`'s height field and gradient scale: its `scale` times those of any `scale`
+    /// textures (Mitsuba 0.5's way) around a `bitmap`, read as data; `None` (warned of) for
+    /// another texture.
+    fn height_map(&mut self, node: Node) -> Result<Option<(Arc<Texture>, f32)>> {
+        let mut scale = self.r.float(node, "scale", 1.0)?;
+        let doc = self.r.doc;
+        let mut t = self.first_texture(node)?;
+        for _ in 0..MAX_NESTING {
+            let Some(tex) = t.and_then(|id| doc.get_node(id)) else { return Ok(None) };
+            match tex.attribute("type").unwrap_or("") {
+                "scale" => {
+                    scale *= self.r.float(tex, "scale", 1.0)?;
+                    t = self.first_texture(tex)?;
+                }
+                "bitmap" => {
+                    self.r.boolean(tex, "raw", true)?;
+                    let file = self
+                        .r
+                        .string(tex, "filename")?
+                        .ok_or_else(|| self.r.error(tex, "a bitmap needs a `filename`"))?;
+                    return Ok(Some((self.image(tex, &file, Encoding::Linear)?, scale)));
+                }
+                other => {
+                    self.warn(tex, format!("a `{other}` height field is not read (a `bitmap` is)"));
+                    return Ok(None);
+                }
+            }
+        }
+        Ok(None)
+    }
+
+    /// The first `<texture>` child of `node`, or the texture its first `<ref>` to one names.
+    fn first_texture(&self, node: Node) -> Result<Option<roxmltree::NodeId>> {
+        for c in node.children().filter(Node::is_element) {
+            match c.tag_name().name() {
+                "texture" => return Ok(Some(c.id())),
+                "ref" => {
+                    let r = self.referenced(c)?;
+                    if r.tag_name().name() == "texture" {
+                        return Ok(Some(r.id()));
+                    }
+                }
+                _ => {}
+            }
+        }
+        Ok(None)
+    }
+
     /// The material of `<bsdf>` element `node`, called `name`, and the texture coordinate map its
     /// textures want.
     pub(super) fn bsdf(&mut self, node: Node, name: &str) -> Result<(Material, Option<UvMap>)> {
@@ -223,7 +272,18 @@ impl Ctx<'_> {
         };
         let (bsdf, maps, uv) = match kind {
             "twosided" => return wrapper(self, None),
-            "bumpmap" => return wrapper(self, Some("the bump map is not rendered yet (the shape's normals are used)")),
+            "bumpmap" => {
+                let heights = self.height_map(node)?;
+                let (mut material, uv) = wrapper(self, None)?;
+                match heights {
+                    Some((texture, scale)) => {
+                        material.normal_map =
+                            Some(NormalMap { texture, relief: Relief::Heights, scale, handed: false });
+                    }
+                    None => self.warn(node, "bsdf `bumpmap` without a bitmap: the shape's normals are used".into()),
+                }
+                return Ok((material, uv));
+            }
             "normalmap" => {
                 // Its texture is data (Mitsuba reads it `raw`), a normal in the shading frame.
                 if let Some(t) = self.r.prop(node, "normalmap") {
@@ -233,7 +293,10 @@ impl Ctx<'_> {
                 let map = self.coloured(node, "normalmap", Vec3::new(0.5, 0.5, 1.0), Encoding::Linear)?;
                 let (mut material, uv) = wrapper(self, None)?;
                 match map.map {
-                    Some(texture) => material.normal_map = Some(NormalMap { texture, scale: 1.0, handed: false }),
+                    Some(texture) => {
+                        material.normal_map =
+                            Some(NormalMap { texture, relief: Relief::Normals, scale: 1.0, handed: false })
+                    }
                     None => self.warn(node, "bsdf `normalmap` without a texture: the shape's normals are used".into()),
                 }
                 if uv.is_some() && map.uv.is_some() && uv != map.uv {
