@@ -241,16 +241,37 @@ fn warnings_name_their_file() {
     assert!(w.iter().any(|w| w.contains("m.mtl:5: material `shiny`: Kd + Ks")), "{w:?}");
 }
 
-/// Texture statements not simulated (`map_d`, `bump`) and transparency are read and said to be ignored, once per material;
-/// `Ns -5`, `illum 99` and a file that is not UTF-8 are errors with their line.
+/// Texture statements not simulated (`map_d`, a bump map's options other than `-bm`) and
+/// transparency are read and said to be ignored, once per material; a `bump` map is read with
+/// its `-bm`, and one with a `-bm` that is no number is an error; `Ns -5`, `illum 99` and a file
+/// that is not UTF-8 are errors with their line.
 #[test]
 fn what_is_not_simulated_is_said() {
     let d = scratch_dir("said");
-    write(&d, "m.mtl", format!("{MTL}map_d -s 2 2 2 alpha.png\nbump -bm 0.3 wood-bump.png\nd 0.4\nsharpness 60\n"));
+    let mut png_bytes = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut png_bytes, 1, 1);
+        enc.set_color(png::ColorType::Grayscale);
+        enc.write_header().unwrap().write_image_data(&[128]).unwrap();
+    }
+    write(&d, "wood-bump.png", png_bytes);
+    write(
+        &d,
+        "m.mtl",
+        format!("{MTL}map_d -s 2 2 2 alpha.png\nbump -bm 0.3 -clamp on wood-bump.png\nd 0.4\nsharpness 60\n"),
+    );
     let scene = load_scene(&write(&d, "a.obj", OBJ)).unwrap().scene;
     let w: Vec<_> = scene.warnings.iter().filter(|w| w.contains("not simulated")).collect();
     assert_eq!(w.len(), 1, "{w:?}");
-    assert!(w[0].contains("m.mtl:4: material `white`") && w[0].contains("`map_d`, `bump`, `d`, `sharpness`"));
+    assert!(
+        w[0].contains("m.mtl:4: material `white`") && w[0].contains("`map_d`, `bump options`, `d`, `sharpness`"),
+        "{w:?}"
+    );
+    let bump = scene.materials.iter().find_map(|m| m.normal_map.as_ref()).expect("the bump map");
+    assert!(bump.scale == 0.3 && bump.relief == photonwave::material::Relief::Heights, "{bump:?}");
+    write(&d, "m.mtl", format!("{MTL}bump -bm x wood-bump.png\n"));
+    let e = load_scene(&d.join("a.obj")).err().unwrap().to_string();
+    assert!(e.contains("m.mtl:6:") && e.contains("-bm"), "{e}");
     for (bad, what) in [("Ns -5", "negative"), ("illum 99", "0–10")] {
         write(&d, "m.mtl", format!("{MTL}{bad}\n"));
         let e = load_scene(&d.join("a.obj")).err().unwrap().to_string();

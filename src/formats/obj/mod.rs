@@ -14,7 +14,7 @@ use crate::files::{read_text, MAX_MATERIAL_FILE, MAX_MESH_FILE};
 use crate::formats::materials::MaterialTable;
 use crate::formats::transform::Transform;
 use crate::geometry::in_range;
-use crate::material::{Bsdf, Maps};
+use crate::material::{Bsdf, Maps, NormalMap, Relief};
 use crate::scene::{first_out_of_range, out_of_range_message, MeshInput};
 use crate::texture::{Encoding, Texture};
 use glam::{Vec2, Vec3};
@@ -48,6 +48,24 @@ impl MaterialTable {
             ke: load("map_Ke", Encoding::Srgb)?,
             metallic: load("map_Pm", Encoding::Linear)?,
         })
+    }
+
+    /// The height field of a material's `bump` (or `map_Bump`) statement, its `-bm` as the
+    /// scale ([`Relief::Heights`]); an image that cannot be read is an error naming it and the
+    /// statement.
+    pub fn load_bump(
+        &mut self,
+        mtl_path: &Path,
+        m: &MtlMaterial,
+        inputs: &mut Vec<PathBuf>,
+    ) -> Result<Option<NormalMap>> {
+        let Some(st) = m.map("bump") else { return Ok(None) };
+        let dir = mtl_path.parent().unwrap_or(Path::new("."));
+        let texture =
+            self.texture(&dir.join(&st.file), Encoding::Linear, "a `bump` height map", inputs).map_err(|e| {
+                named_by_statement(e, &format!("`bump` of material `{}` at {}:{}", m.name, mtl_path.display(), st.line))
+            })?;
+        Ok(Some(NormalMap { texture, relief: Relief::Heights, scale: st.scale, handed: false }))
     }
 }
 
@@ -157,6 +175,7 @@ pub fn load_obj(
     for (file, m) in &mtl {
         let mut material = material_from_mtl(m, file, warnings);
         material.maps = table.load_maps(file, m, inputs)?;
+        material.normal_map = table.load_bump(file, m, inputs)?;
         // A PBR metal's colour is its `Kd`: so is its texture's.
         if m.pm.is_some_and(|p| p >= 0.5) && material.maps.ks.is_none() {
             material.maps.ks = material.maps.kd.take();

@@ -64,6 +64,8 @@ pub struct MapStatement {
     pub file: String,
     /// Its line.
     pub line: usize,
+    /// The bump multiplier (`-bm` of a `bump` map; 1 elsewhere).
+    pub scale: f32,
 }
 
 impl MtlMaterial {
@@ -120,6 +122,16 @@ fn colour(path: &Path, line: usize, kw: &str, words: &[&str]) -> Result<Option<V
 
 /// The image file of a texture statement's words: the spec's options (`-o 1 1 1`, `-bm 0.5`,
 /// `-clamp on`, …) with their arguments come first, the file name (which may hold spaces) last.
+/// The `-bm` multiplier among a map statement's `words` (1 without one); an error naming the
+/// line when it is not a finite number.
+fn bump_multiplier(path: &Path, line: usize, words: &[&str]) -> Result<f32> {
+    let Some(i) = words.iter().position(|w| *w == "-bm") else { return Ok(1.0) };
+    match words.get(i + 1).and_then(|w| w.parse::<f32>().ok()).filter(|v| v.is_finite()) {
+        Some(v) => Ok(v),
+        None => Err(Error::parse(path, line, "`-bm` needs a finite number (the bump multiplier)")),
+    }
+}
+
 fn texture_file(words: &[&str]) -> Option<String> {
     let mut i = 0;
     while let Some(opt) = words.get(i).filter(|w| w.starts_with('-')) {
@@ -318,7 +330,14 @@ fn statement(path: &Path, line: usize, kw: &str, words: &[&str], m: &mut MtlMate
                 if words.first().is_some_and(|w| w.starts_with('-')) {
                     m.ignore(&format!("{kw} options"));
                 }
-                m.maps.push(MapStatement { key: kw.to_string(), file, line });
+                m.maps.push(MapStatement { key: kw.to_string(), file, line, scale: 1.0 });
+            } else if matches!(kw, "bump" | "map_Bump" | "map_bump") {
+                // A height field: `-bm` scales the heights, other options are not simulated.
+                let scale = bump_multiplier(path, line, words)?;
+                if words.iter().any(|w| w.starts_with('-') && *w != "-bm") {
+                    m.ignore("bump options");
+                }
+                m.maps.push(MapStatement { key: "bump".to_string(), file, line, scale });
             } else {
                 m.ignore(kw);
             }
@@ -386,10 +405,10 @@ mod tests {
                     d 0.5\nd -halo 1\nmap_Ks spec.png\nnewmtl b\nd 1\nTr 0\n";
         let (m, w) = parse(text);
         let m = m.unwrap();
-        assert_eq!(m[0].ignored, ["sharpness", "Km", "map_Kd options", "bump", "d"]);
+        assert_eq!(m[0].ignored, ["sharpness", "Km", "map_Kd options", "d"]);
         assert_eq!(
-            m[0].maps.iter().map(|s| (s.key.as_str(), s.file.as_str(), s.line)).collect::<Vec<_>>(),
-            [("map_Kd", "tex.png", 5), ("map_Ks", "spec.png", 9)]
+            m[0].maps.iter().map(|s| (s.key.as_str(), s.file.as_str(), s.line, s.scale)).collect::<Vec<_>>(),
+            [("map_Kd", "tex.png", 5, 1.0), ("bump", "b.png", 6, 0.5), ("map_Ks", "spec.png", 9, 1.0)]
         );
         assert!(m[1].ignored.is_empty(), "opaque `d 1` and `Tr 0` change nothing");
         assert_eq!(w.len(), 1, "{w:?}");
