@@ -59,19 +59,25 @@ impl Texture {
         self.texels[j * self.width as usize + i]
     }
 
-    /// The bilinear value at `uv`, wrapping outside [0, 1). A non-finite coordinate reads
-    /// texel (0, 0) rather than NaN.
-    #[must_use]
-    pub fn lookup(&self, uv: Vec2) -> Vec3 {
+    /// The cell of texel centres around `uv` (wrapping outside [0, 1)): its first texel's column
+    /// and row and the fractions across it; `None` at a non-finite coordinate.
+    #[inline]
+    fn cell(&self, uv: Vec2) -> Option<(i64, i64, f32, f32)> {
         // Continuous texel coordinates whose integers are texel centres.
         let x = uv.x.fract() * self.width as f32 - 0.5;
         let y = (1.0 - uv.y.fract()) * self.height as f32 - 0.5;
         if !(x.is_finite() && y.is_finite()) {
-            return self.texels[0];
+            return None;
         }
         let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (i, j) = (x0 as i64, y0 as i64);
+        Some((x0 as i64, y0 as i64, x - x0, y - y0))
+    }
+
+    /// The bilinear value at `uv`, wrapping outside [0, 1). A non-finite coordinate reads
+    /// texel (0, 0) rather than NaN.
+    #[must_use]
+    pub fn lookup(&self, uv: Vec2) -> Vec3 {
+        let Some((i, j, fx, fy)) = self.cell(uv) else { return self.texels[0] };
         let top = self.texel(i, j) * (1.0 - fx) + self.texel(i + 1, j) * fx;
         let bottom = self.texel(i, j + 1) * (1.0 - fx) + self.texel(i + 1, j + 1) * fx;
         top * (1.0 - fy) + bottom * fy
@@ -82,14 +88,7 @@ impl Texture {
     /// Rows run down the image as v falls, so ∂/∂v is the row difference times −height.
     #[must_use]
     pub fn gradient(&self, uv: Vec2) -> (Vec3, Vec3) {
-        let x = uv.x.fract() * self.width as f32 - 0.5;
-        let y = (1.0 - uv.y.fract()) * self.height as f32 - 0.5;
-        if !(x.is_finite() && y.is_finite()) {
-            return (Vec3::ZERO, Vec3::ZERO);
-        }
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (i, j) = (x0 as i64, y0 as i64);
+        let Some((i, j, fx, fy)) = self.cell(uv) else { return (Vec3::ZERO, Vec3::ZERO) };
         let (a, b, c, d) = (self.texel(i, j), self.texel(i + 1, j), self.texel(i, j + 1), self.texel(i + 1, j + 1));
         let dx = (b - a) * (1.0 - fy) + (d - c) * fy;
         let dy = (c - a) * (1.0 - fx) + (d - b) * fx;

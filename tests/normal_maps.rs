@@ -63,6 +63,25 @@ fn plane_of(dir: &Path, name: &str, bsdf: &str) -> photonwave::formats::LoadedSc
     load_scene(&path).unwrap()
 }
 
+/// The 8² beauty images of `mapped` and `flat` (the same camera) by each engine, in turn.
+fn beauty_in_every_engine(
+    mapped: photonwave::formats::LoadedScene,
+    flat: photonwave::formats::LoadedScene,
+) -> Vec<(Engine, Vec<Vec3>, Vec<Vec3>)> {
+    let rays = flat.camera.unwrap().prepare(8, 8).unwrap();
+    let (flat, mapped) = (Arc::new(flat.scene), Arc::new(mapped.scene));
+    let s = Settings { width: 8, height: 8, spp: 2, photons: 500, caustic_photons: 500, ..Settings::default() };
+    [Engine::Wavefront, Engine::Reference, Engine::Path]
+        .into_iter()
+        .map(|engine| {
+            let beauty = |scene: &Arc<photonwave::scene::Scene>| {
+                render(scene, &rays, &s, engine, None, &NoProgress).unwrap().0.beauty()
+            };
+            (engine, beauty(&mapped), beauty(&flat))
+        })
+        .collect()
+}
+
 #[test]
 fn a_normal_map_tilting_a_plane_scales_its_direct_light_by_the_cosine() {
     // Sunlight along the plane's normal: a Lambertian's radiance is kd/π·E·cos θ, θ between the
@@ -76,14 +95,7 @@ fn a_normal_map_tilting_a_plane_scales_its_direct_light_by_the_cosine() {
         let cos = m.z / m.length();
         let (flat, mapped) = (plane(&d, "flat.xml", None), plane(&d, &format!("tilt{k}.xml"), Some(&file)));
         assert!(mapped.scene.materials.iter().any(|m| m.normal_map.is_some()), "the map is read");
-        let rays = flat.camera.unwrap().prepare(8, 8).unwrap();
-        let (flat, mapped) = (Arc::new(flat.scene), Arc::new(mapped.scene));
-        for engine in [Engine::Wavefront, Engine::Reference, Engine::Path] {
-            let s = Settings { width: 8, height: 8, spp: 2, photons: 500, caustic_photons: 500, ..Settings::default() };
-            let beauty = |scene: &Arc<photonwave::scene::Scene>| {
-                render(scene, &rays, &s, engine, None, &NoProgress).unwrap().0.beauty()
-            };
-            let (a, b) = (beauty(&mapped), beauty(&flat));
+        for (engine, a, b) in beauty_in_every_engine(mapped, flat) {
             for (x, y) in a.iter().zip(&b) {
                 assert!((y.x - 0.5 / std::f32::consts::PI).abs() < 1e-5, "{engine:?}: the flat plane is kd/π: {y}");
                 assert!((*x - *y * cos).abs().max_element() < 1e-5, "{engine:?} texel {rgb:?}: {x} against {y}·{cos}");
@@ -109,14 +121,8 @@ fn a_height_map_sloping_along_u_tilts_the_plane_by_its_gradient() {
     assert!(bumped.scene.materials.iter().any(|m| m.normal_map.is_some()), "the height map is read");
     let g = 8.0 * 64.0 / 255.0 / 4.0f32;
     let cos = 1.0 / (1.0 + g * g).sqrt();
-    let rays = flat.camera.unwrap().prepare(8, 8).unwrap();
-    let (flat, bumped) = (Arc::new(flat.scene), Arc::new(bumped.scene));
-    for engine in [Engine::Wavefront, Engine::Reference, Engine::Path] {
-        let s = Settings { width: 8, height: 8, spp: 2, photons: 500, caustic_photons: 500, ..Settings::default() };
-        let beauty = |scene: &Arc<photonwave::scene::Scene>| {
-            render(scene, &rays, &s, engine, None, &NoProgress).unwrap().0.beauty()
-        };
-        for (x, y) in beauty(&bumped).iter().zip(&beauty(&flat)) {
+    for (engine, a, b) in beauty_in_every_engine(bumped, flat) {
+        for (x, y) in a.iter().zip(&b) {
             assert!((*x - *y * cos).abs().max_element() < 1e-5, "{engine:?}: {x} against {y}·{cos}");
         }
     }

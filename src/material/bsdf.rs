@@ -65,20 +65,17 @@ impl Bsdf {
     /// plastic's kd′·(1 − F(wo))·(1 − F(wi))/η² ([`SmoothPlastic::base`]).
     #[must_use]
     pub fn gather_weight(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> Vec3 {
-        let local = || {
-            let (_, ns) = frame.oriented(wo);
-            let f = Frame::new(ns);
-            (f.to_local(wo), f.to_local(wi))
-        };
-        if let Some(p) = self.plastic() {
-            let (lo, li) = local();
-            return p.base(lo, li);
+        if !self.gather_varies() {
+            return self.diffuse();
         }
-        if let Some(p) = self.smooth_plastic() {
-            let (lo, li) = local();
-            return p.base(lo, li);
+        let (_, ns) = frame.oriented(wo);
+        let f = Frame::new(ns);
+        let (lo, li) = (f.to_local(wo), f.to_local(wi));
+        match (self.plastic(), self.smooth_plastic()) {
+            (Some(p), _) => p.base(lo, li),
+            (_, Some(p)) => p.base(lo, li),
+            _ => self.diffuse(),
         }
-        self.diffuse()
     }
 
     /// A smooth plastic's model ([`SmoothPlastic`]); `None` for the other materials.

@@ -57,9 +57,13 @@ impl SmoothPlastic {
     /// The probability of sampling the coat from `wo` (see the module doc).
     #[must_use]
     pub fn coat_probability(&self, wo: Vec3) -> f32 {
+        self.coat_share(fresnel_dielectric(wo.z.max(0.0), self.eta))
+    }
+
+    /// The coat probability for the coat's Fresnel reflectance `f` toward the viewer.
+    fn coat_share(&self, f: f32) -> f32 {
         let (s, d) = (self.ks.element_sum(), self.kd.element_sum());
         let w = if s + d > 0.0 { s / (s + d) } else { 1.0 };
-        let f = fresnel_dielectric(wo.z.max(0.0), self.eta);
         let (coat, base) = (f * w, (1.0 - f) * (1.0 - w));
         if coat + base > 0.0 {
             coat / (coat + base)
@@ -91,10 +95,12 @@ impl SmoothPlastic {
         if wo.z <= 0.0 {
             return None;
         }
-        let p = self.coat_probability(wo);
+        // One Fresnel reflectance serves the choice and the coat's weight.
+        let f = fresnel_dielectric(wo.z, self.eta);
+        let p = self.coat_share(f);
         if u[2] < p {
-            let c = self.coat(wo);
-            return Some(PlasticSample { sample: LocalSample { wi: c.wi, weight: c.weight / p }, coat: true });
+            let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+            return Some(PlasticSample { sample: LocalSample { wi, weight: self.ks * f / p }, coat: true });
         }
         let wi = cosine_hemisphere([u[0], u[1]]);
         if wi.z <= 0.0 || p >= 1.0 {

@@ -244,11 +244,6 @@ impl Scene {
         }
         let dpdu = (e1 * d2.y - e2 * d1.y) / det;
         let dpdv = (e2 * d1.x - e1 * d2.x) / det;
-        let Some(s) = (dpdu - n * n.dot(dpdu)).try_normalize() else { return n };
-        let mut tangent_v = n.cross(s);
-        if map.handed && dpdu.cross(dpdv).dot(n) < 0.0 {
-            tangent_v = -tangent_v;
-        }
         if map.relief == Relief::Heights {
             // Luminance weights of the texture's linear RGB (Mitsuba's).
             let luminance = |c: Vec3| c.dot(Vec3::new(0.212_671, 0.715_160, 0.072_169));
@@ -257,6 +252,11 @@ impl Scene {
             let dv = dpdv + n * (map.scale * luminance(gv) - n.dot(dpdv));
             let Some(bumped) = du.cross(dv).try_normalize() else { return n };
             return if bumped.dot(self.ng[i]) < 0.0 { -bumped } else { bumped };
+        }
+        let Some(s) = (dpdu - n * n.dot(dpdu)).try_normalize() else { return n };
+        let mut tangent_v = n.cross(s);
+        if map.handed && dpdu.cross(dpdv).dot(n) < 0.0 {
+            tangent_v = -tangent_v;
         }
         let m = map.texture.lookup(uv) * 2.0 - Vec3::ONE;
         if !(m.z > 0.0) {

@@ -29,17 +29,8 @@ impl MaterialTable {
     /// read before); each file read is added to `inputs`. An image that cannot be read is an
     /// error naming it and the MTL statement.
     pub fn load_maps(&mut self, mtl_path: &Path, m: &MtlMaterial, inputs: &mut Vec<PathBuf>) -> Result<Maps> {
-        let dir = mtl_path.parent().unwrap_or(Path::new("."));
-        let mut load = |key: &str, encoding: Encoding| -> Result<Option<Arc<Texture>>> {
-            let Some(st) = m.map(key) else { return Ok(None) };
-            let what = format!("a `{key}` texture");
-            let texture = self.texture(&dir.join(&st.file), encoding, &what, inputs).map_err(|e| {
-                named_by_statement(
-                    e,
-                    &format!("`{key}` of material `{}` at {}:{}", m.name, mtl_path.display(), st.line),
-                )
-            })?;
-            Ok(Some(texture))
+        let mut load = |key: &str, encoding: Encoding| {
+            self.load_statement(mtl_path, m, key, encoding, &format!("a `{key}` texture"), inputs)
         };
         Ok(Maps {
             kd: load("map_Kd", Encoding::Srgb)?,
@@ -59,13 +50,28 @@ impl MaterialTable {
         m: &MtlMaterial,
         inputs: &mut Vec<PathBuf>,
     ) -> Result<Option<NormalMap>> {
-        let Some(st) = m.map("bump") else { return Ok(None) };
+        let Some(scale) = m.map("bump").map(|st| st.scale) else { return Ok(None) };
+        let texture = self.load_statement(mtl_path, m, "bump", Encoding::Linear, "a `bump` height map", inputs)?;
+        Ok(texture.map(|texture| NormalMap { texture, relief: Relief::Heights, scale, handed: false }))
+    }
+
+    /// The image of material `m`'s map statement `key` (`None` without one), read as `what` in
+    /// `encoding`; an image that cannot be read is an error naming it and the statement.
+    fn load_statement(
+        &mut self,
+        mtl_path: &Path,
+        m: &MtlMaterial,
+        key: &str,
+        encoding: Encoding,
+        what: &str,
+        inputs: &mut Vec<PathBuf>,
+    ) -> Result<Option<Arc<Texture>>> {
+        let Some(st) = m.map(key) else { return Ok(None) };
         let dir = mtl_path.parent().unwrap_or(Path::new("."));
-        let texture =
-            self.texture(&dir.join(&st.file), Encoding::Linear, "a `bump` height map", inputs).map_err(|e| {
-                named_by_statement(e, &format!("`bump` of material `{}` at {}:{}", m.name, mtl_path.display(), st.line))
-            })?;
-        Ok(Some(NormalMap { texture, relief: Relief::Heights, scale: st.scale, handed: false }))
+        let texture = self.texture(&dir.join(&st.file), encoding, what, inputs).map_err(|e| {
+            named_by_statement(e, &format!("`{key}` of material `{}` at {}:{}", m.name, mtl_path.display(), st.line))
+        })?;
+        Ok(Some(texture))
     }
 }
 
