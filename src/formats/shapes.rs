@@ -3,6 +3,13 @@
 //! z = 0 plane facing +z, a `disk` the unit disk there, a `cube` [−1, 1]³ facing out, a `sphere`
 //! the unit sphere facing out (smooth normals). The scene's transform places them.
 //!
+//! Their texture coordinates are Mitsuba 3's (`SurfaceInteraction3f::uv` on its shapes, checked
+//! point by point in tests/mitsuba_uv.rs) with v turned over, v → 1 − v: Mitsuba reads an
+//! image's first row at v = 0, photonwave at v = 1 ([`crate::texture`]), so the same texel lands
+//! on the same point. A rectangle is (x + 1)/2, (1 − y)/2; a disk (r, 1 − φ/2π), each fan
+//! triangle with its own vertices so that neither the centre nor the seam at φ = 0 is shared; a
+//! cube has Mitsuba's per-face layout; a sphere (φ/2π, 1 − θ/π).
+//!
 //! Writes [`MeshInput`]s; the front (emitting) face of each is the one its normal points out of.
 
 use crate::error::{Error, Result};
@@ -34,31 +41,40 @@ pub fn shape(name: &str, source: &str, material: u32) -> Result<MeshInput> {
     Ok(mesh)
 }
 
-/// [−1, 1]² at z = 0, facing +z, texture coordinates (0, 0) to (1, 1).
+/// [−1, 1]² at z = 0, facing +z, texture coordinates ((x + 1)/2, (1 − y)/2).
 fn rectangle() -> MeshInput {
     let corners = [Vec2::new(-1.0, -1.0), Vec2::new(1.0, -1.0), Vec2::new(1.0, 1.0), Vec2::new(-1.0, 1.0)];
     MeshInput {
         positions: corners.iter().map(|c| c.extend(0.0)).collect(),
-        texcoords: corners.iter().map(|c| (*c + 1.0) * 0.5).collect(),
+        texcoords: corners.iter().map(|c| Vec2::new(c.x + 1.0, 1.0 - c.y) * 0.5).collect(),
         triangles: vec![[0, 1, 2], [0, 2, 3]],
         ..Default::default()
     }
 }
 
-/// The unit disk at z = 0 facing +z, a fan of `segments` triangles.
+/// The unit disk at z = 0 facing +z, a fan of `segments` triangles, texture coordinates
+/// (r, 1 − φ/2π): each triangle has its own centre (at its middle φ) and rim vertices, the last
+/// one's far rim at φ = 2π.
 fn disk(segments: u32) -> MeshInput {
-    let mut mesh = MeshInput { positions: vec![Vec3::ZERO], texcoords: vec![Vec2::splat(0.5)], ..Default::default() };
+    let mut mesh = MeshInput::default();
+    let rim = |j: u32| {
+        let f = j as f32 / segments as f32;
+        // The rim point of φ = 2π·f, exactly (1, 0) at both ends of the seam.
+        let (s, c) = if j.is_multiple_of(segments) { (0.0, 1.0) } else { (2.0 * PI * f).sin_cos() };
+        (Vec3::new(c, s, 0.0), Vec2::new(1.0, 1.0 - f))
+    };
     for j in 0..segments {
-        let phi = 2.0 * PI * j as f32 / segments as f32;
-        let (s, c) = phi.sin_cos();
-        mesh.positions.push(Vec3::new(c, s, 0.0));
-        mesh.texcoords.push(Vec2::new(0.5 + 0.5 * c, 0.5 + 0.5 * s));
-        mesh.triangles.push([0, 1 + j, 1 + (j + 1) % segments]);
+        let base = mesh.positions.len() as u32;
+        let ((p0, t0), (p1, t1)) = (rim(j), rim(j + 1));
+        mesh.positions.extend([Vec3::ZERO, p0, p1]);
+        mesh.texcoords.extend([Vec2::new(0.0, (t0.y + t1.y) * 0.5), t0, t1]);
+        mesh.triangles.push([base, base + 1, base + 2]);
     }
     mesh
 }
 
-/// [−1, 1]³, each face facing out, two triangles per face (flat).
+/// [−1, 1]³, each face facing out, two triangles per face (flat), with Mitsuba's texture layout
+/// per face ([`cube_uv`]).
 fn cube() -> MeshInput {
     let mut mesh = MeshInput::default();
     for axis in 0..3 {
@@ -69,14 +85,30 @@ fn cube() -> MeshInput {
             let v = n.cross(u);
             let base = mesh.positions.len() as u32;
             for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                mesh.positions.push(n + u * a + v * b);
-                mesh.texcoords.push(Vec2::new((a + 1.0) * 0.5, (b + 1.0) * 0.5));
+                let p = n + u * a + v * b;
+                mesh.positions.push(p);
+                mesh.texcoords.push(cube_uv(axis, sign, p));
             }
             mesh.triangles.push([base, base + 1, base + 2]);
             mesh.triangles.push([base, base + 2, base + 3]);
         }
     }
     mesh
+}
+
+/// The texture coordinates of point `p` on the cube's face along `axis` (0, 1, 2: x, y, z) on
+/// the `sign` side: Mitsuba 3's (u, v) there, v turned over.
+fn cube_uv(axis: usize, sign: f32, p: Vec3) -> Vec2 {
+    let (x, y, z) = (p.x, p.y, p.z);
+    let mitsuba = match (axis, sign > 0.0) {
+        (0, true) => Vec2::new(y + 1.0, 1.0 - z),
+        (0, false) => Vec2::new(y + 1.0, z + 1.0),
+        (1, true) => Vec2::new(1.0 - x, 1.0 - z),
+        (1, false) => Vec2::new(z + 1.0, x + 1.0),
+        (_, true) => Vec2::new(y + 1.0, x + 1.0),
+        (_, false) => Vec2::new(1.0 - y, x + 1.0),
+    } * 0.5;
+    Vec2::new(mitsuba.x, 1.0 - mitsuba.y)
 }
 
 /// The unit sphere, `rings` × `segments` quads (the pole rows as single triangles), with its

@@ -32,7 +32,7 @@ use crate::scene::MeshInput;
 use crate::settings::MAX_IMAGE_SIDE;
 use crate::texture::{Encoding, Texture};
 use bsdfs::UvMap;
-use glam::{Affine3A, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 use props::Reader;
 use roxmltree::{Node, NodeId};
 use std::collections::HashMap;
@@ -178,6 +178,12 @@ impl<'a> Ctx<'a> {
                 if self.r.boolean(node, "face_normals", false)? {
                     mesh.normals.clear();
                 }
+                // Mitsuba turns an OBJ's v over by default and a PLY's not; it reads an image's
+                // first row at v = 0, photonwave at v = 1 (as the OBJ files' v means): a file
+                // whose v Mitsuba keeps is turned over here.
+                if !self.r.boolean(node, "flip_tex_coords", kind == "obj")? {
+                    mesh.texcoords.iter_mut().for_each(|t| t.y = 1.0 - t.y);
+                }
                 mesh
             }
             "rectangle" | "disk" | "cube" => shape(kind, &source, material)?,
@@ -207,7 +213,9 @@ impl<'a> Ctx<'a> {
             mesh.normals.iter_mut().for_each(|n| *n = -*n);
         }
         if let Some(m) = uv {
-            mesh.texcoords.iter_mut().for_each(|t| *t = *t * m.scale + m.offset);
+            // The texture transform acts on Mitsuba's coordinates, v the other way up.
+            let turn = |t: Vec2| Vec2::new(t.x, 1.0 - t.y);
+            mesh.texcoords.iter_mut().for_each(|t| *t = turn(turn(*t) * m.scale + m.offset));
         }
         to_world.apply(&mut mesh);
         mesh.source = source;
