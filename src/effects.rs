@@ -84,6 +84,16 @@ impl Effects {
         } else {
             Part::new(false, "no dielectric with an absorbing interior")
         };
-        Effects { caustic_map, global_map, final_gather, refraction, shadow_rays, absorption }
+        let cut_outs = match scene.cut_out_materials() {
+            0 => Part::new(false, "no material has an opacity mask"),
+            n => Part::new(
+                true,
+                format!(
+                    "{n} material{} cut out by opacity (mask, alphaMode, map_d): every ray passes their transparent texels",
+                    if n == 1 { "" } else { "s" }
+                ),
+            ),
+        };
+        Effects { caustic_map, global_map, final_gather, refraction, shadow_rays, absorption, cut_outs }
     }
 }

@@ -149,7 +149,7 @@ pub fn edge_ray(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3, target: Vec3, nor
     let (bvh, order) = Bvh::build(&p0, &p1, &p2);
     let pick = |v: &[Vec3; 2]| order.iter().map(|&i| v[i as usize]).collect::<Vec<_>>();
     let (q0, q1, q2) = (pick(&p0), pick(&p1), pick(&p2));
-    let cols = TriangleColumns { p0: &q0, p1: &q1, p2: &q2 };
+    let cols = TriangleColumns::new(&q0, &q1, &q2);
     let rays = [RayQuery::new(o, d, f32::INFINITY)];
     let (mut scalar, mut packet) = ([None], [None]);
     closest_rays(&bvh, cols, &rays, &mut scalar);
@@ -158,7 +158,7 @@ pub fn edge_ray(a: Vec3, b: Vec3, c1: Vec3, c2: Vec3, o: Vec3, target: Vec3, nor
         return Err(format!("{:?}: scalar {:?}, packet {:?}", rays[0], scalar[0], packet[0]));
     }
     let mut wide = [None];
-    crate::geometry::wide_traverse::closest_rays::<true>(bvh.wide(cols), &rays, &mut wide);
+    crate::geometry::wide_traverse::closest_rays::<true>(bvh.wide(cols), cols.cut, &rays, &mut wide);
     if scalar != wide {
         return Err(format!("{:?}: scalar {:?}, 8-wide {:?}", rays[0], scalar[0], wide[0]));
     }

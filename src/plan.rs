@@ -43,6 +43,10 @@ pub struct Effects {
     /// written before it existed: read as off).
     #[serde(default = "Part::not_recorded")]
     pub absorption: Part,
+    /// Alpha cut-outs: every traversal asks whether a ray passes the hits on cut-out materials
+    /// (absent from plans written before it existed: read as off).
+    #[serde(default = "Part::not_recorded")]
+    pub cut_outs: Part,
 }
 
 impl Effects {
@@ -75,6 +79,7 @@ impl Effects {
             line("refraction", &self.refraction),
             line("shadow rays", &self.shadow_rays),
             line("absorption", &self.absorption),
+            line("cut-outs", &self.cut_outs),
         ]
         .concat()
     }

@@ -17,6 +17,12 @@ pub enum Encoding {
     Srgb,
     /// A number: taken as it is (`map_Pr`, `map_Pm`; every EXR).
     Linear,
+    /// An alpha channel, taken as it is in every channel; 1 where the image has none (glTF's
+    /// base colour alpha).
+    Alpha,
+    /// An opacity: the alpha channel where the image has one, else its grey level (the
+    /// luminance of an RGB image), taken as it is (MTL `map_d`).
+    Opacity,
 }
 
 /// An RGB image in linear values, ready for lookups.

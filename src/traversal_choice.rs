@@ -353,7 +353,7 @@ impl TraversalChoice {
         }
         self.run(queue, bvh, tris, &mut out, |k, o| match k {
             Kernel::Packets => set.closest_coherent(bvh, tris, rays, bounds, o),
-            Kernel::Single => wide_traverse::closest_rays::<true>(bvh.wide(tris), rays, o),
+            Kernel::Single => wide_traverse::closest_rays::<true>(bvh.wide(tris), tris.cut, rays, o),
             Kernel::WidePackets => in_coherent_order(rays, bounds, o, |r, o| {
                 wide_packet::closest_packets8(bvh.wide(tris), tris, r, o, wide_packet::THIN_LANES);
             }),
@@ -377,7 +377,7 @@ impl TraversalChoice {
         }
         self.run(queue, bvh, tris, out, |k, o| match k {
             Kernel::Packets => packet::occluded_packets(bvh, tris, rays, o),
-            Kernel::Single => wide_traverse::occluded_rays::<true>(bvh.wide(tris), rays, o),
+            Kernel::Single => wide_traverse::occluded_rays::<true>(bvh.wide(tris), tris.cut, rays, o),
             Kernel::WidePackets => {
                 wide_packet::occluded_packets8(bvh.wide(tris), tris, rays, o, wide_packet::THIN_LANES);
             }
@@ -492,7 +492,7 @@ mod tests {
     fn camera_rays_try_both_packet_kernels_before_the_pass() {
         let (p0, p1, p2) = ([Vec3::new(-1.0, -1.0, 2.0)], [Vec3::new(1.0, -1.0, 2.0)], [Vec3::new(0.0, 1.0, 2.0)]);
         let (bvh, _) = Bvh::build(&p0, &p1, &p2);
-        let tris = TriangleColumns { p0: &p0, p1: &p1, p2: &p2 };
+        let tris = TriangleColumns::new(&p0, &p1, &p2);
         let bounds = (Vec3::splat(-1.0), Vec3::new(1.0, 1.0, 2.0));
         let ray = RayQuery::new(Vec3::ZERO, Vec3::Z, f32::INFINITY);
         let chunks = vec![vec![ray; 1024]; TRIAL_CHUNKS as usize];
@@ -530,7 +530,7 @@ mod tests {
         // One triangle is tree enough: `run` only hands the kernel to the closure.
         let (p0, p1, p2) = ([Vec3::ZERO], [Vec3::X], [Vec3::Y]);
         let (bvh, _) = Bvh::build(&p0, &p1, &p2);
-        let tris = TriangleColumns { p0: &p0, p1: &p1, p2: &p2 };
+        let tris = TriangleColumns::new(&p0, &p1, &p2);
         let c = TraversalChoice::timed();
         let mut out = [0u32; 1024];
         for chunk in 0..2 {

@@ -39,7 +39,7 @@ fn closed_room_needs_few_triangle_tests_per_ray() {
     let (bvh, order) = Bvh::build(&p0, &p1, &p2);
     let pick = |v: &Vec<Vec3>| order.iter().map(|&i| v[i as usize]).collect::<Vec<_>>();
     let (q0, q1, q2) = (pick(&p0), pick(&p1), pick(&p2));
-    let cols = TriangleColumns { p0: &q0, p1: &q1, p2: &q2 };
+    let cols = TriangleColumns::new(&q0, &q1, &q2);
     let c = s.centre();
     let rays = 4096;
     let tests: u64 = (0..rays)

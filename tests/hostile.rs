@@ -241,9 +241,9 @@ fn warnings_name_their_file() {
     assert!(w.iter().any(|w| w.contains("m.mtl:5: material `shiny`: Kd + Ks")), "{w:?}");
 }
 
-/// Texture statements not simulated (`map_d`, a bump map's options other than `-bm`) and
-/// transparency are read and said to be ignored, once per material; a `bump` map is read with
-/// its `-bm`, and one with a `-bm` that is no number is an error; `Ns -5`, `illum 99` and a file
+/// Texture options not simulated (`map_d`'s, a bump map's other than `-bm`) are read and said to
+/// be ignored, once per material; `map_d` and `d` make a cut-out, a `bump` map is read with its
+/// `-bm`, and one with a `-bm` that is no number is an error; `Ns -5`, `illum 99` and a file
 /// that is not UTF-8 are errors with their line.
 #[test]
 fn what_is_not_simulated_is_said() {
@@ -254,7 +254,8 @@ fn what_is_not_simulated_is_said() {
         enc.set_color(png::ColorType::Grayscale);
         enc.write_header().unwrap().write_image_data(&[128]).unwrap();
     }
-    write(&d, "wood-bump.png", png_bytes);
+    write(&d, "wood-bump.png", &png_bytes);
+    write(&d, "alpha.png", png_bytes);
     write(
         &d,
         "m.mtl",
@@ -264,9 +265,11 @@ fn what_is_not_simulated_is_said() {
     let w: Vec<_> = scene.warnings.iter().filter(|w| w.contains("not simulated")).collect();
     assert_eq!(w.len(), 1, "{w:?}");
     assert!(
-        w[0].contains("m.mtl:4: material `white`") && w[0].contains("`map_d`, `bump options`, `d`, `sharpness`"),
+        w[0].contains("m.mtl:4: material `white`") && w[0].contains("`map_d options`, `bump options`, `sharpness`"),
         "{w:?}"
     );
+    let cut = scene.materials.iter().find_map(|m| m.opacity.as_ref()).expect("the cut-out");
+    assert!(cut.factor == 0.4 && cut.texture.is_some(), "{cut:?}");
     let bump = scene.materials.iter().find_map(|m| m.normal_map.as_ref()).expect("the bump map");
     assert!(bump.scale == 0.3 && bump.relief == photonwave::material::Relief::Heights, "{bump:?}");
     write(&d, "m.mtl", format!("{MTL}bump -bm x wood-bump.png\n"));

@@ -9,7 +9,7 @@ use common::{assert_engines_agree, bundled, gallery_with, scratch_dir};
 use glam::{Vec2, Vec3};
 use photonwave::engine::{render, Engine};
 use photonwave::formats::{load_scene, LoadedScene};
-use photonwave::material::Bsdf;
+use photonwave::material::{AlphaMode, Bsdf};
 use photonwave::microfacet::Alpha;
 use photonwave::optics::conductor_f0;
 use photonwave::progress::NoProgress;
@@ -226,9 +226,29 @@ fn gltf_materials_map_onto_the_bsdfs_they_name() {
     assert!(m.maps.kd.is_some());
     // The same image as a normal texture: read as data, its scale kept, glTF's handedness.
     let bumpy = json!({"normalTexture": {"index": 0, "scale": 0.5}, "pbrMetallicRoughness": {"metallicFactor": 0}});
-    let bumped = load_doc(&d, &gltf_doc(node, bumpy, extra)).unwrap();
+    let bumped = load_doc(&d, &gltf_doc(node, bumpy, extra.clone())).unwrap();
     let map = bumped.scene.materials[bumped.scene.material[0] as usize].normal_map.clone().expect("a normal map");
     assert!(map.scale == 0.5 && map.handed && map.texture.texels[0] == Vec3::X, "{map:?}");
+    // alphaMode: MASK cuts out below alphaCutoff, BLEND reads alpha as coverage; α is the base
+    // colour factor's alpha times the texture's alpha channel (1 in this RGB image, so no
+    // texture is kept); OPAQUE ignores alpha.
+    let modes = [
+        (json!({"alphaMode": "MASK", "alphaCutoff": 0.3}), Some(AlphaMode::Cutoff(0.3))),
+        (json!({"alphaMode": "MASK"}), Some(AlphaMode::Cutoff(0.5))),
+        (json!({"alphaMode": "BLEND"}), Some(AlphaMode::Coverage)),
+        (json!({}), None),
+    ];
+    for (mode, want) in modes {
+        let mut m = json!({"pbrMetallicRoughness": {"metallicFactor": 0, "baseColorFactor": [1, 1, 1, 0.2],
+            "baseColorTexture": {"index": 0}}});
+        if let (Value::Object(m), Value::Object(mode)) = (&mut m, mode) {
+            m.extend(mode);
+        }
+        let loaded = load_doc(&d, &gltf_doc(json!([{"mesh": 0}]), m, extra.clone())).unwrap();
+        let o = loaded.scene.materials[loaded.scene.material[0] as usize].opacity.clone();
+        assert_eq!(o.as_ref().map(|o| o.mode), want);
+        assert!(o.is_none_or(|o| o.factor == 0.2 && o.texture.is_none()));
+    }
     // Corner (1, 0) in glTF coordinates: scaled to (2, 0), offset to (2.5, 0), v flipped to 1.
     let uvs: Vec<Vec2> = loaded.scene.uv[0].to_vec();
     assert!(uvs.iter().any(|uv| (*uv - Vec2::new(2.5, 1.0)).length() < 1e-6), "{uvs:?}");
@@ -246,10 +266,10 @@ fn gltf_bad_files_are_errors_naming_the_element() {
                         "images": [{"uri": "data:image/png;base64,"}]});
     // What is not rendered is warned of; an empty image is an error naming what reads it, a
     // normal texture as a base colour.
-    let masked = json!({"alphaMode": "MASK", "pbrMetallicRoughness": {"metallicFactor": 0}});
-    let loaded = load_doc(&d, &gltf_doc(node.clone(), masked, images.clone())).unwrap();
+    let occluded = json!({"occlusionTexture": {"index": 0}, "pbrMetallicRoughness": {"metallicFactor": 0}});
+    let loaded = load_doc(&d, &gltf_doc(node.clone(), occluded, images.clone())).unwrap();
     let w = loaded.scene.warnings.join("\n");
-    assert!(w.contains("KHR_materials_clearcoat") && w.contains("alphaMode Mask"), "{w}");
+    assert!(w.contains("KHR_materials_clearcoat") && w.contains("occlusion texture"), "{w}");
     let bumpy = json!({"normalTexture": {"index": 0}, "pbrMetallicRoughness": {"metallicFactor": 0}});
     let e = load_doc(&d, &gltf_doc(node.clone(), bumpy, images.clone())).err().unwrap().to_string();
     assert!(e.contains("the normal texture of material"), "{e}");

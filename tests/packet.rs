@@ -27,9 +27,9 @@ fn agree(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery]) -> Vec<Option<
     for (label, simd) in [("8-wide", true), ("8-wide scalar", false)] {
         let mut w = vec![None; rays.len()];
         if simd {
-            wide_traverse::closest_rays::<true>(bvh.wide(tris), rays, &mut w);
+            wide_traverse::closest_rays::<true>(bvh.wide(tris), tris.cut, rays, &mut w);
         } else {
-            wide_traverse::closest_rays::<false>(bvh.wide(tris), rays, &mut w);
+            wide_traverse::closest_rays::<false>(bvh.wide(tris), tris.cut, rays, &mut w);
         }
         for (i, (x, y)) in a.iter().zip(&w).enumerate() {
             assert_eq!(x, y, "{label}: closest hit differs for ray {i}: {:?}", rays[i]);
@@ -54,8 +54,8 @@ fn agree(bvh: &Bvh, tris: TriangleColumns<'_>, rays: &[RayQuery]) -> Vec<Option<
     let mut os = vec![false; rays.len()];
     occluded_rays(bvh, tris, rays, &mut oa);
     occluded_packets(bvh, tris, rays, &mut ob);
-    wide_traverse::occluded_rays::<true>(bvh.wide(tris), rays, &mut ow);
-    wide_traverse::occluded_rays::<false>(bvh.wide(tris), rays, &mut os);
+    wide_traverse::occluded_rays::<true>(bvh.wide(tris), tris.cut, rays, &mut ow);
+    wide_traverse::occluded_rays::<false>(bvh.wide(tris), tris.cut, rays, &mut os);
     for (i, x) in oa.iter().enumerate() {
         assert_eq!(*x, ob[i], "packet: any hit differs for ray {i}: {:?}", rays[i]);
         assert_eq!(*x, ow[i], "8-wide: any hit differs for ray {i}: {:?}", rays[i]);
@@ -196,7 +196,7 @@ fn packets_match_scalar_on_a_flat_mesh_with_slivers_and_degenerate_triangles() {
     let (bvh, order) = Bvh::build(&p0, &p1, &p2);
     let pick = |v: &Vec<Vec3>| order.iter().map(|&i| v[i as usize]).collect::<Vec<_>>();
     let (q0, q1, q2) = (pick(&p0), pick(&p1), pick(&p2));
-    let cols = TriangleColumns { p0: &q0, p1: &q1, p2: &q2 };
+    let cols = TriangleColumns::new(&q0, &q1, &q2);
     let mut rays = vec![];
     for i in 0..=4 * n {
         for j in 0..=4 * n {
@@ -309,7 +309,7 @@ fn collapse_keeps_every_triangle_once() {
     }
     let (bvh, order) = Bvh::build(&p[0], &p[1], &p[2]);
     let cols: Vec<Vec<Vec3>> = p.iter().map(|c| order.iter().map(|&i| c[i as usize]).collect()).collect();
-    let tris = TriangleColumns { p0: &cols[0], p1: &cols[1], p2: &cols[2] };
+    let tris = TriangleColumns::new(&cols[0], &cols[1], &cols[2]);
     let wide = bvh.wide(tris);
     let mut seen = vec![0u32; order.len()];
     for b in wide.blocks() {
@@ -344,6 +344,52 @@ fn collapse_keeps_every_triangle_once() {
                         }
                     }
                 }
+            }
+        }
+    }
+}
+
+/// A cut-out for the kernels alone: triangles with an odd index pass rays where the first
+/// barycentric is below ½ (a hard edge across each triangle), and triangles whose index is a
+/// multiple of 3 pass half the rays by the ray's own hash (partial coverage).
+struct TestCut;
+
+impl photonwave::geometry::cut_out::CutOut for TestCut {
+    fn passes(&self, tri: u32, b: [f32; 3], o: Vec3, d: Vec3) -> bool {
+        let hard = tri % 2 == 1 && b[0] < 0.5;
+        let soft = tri.is_multiple_of(3) && photonwave::geometry::cut_out::coverage_sample(tri, o, d) >= 0.5;
+        hard || soft
+    }
+}
+
+#[test]
+fn every_kernel_passes_the_same_cut_outs() {
+    // With cut-outs every kernel (BVH2 packets, 8-wide single rays with either child test,
+    // 8-wide packets at every hand-over threshold, their scalar twin) keeps the same hits —
+    // none of them on a passed texel — and any-hit agrees with closest-hit. The cut changes
+    // many hits, so the test sees the filter at work.
+    let cut = TestCut;
+    for name in ["cornell-box.toml", "cornell-spheres.toml"] {
+        let loaded = load(name);
+        let s = &loaded.scene;
+        let plain = s.columns();
+        let tris = TriangleColumns { cut: Some(&cut), ..plain };
+        let rays = random_rays(s, 4000, 11);
+        let cut_hits = agree(s.bvh(), tris, &rays);
+        let plain_hits = agree(s.bvh(), plain, &rays);
+        let changed = cut_hits.iter().zip(&plain_hits).filter(|(a, b)| a != b).count();
+        assert!(changed > 400, "{name}: the cut-outs changed only {changed} of 4000 hits");
+        for (h, r) in cut_hits.iter().zip(&rays) {
+            if let Some(h) = h {
+                let passes = photonwave::geometry::cut_out::CutOut::passes(&cut, h.tri, h.b, r.origin, r.direction);
+                assert!(!passes, "{name}: a kept hit lies on a passed texel: {h:?}");
+            }
+        }
+        // A ray never hits farther with the cut than without it, and where the plain hit is kept
+        // the two agree.
+        for (a, b) in cut_hits.iter().zip(&plain_hits) {
+            if let (Some(a), Some(b)) = (a, b) {
+                assert!(a.t >= b.t, "{name}: a cut-out brought a hit nearer: {a:?} against {b:?}");
             }
         }
     }

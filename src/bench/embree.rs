@@ -348,7 +348,7 @@ mod tests {
     fn one_triangle_is_hit_through_its_middle_and_missed_beside_it_in_both_modes() {
         let (p0, p1, p2) = ([Vec3::new(0.0, 0.0, 1.0)], [Vec3::new(1.0, 0.0, 1.0)], [Vec3::new(0.0, 1.0, 1.0)]);
         for robust in [false, true] {
-            let e = EmbreeScene::build(TriangleColumns { p0: &p0, p1: &p1, p2: &p2 }, robust).unwrap();
+            let e = EmbreeScene::build(TriangleColumns::new(&p0, &p1, &p2), robust).unwrap();
             let rays = [
                 RayQuery::new(Vec3::new(0.25, 0.25, 0.0), Vec3::Z, f32::INFINITY),
                 RayQuery::new(Vec3::new(0.9, 0.9, 0.0), Vec3::Z, f32::INFINITY),

@@ -173,11 +173,11 @@ impl Kernels<'_> {
         let wide = self.scene.bvh().wide(self.scene.columns());
         if self.any {
             let mut out = vec![false; c.len()];
-            w::occluded_rays::<true>(wide, c, &mut out);
+            w::occluded_rays::<true>(wide, None, c, &mut out);
             blocked(&out)
         } else {
             let mut out = vec![None; c.len()];
-            w::closest_rays::<true>(wide, c, &mut out);
+            w::closest_rays::<true>(wide, None, c, &mut out);
             found(&out)
         }
     }
@@ -379,9 +379,9 @@ fn count_visits(bvh: &crate::geometry::wide::Bvh8, rays: &[RayQuery], any: bool)
     let mut v = Visits::default();
     for r in rays {
         if any {
-            let _ = occluded_counted::<true, true>(bvh, r, &mut stack, &mut v);
+            let _ = occluded_counted::<true, true>(bvh, None, r, &mut stack, &mut v);
         } else {
-            let _ = closest_counted::<true, true>(bvh, r, &mut stack, &mut v);
+            let _ = closest_counted::<true, true>(bvh, None, r, &mut stack, &mut v);
         }
     }
     v

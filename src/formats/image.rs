@@ -3,7 +3,8 @@
 //!
 //! 8- and 16-bit images are scaled to [0, 1] and, for colour maps, decoded from sRGB; EXR values
 //! are linear already and taken as they are. Grey images fill all three channels; alpha is
-//! dropped. A file that cannot be read, is not an image of these kinds, is truncated or damaged,
+//! dropped, except from an opacity ([`Encoding::Alpha`], [`Encoding::Opacity`]), which fills
+//! every channel with the alpha channel (or, without one, with 1 or the grey level). A file that cannot be read, is not an image of these kinds, is truncated or damaged,
 //! has no texels, or holds a non-finite or negative value, is an error naming the file.
 
 use crate::error::{Error, Result};
@@ -61,6 +62,12 @@ pub fn load_texture(path: &Path, encoding: Encoding, what: &str) -> Result<Textu
         Format::Exr => {
             let image = crate::film::read_exr(path)?;
             let (_, pixels) = image.layers.into_iter().next().unwrap_or_default();
+            // The first RGB layer has no alpha.
+            let pixels = match encoding {
+                Encoding::Alpha => vec![Vec3::ONE; pixels.len()],
+                Encoding::Opacity => pixels.iter().map(|&p| Vec3::splat(luminance(p))).collect(),
+                Encoding::Srgb | Encoding::Linear => pixels,
+            };
             (image.width, image.height, pixels)
         }
         Format::Png | Format::Jpeg => {
@@ -164,17 +171,38 @@ fn check_size(w: u32, h: u32) -> std::result::Result<(), String> {
     }
 }
 
-/// Samples of 1–4 channels as linear RGB (grey repeated, alpha dropped).
+/// The luminance of linear RGB (Rec. 709 weights).
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.212_671, 0.715_160, 0.072_169))
+}
+
+/// Samples of 1–4 channels as linear RGB (grey repeated, alpha dropped), or as an opacity in
+/// every channel ([`Encoding::Alpha`], [`Encoding::Opacity`]).
 fn to_rgb(values: &[u16], channels: usize, max: f32, encoding: Encoding) -> Vec<Vec3> {
     let decode = |v: u16| {
         let x = f32::from(v) / max;
         match encoding {
             Encoding::Srgb => srgb_to_linear(x),
-            Encoding::Linear => x,
+            Encoding::Linear | Encoding::Alpha | Encoding::Opacity => x,
         }
     };
     if channels == 0 {
         return Vec::new();
+    }
+    if matches!(encoding, Encoding::Alpha | Encoding::Opacity) {
+        // Grey + alpha and RGBA end with alpha.
+        let has_alpha = channels == 2 || channels == 4;
+        return values
+            .chunks_exact(channels)
+            .map(|p| {
+                Vec3::splat(match (has_alpha, encoding) {
+                    (true, _) => decode(p[channels - 1]),
+                    (false, Encoding::Alpha) => 1.0,
+                    (false, _) if channels >= 3 => luminance(Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))),
+                    (false, _) => decode(p[0]),
+                })
+            })
+            .collect();
     }
     values
         .chunks_exact(channels)
@@ -219,6 +247,22 @@ mod tests {
         assert!((t.texels[0].y - 128.0 / 255.0).abs() < 1e-6);
         let g = temp("grey.png", &png_bytes(1, 1, png::ColorType::GrayscaleAlpha, &[255, 7]));
         assert_eq!(load_texture(&g, Encoding::Srgb, "t").unwrap().texels, [Vec3::ONE]);
+    }
+
+    /// An opacity is the alpha channel where there is one; without one, 1 for glTF's alpha and
+    /// the grey level (RGB: its luminance) for MTL's `map_d`. Never decoded from sRGB.
+    #[test]
+    fn opacities_read_alpha_or_grey() {
+        let rgba = temp("rgba.png", &png_bytes(1, 1, png::ColorType::Rgba, &[255, 255, 255, 51]));
+        for e in [Encoding::Alpha, Encoding::Opacity] {
+            assert_eq!(load_texture(&rgba, e, "t").unwrap().texels, [Vec3::splat(0.2)]);
+        }
+        let grey = temp("grey-a.png", &png_bytes(1, 1, png::ColorType::Grayscale, &[51]));
+        assert_eq!(load_texture(&grey, Encoding::Alpha, "t").unwrap().texels, [Vec3::ONE]);
+        assert_eq!(load_texture(&grey, Encoding::Opacity, "t").unwrap().texels, [Vec3::splat(0.2)]);
+        let rgb = temp("rgb-a.png", &png_bytes(1, 1, png::ColorType::Rgb, &[0, 255, 0]));
+        let t = load_texture(&rgb, Encoding::Opacity, "t").unwrap();
+        assert!((t.texels[0].x - 0.715_16).abs() < 1e-6, "{}", t.texels[0]);
     }
 
     #[test]

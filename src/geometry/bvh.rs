@@ -11,6 +11,7 @@
 //! move, the union grows, and no centre lies on its max face. Padding also keeps the slab test
 //! conservative for flat boxes and rays that graze box faces.
 
+use super::cut_out::CutOuts;
 use super::triangle::{intersect_triangle, TriangleHit};
 use super::wide::Bvh8;
 use glam::{Vec3, Vec3A};
@@ -95,12 +96,12 @@ impl Bvh {
         let mut rh = obvhs::ray::RayHit::none();
         self.bvh.ray_traverse(ray, &mut rh, |r, id| {
             match intersect_triangle(o, d, r.tmax, tris.p0[id], tris.p1[id], tris.p2[id]) {
-                Some(h) => {
+                Some(h) if !tris.passes(id as u32, h.b, o, d) => {
                     best = Some(h);
                     best_tri = id as u32;
                     h.t
                 }
-                None => f32::INFINITY,
+                _ => f32::INFINITY,
             }
         });
         best.map(|h| Hit { tri: best_tri, t: h.t, b: h.b })
@@ -134,10 +135,13 @@ impl Bvh {
     }
 }
 
-/// t of triangle `i`'s hit in (0, t_max), or +∞: what obvhs's traversal callbacks return.
+/// t of triangle `i`'s hit in (0, t_max), or +∞ (also where the ray passes a cut-out): what
+/// obvhs's traversal callbacks return.
 #[inline]
 fn hit_t(tris: TriangleColumns<'_>, o: Vec3, d: Vec3, t_max: f32, i: usize) -> f32 {
-    intersect_triangle(o, d, t_max, tris.p0[i], tris.p1[i], tris.p2[i]).map_or(f32::INFINITY, |h| h.t)
+    intersect_triangle(o, d, t_max, tris.p0[i], tris.p1[i], tris.p2[i])
+        .filter(|h| !tris.passes(i as u32, h.b, o, d))
+        .map_or(f32::INFINITY, |h| h.t)
 }
 
 /// The padding every triangle's box gets: [`BOX_PAD`] of the scene diagonal (1 for no triangles).
@@ -207,7 +211,7 @@ impl CwBaseline {
     }
 }
 
-/// Borrowed vertex columns in BVH order.
+/// Borrowed vertex columns in BVH order, and the cut-outs that traversals over them honour.
 #[derive(Clone, Copy)]
 pub struct TriangleColumns<'a> {
     /// First vertices.
@@ -216,4 +220,22 @@ pub struct TriangleColumns<'a> {
     pub p1: &'a [Vec3],
     /// Third vertices.
     pub p2: &'a [Vec3],
+    /// What lets rays through parts of triangles ([`super::cut_out`]); `None`: every hit counts.
+    pub cut: CutOuts<'a>,
+}
+
+impl<'a> TriangleColumns<'a> {
+    /// The columns, without cut-outs.
+    #[must_use]
+    pub fn new(p0: &'a [Vec3], p1: &'a [Vec3], p2: &'a [Vec3]) -> Self {
+        TriangleColumns { p0, p1, p2, cut: None }
+    }
+
+    /// Whether the ray `o + t·d` passes through triangle `id` at barycentrics `b`
+    /// ([`super::cut_out::passes`]).
+    #[inline(always)]
+    #[must_use]
+    pub fn passes(&self, id: u32, b: [f32; 3], o: Vec3, d: Vec3) -> bool {
+        super::cut_out::passes(self.cut, id, b, o, d)
+    }
 }

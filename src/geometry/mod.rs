@@ -1,6 +1,7 @@
 //! Geometry: watertight ray/triangle intersection, robust ray origins, and the obvhs BVH.
 
 pub mod bvh;
+pub mod cut_out;
 pub mod offset;
 pub mod packet;
 pub mod sah;

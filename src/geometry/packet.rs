@@ -231,7 +231,10 @@ pub(super) fn closest_leaf(
         while hit != 0 {
             let l = hit.trailing_zeros() as usize;
             hit &= hit - 1;
-            best[l].offer(t[l], id, [b[0][l], b[1][l], b[2][l]]);
+            let b = [b[0][l], b[1][l], b[2][l]];
+            if !tris.passes(id, b, p.origin(l), p.dir(l)) {
+                best[l].offer(t[l], id, b);
+            }
         }
         while fallback != 0 {
             let l = fallback.trailing_zeros() as usize;
@@ -327,19 +330,37 @@ pub(super) fn any_leaf(
         if is_degenerate(v[0], v[1], v[2]) {
             continue;
         }
-        let (hit, mut fallback, t, _) = intersect8(p, open, v, t_max);
+        let (hit, mut fallback, t, b) = intersect8(p, open, v, t_max);
         if hit != 0 {
-            blocked |= hit & bits(p.settle(t, v, pad).simd_lt(t_max));
+            let hit = hit & bits(p.settle(t, v, pad).simd_lt(t_max));
+            blocked |= if tris.cut.is_none() { hit } else { kept(p, tris, id, hit, b) };
         }
         while fallback != 0 {
             let l = fallback.trailing_zeros() as usize;
             fallback &= fallback - 1;
-            if intersect_settled(p.origin(l), p.dir(l), p.inv(l), t_arr[l], v, pad).is_some() {
+            let (o, d) = (p.origin(l), p.dir(l));
+            if intersect_settled(o, d, p.inv(l), t_arr[l], v, pad).is_some_and(|h| !tris.passes(id, h.b, o, d)) {
                 blocked |= 1 << l;
             }
         }
     }
     blocked
+}
+
+/// The lanes of `hit` (lanes that hit triangle `id` at barycentrics `b`) that its cut-out does
+/// not let through.
+#[cold]
+fn kept(p: &Packet, tris: TriangleColumns<'_>, id: u32, hit: u32, b: [f32x8; 3]) -> u32 {
+    let b = b.map(f32x8::to_array);
+    let (mut m, mut kept) = (hit, 0);
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        if !tris.passes(id, [b[0][l], b[1][l], b[2][l]], p.origin(l), p.dir(l)) {
+            kept |= 1 << l;
+        }
+    }
+    kept
 }
 
 /// Any-hit tests of 8 rays.

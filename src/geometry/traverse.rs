@@ -86,13 +86,15 @@ impl Best {
         }
     }
     /// Tests triangle `id` ([`intersect_settled`], boxes padded by `pad`) and keeps it by
-    /// [`Best::offer`]'s rule.
+    /// [`Best::offer`]'s rule unless the ray passes its cut-out.
     #[inline]
     pub fn test(&mut self, tris: TriangleColumns<'_>, o: Vec3, d: Vec3, inv: Vec3, pad: f32, id: u32) {
         let i = id as usize;
         let p = [tris.p0[i], tris.p1[i], tris.p2[i]];
         if let Some(h) = intersect_settled(o, d, inv, self.limit(), p, pad) {
-            self.offer(h.t, id, h.b);
+            if !tris.passes(id, h.b, o, d) {
+                self.offer(h.t, id, h.b);
+            }
         }
     }
 }
@@ -196,6 +198,14 @@ pub fn closest_from(
     }
 }
 
+/// Whether triangle `id` blocks the ray within (0, t_max): hit, and not passed by its cut-out.
+#[inline]
+fn blocks(tris: TriangleColumns<'_>, id: u32, o: Vec3, d: Vec3, inv: Vec3, t_max: f32, pad: f32) -> bool {
+    let i = id as usize;
+    intersect_settled(o, d, inv, t_max, [tris.p0[i], tris.p1[i], tris.p2[i]], pad)
+        .is_some_and(|h| !tris.passes(id, h.b, o, d))
+}
+
 /// Any-hit traversal of one ray from node `start`: true at the first triangle hit in (0, t_max).
 /// Leaf children are tested as soon as their parent is reached (as obvhs's loop does).
 #[allow(clippy::too_many_arguments)]
@@ -218,8 +228,7 @@ pub fn occluded_from(
             let node = &nodes[cur as usize];
             if node.prim_count > 0 {
                 for id in node.first_index..node.first_index + node.prim_count {
-                    let i = id as usize;
-                    if intersect_settled(o, d, inv, t_max, [tris.p0[i], tris.p1[i], tris.p2[i]], pad).is_some() {
+                    if blocks(tris, id, o, d, inv, t_max, pad) {
                         stack.clear();
                         return true;
                     }
@@ -240,9 +249,7 @@ pub fn occluded_from(
                 let child = &nodes[g.0 as usize];
                 if g.1 && child.prim_count > 0 {
                     for id in child.first_index..child.first_index + child.prim_count {
-                        let i = id as usize;
-                        let p = [tris.p0[i], tris.p1[i], tris.p2[i]];
-                        if intersect_settled(o, d, inv, t_max, p, pad).is_some() {
+                        if blocks(tris, id, o, d, inv, t_max, pad) {
                             stack.clear();
                             return true;
                         }

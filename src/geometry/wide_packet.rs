@@ -129,6 +129,7 @@ fn closest8(
                 let ray = prepared[l].get_or_insert_with(|| Prepared::new(&rays[l]));
                 closest_walk::<true, false>(
                     bvh,
+                    tris.cut,
                     ray,
                     (e.child, e.count, t[l]),
                     &mut best[l],
@@ -193,7 +194,7 @@ fn occluded8(
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
                 let ray = prepared[l].get_or_insert_with(|| Prepared::new(&rays[l]));
-                if any_walk::<true, false>(bvh, ray, (n, 0, 0.0), t_arr[l], single, &mut Visits::default()) {
+                if any_walk::<true, false>(bvh, tris.cut, ray, (n, 0, 0.0), t_arr[l], single, &mut Visits::default()) {
                     blocked |= 1 << l;
                 }
             }

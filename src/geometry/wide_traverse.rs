@@ -23,6 +23,7 @@
 //! two keys, without the key array and its loop (issue 18, seventeenth part).
 
 use super::bvh::Hit;
+use super::cut_out::{passes, CutOuts};
 use super::slab::{intersect_settled, inverse_direction};
 use super::traverse::{Best, RayQuery, Stack};
 use super::triangle8::{intersect_block, ShearedRay, TriBlock};
@@ -71,7 +72,7 @@ fn leaf(bvh: &Bvh8, first: u32, count: u32) -> &[TriBlock] {
 /// traversal, testing them one by one, would decide it (a miss under a limit stays a miss under
 /// a lower one).
 #[inline(always)]
-fn closest_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, best: &mut Best) -> u64 {
+fn closest_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, cut: CutOuts<'_>, best: &mut Best) -> u64 {
     let r = &ray.sheared;
     let mut scalar = 0;
     for b in blocks {
@@ -94,11 +95,16 @@ fn closest_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, best: &mut Best) 
             todo &= todo - 1;
             let id = b.ids[l];
             if hit >> l & 1 == 1 && best.limit().to_bits() == limit.to_bits() {
-                best.offer(t[l], id, [bary[0][l], bary[1][l], bary[2][l]]);
+                let b = [bary[0][l], bary[1][l], bary[2][l]];
+                if !passes(cut, id, b, r.origin, r.dir) {
+                    best.offer(t[l], id, b);
+                }
             } else {
                 scalar += 1;
                 if let Some(h) = intersect_settled(r.origin, r.dir, ray.inv, best.limit(), b.triangle(l), pad) {
-                    best.offer(h.t, id, h.b);
+                    if !passes(cut, id, h.b, r.origin, r.dir) {
+                        best.offer(h.t, id, h.b);
+                    }
                 }
             }
         }
@@ -108,23 +114,44 @@ fn closest_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, best: &mut Best) 
 
 /// Whether any triangle of the leaf is hit within (0, t_max), its t [`super::slab::settle`]d.
 #[inline(always)]
-fn any_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, t_max: f32, scalar: &mut u64) -> bool {
+fn any_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, t_max: f32, cut: CutOuts<'_>, scalar: &mut u64) -> bool {
     let r = &ray.sheared;
     blocks.iter().any(|b| {
-        let (hit, mut fallback, t, _) = intersect_block(r, b, t_max);
-        if hit != 0 && hit & ray.wide.settle(t, b, pad).simd_lt(f32x8::splat(t_max)).to_bitmask() != 0 {
-            return true;
+        let (hit, mut fallback, t, bary) = intersect_block(r, b, t_max);
+        if hit != 0 {
+            let hit = hit & ray.wide.settle(t, b, pad).simd_lt(f32x8::splat(t_max)).to_bitmask();
+            if hit != 0 && (cut.is_none() || any_kept(b, hit, bary, r, cut)) {
+                return true;
+            }
         }
         *scalar += u64::from(fallback.count_ones());
         while fallback != 0 {
             let l = fallback.trailing_zeros() as usize;
             fallback &= fallback - 1;
-            if intersect_settled(r.origin, r.dir, ray.inv, t_max, b.triangle(l), pad).is_some() {
+            if intersect_settled(r.origin, r.dir, ray.inv, t_max, b.triangle(l), pad)
+                .is_some_and(|h| !passes(cut, b.ids[l], h.b, r.origin, r.dir))
+            {
                 return true;
             }
         }
         false
     })
+}
+
+/// Whether a lane of `hit` (lanes of block `b` hit at barycentrics `bary`) is not let through
+/// by its cut-out.
+#[cold]
+fn any_kept(b: &TriBlock, hit: u32, bary: [f32x8; 3], r: &ShearedRay, cut: CutOuts<'_>) -> bool {
+    let bary = bary.map(f32x8::to_array);
+    let mut m = hit;
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        if !passes(cut, b.ids[l], [bary[0][l], bary[1][l], bary[2][l]], r.origin, r.dir) {
+            return true;
+        }
+    }
+    false
 }
 
 /// The bit mask of the children of `node` that the ray enters within `t_max`, and their entry
@@ -229,21 +256,27 @@ pub(super) fn unkey(key: u64) -> (usize, f32) {
 
 /// Closest hit of one ray, with a caller's stack.
 #[must_use]
-pub fn closest_with<const SIMD: bool>(bvh: &Bvh8, ray: &RayQuery, stack: &mut Stack<Entry>) -> Option<Hit> {
-    closest_counted::<SIMD, false>(bvh, ray, stack, &mut Visits::default())
+pub fn closest_with<const SIMD: bool>(
+    bvh: &Bvh8,
+    cut: CutOuts<'_>,
+    ray: &RayQuery,
+    stack: &mut Stack<Entry>,
+) -> Option<Hit> {
+    closest_counted::<SIMD, false>(bvh, cut, ray, stack, &mut Visits::default())
 }
 
 /// [`closest_with`], adding its work to `visits` when `COUNT`.
 #[must_use]
 pub fn closest_counted<const SIMD: bool, const COUNT: bool>(
     bvh: &Bvh8,
+    cut: CutOuts<'_>,
     ray: &RayQuery,
     stack: &mut Stack<Entry>,
     visits: &mut Visits,
 ) -> Option<Hit> {
     let prepared = prepare(bvh, ray)?;
     let mut best = Best::new(ray.t_max);
-    closest_walk::<SIMD, COUNT>(bvh, &prepared, (0, 0, 0.0), &mut best, stack, visits);
+    closest_walk::<SIMD, COUNT>(bvh, cut, &prepared, (0, 0, 0.0), &mut best, stack, visits);
     best.hit()
 }
 
@@ -253,6 +286,7 @@ pub fn closest_counted<const SIMD: bool, const COUNT: bool>(
 #[inline(always)]
 pub(super) fn closest_walk<const SIMD: bool, const COUNT: bool>(
     bvh: &Bvh8,
+    cut: CutOuts<'_>,
     prepared: &Prepared,
     start: Entry,
     best: &mut Best,
@@ -277,7 +311,7 @@ pub(super) fn closest_walk<const SIMD: bool, const COUNT: bool>(
             if COUNT {
                 visits.leaf(blocks);
             }
-            let scalar = closest_leaf(blocks, prepared, bvh.pad(), best);
+            let scalar = closest_leaf(blocks, prepared, bvh.pad(), cut, best);
             if COUNT {
                 visits.scalar += scalar;
             }
@@ -327,14 +361,15 @@ pub(super) fn closest_walk<const SIMD: bool, const COUNT: bool>(
 
 /// True if anything is hit in (0, t_max), with a caller's stack.
 #[must_use]
-pub fn occluded_with<const SIMD: bool>(bvh: &Bvh8, ray: &RayQuery, stack: &mut Stack<Entry>) -> bool {
-    occluded_counted::<SIMD, false>(bvh, ray, stack, &mut Visits::default())
+pub fn occluded_with<const SIMD: bool>(bvh: &Bvh8, cut: CutOuts<'_>, ray: &RayQuery, stack: &mut Stack<Entry>) -> bool {
+    occluded_counted::<SIMD, false>(bvh, cut, ray, stack, &mut Visits::default())
 }
 
 /// [`occluded_with`], adding its work to `visits` when `COUNT`.
 #[must_use]
 pub fn occluded_counted<const SIMD: bool, const COUNT: bool>(
     bvh: &Bvh8,
+    cut: CutOuts<'_>,
     ray: &RayQuery,
     stack: &mut Stack<Entry>,
     visits: &mut Visits,
@@ -342,7 +377,7 @@ pub fn occluded_counted<const SIMD: bool, const COUNT: bool>(
     let Some(prepared) = prepare(bvh, ray) else {
         return false;
     };
-    any_walk::<SIMD, COUNT>(bvh, &prepared, (0, 0, 0.0), ray.t_max, stack, visits)
+    any_walk::<SIMD, COUNT>(bvh, cut, &prepared, (0, 0, 0.0), ray.t_max, stack, visits)
 }
 
 /// Whether the subtree of `start` (a node or a leaf) holds a hit of a prepared ray within
@@ -351,6 +386,7 @@ pub fn occluded_counted<const SIMD: bool, const COUNT: bool>(
 #[inline(always)]
 pub(super) fn any_walk<const SIMD: bool, const COUNT: bool>(
     bvh: &Bvh8,
+    cut: CutOuts<'_>,
     prepared: &Prepared,
     start: Entry,
     t_max: f32,
@@ -365,7 +401,7 @@ pub(super) fn any_walk<const SIMD: bool, const COUNT: bool>(
         if COUNT {
             visits.leaf(blocks);
         }
-        any_leaf(blocks, prepared, bvh.pad(), t_max, &mut visits.scalar)
+        any_leaf(blocks, prepared, bvh.pad(), t_max, cut, &mut visits.scalar)
     };
     stack.clear();
     // The nearest entered inner child is visited next without a trip through the stack.
@@ -408,17 +444,17 @@ pub(super) fn any_walk<const SIMD: bool, const COUNT: bool>(
 
 /// Closest hits of `rays` into `out`, one ray at a time through the 8-wide BVH (`SIMD`: the
 /// 8-wide child test; otherwise its scalar twin).
-pub fn closest_rays<const SIMD: bool>(bvh: &Bvh8, rays: &[RayQuery], out: &mut [Option<Hit>]) {
+pub fn closest_rays<const SIMD: bool>(bvh: &Bvh8, cut: CutOuts<'_>, rays: &[RayQuery], out: &mut [Option<Hit>]) {
     let mut stack = Stack::new();
     for (r, o) in rays.iter().zip(out.iter_mut()) {
-        *o = closest_with::<SIMD>(bvh, r, &mut stack);
+        *o = closest_with::<SIMD>(bvh, cut, r, &mut stack);
     }
 }
 
 /// Any-hit tests of `rays` into `out` (see [`closest_rays`]).
-pub fn occluded_rays<const SIMD: bool>(bvh: &Bvh8, rays: &[RayQuery], out: &mut [bool]) {
+pub fn occluded_rays<const SIMD: bool>(bvh: &Bvh8, cut: CutOuts<'_>, rays: &[RayQuery], out: &mut [bool]) {
     let mut stack = Stack::new();
     for (r, o) in rays.iter().zip(out.iter_mut()) {
-        *o = occluded_with::<SIMD>(bvh, r, &mut stack);
+        *o = occluded_with::<SIMD>(bvh, cut, r, &mut stack);
     }
 }

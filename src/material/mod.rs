@@ -14,7 +14,9 @@ use glam::{Vec2, Vec3};
 use std::sync::Arc;
 
 mod bsdf;
+mod opacity;
 mod plastic;
+pub use opacity::{AlphaMode, Opacity};
 pub use plastic::{fresnel_diffuse_reflectance, PlasticSample, SmoothPlastic};
 
 /// What flows along the path: radiance (camera paths) or power (photons). Refraction scales
@@ -125,6 +127,8 @@ pub struct Material {
     pub interior: Vec3,
     /// A tangent-space normal map that bends the shading normal ([`NormalMap`]).
     pub normal_map: Option<NormalMap>,
+    /// An alpha cut-out: where the surface is absent ([`Opacity`]); `None`: opaque everywhere.
+    pub opacity: Option<Opacity>,
 }
 
 /// A texture that bends the shading normal ([`crate::scene::Scene::surface`]):
@@ -193,7 +197,22 @@ impl Material {
     /// A material without textures.
     #[must_use]
     pub fn new(name: impl Into<String>, bsdf: Bsdf, emission: Vec3) -> Material {
-        Material { name: name.into(), bsdf, emission, maps: Maps::default(), interior: Vec3::ZERO, normal_map: None }
+        Material {
+            name: name.into(),
+            bsdf,
+            emission,
+            maps: Maps::default(),
+            interior: Vec3::ZERO,
+            normal_map: None,
+            opacity: None,
+        }
+    }
+
+    /// True when some texture of the material is read at texture coordinates (colour maps, a
+    /// normal map, an opacity map): its triangles need theirs.
+    #[must_use]
+    pub fn reads_texture_coordinates(&self) -> bool {
+        !self.maps.is_empty() || self.normal_map.is_some() || self.opacity.as_ref().is_some_and(|o| o.texture.is_some())
     }
 
     /// The radiance emitted at texture coordinates `uv` from the front face: the constant

@@ -42,6 +42,21 @@ impl Scene {
             extra_lights.push(Light::Environment);
         }
         let zero_normals = meshes.iter().map(|m| m.zero_normals).sum();
+        let mut materials = materials;
+        for m in &mut materials {
+            match &m.opacity {
+                Some(o) if o.is_opaque() => m.opacity = None,
+                Some(_) if m.emission != Vec3::ZERO => {
+                    warnings.push(format!(
+                        "material `{}`: its cut-out (opacity) is not rendered on an emitter: the light is opaque and \
+                         emits everywhere, so that what light sampling sees and what rays hit agree",
+                        m.name
+                    ));
+                    m.opacity = None;
+                }
+                _ => {}
+            }
+        }
         let t = Triangles::gather(&meshes, &materials, &mut warnings)?;
         if t.p0.is_empty() {
             let directional = extra_lights.iter().any(Light::is_distant);
@@ -108,21 +123,22 @@ impl Scene {
             encloses_lights: false,
             warnings,
             bvh,
-            kinds: (false, false, false, false, false),
+            kinds: (false, false, false, false, false, false),
             open_edges: open_edges::OpenEdges::default(),
             caustic_targets: Vec::new(),
         };
         scene.find_kinds();
         scene.distribute_lights()?;
         let edges = scene.edge_uses();
-        scene.encloses_lights = scene.find_enclosure(&edges);
+        // Light may leave through a cut-out's holes: a photon that escapes has not leaked.
+        scene.encloses_lights = !scene.kinds.5 && scene.find_enclosure(&edges);
         scene.open_edges = scene.find_open_edges(scene.diagonal().max(f32::MIN_POSITIVE), &edges);
         scene.caustic_targets = scene.find_caustic_targets(&edges);
         Ok(scene)
     }
 
     /// Which kinds of material the scene's triangles use: (any passed as specular by photons,
-    /// any glass, any non-delta, any absorbing interior, any normal map).
+    /// any glass, any non-delta, any absorbing interior, any normal map, any cut-out).
     fn find_kinds(&mut self) {
         let mut used = vec![false; self.materials.len()];
         for &m in &self.material {
@@ -134,6 +150,7 @@ impl Scene {
             self.kinds.2 |= !m.bsdf.is_delta();
             self.kinds.3 |= m.interior != Vec3::ZERO;
             self.kinds.4 |= m.normal_map.is_some();
+            self.kinds.5 |= m.opacity.is_some();
         }
     }
 
@@ -238,7 +255,7 @@ impl Triangles {
     /// textured materials on meshes without texture coordinates; an emitter material whose every
     /// triangle is degenerate is an error.
     fn gather(meshes: &[MeshInput], materials: &[Material], warnings: &mut Vec<String>) -> Result<Triangles> {
-        let textured = materials.iter().any(|m| !m.maps.is_empty() || m.normal_map.is_some());
+        let textured = materials.iter().any(Material::reads_texture_coordinates);
         let mut t =
             Triangles { p0: vec![], p1: vec![], p2: vec![], vn: vec![], mat: vec![], uv: vec![], textured, dropped: 0 };
         let mut untextured_uses: Vec<String> = vec![];
@@ -280,8 +297,8 @@ impl Triangles {
                 if textured {
                     if m.texcoords.is_empty() {
                         let name = &materials[material as usize];
-                        let mapped = !name.maps.is_empty() || name.normal_map.is_some();
-                        if mapped && !untextured_uses.iter().any(|u| u.starts_with(&m.source)) {
+                        if name.reads_texture_coordinates() && !untextured_uses.iter().any(|u| u.starts_with(&m.source))
+                        {
                             untextured_uses.push(format!(
                                 "{}: material `{}` has a texture but the mesh has no texture coordinates (`vt`); it \
                                  reads the texture at (0, 0) everywhere",

@@ -13,6 +13,7 @@ pub mod targets;
 
 use crate::error::{Error, Result};
 use crate::geometry::bvh::TriangleColumns;
+use crate::geometry::cut_out::{coverage_sample, CutOut};
 use crate::geometry::offset::barycentric_error;
 use crate::geometry::triangle::is_degenerate;
 use crate::geometry::{in_range, normal_and_area, Bvh, Hit, MAX_COORDINATE};
@@ -140,7 +141,7 @@ pub struct Scene {
     bvh: Bvh,
     /// (any delta, any glass, any non-delta, any absorbing interior, any normal map) material on
     /// a triangle, computed once.
-    kinds: (bool, bool, bool, bool, bool),
+    kinds: (bool, bool, bool, bool, bool, bool),
 }
 
 impl Scene {
@@ -177,7 +178,21 @@ impl Scene {
     /// Vertex columns for intersection.
     #[must_use]
     pub fn columns(&self) -> TriangleColumns<'_> {
-        TriangleColumns { p0: &self.p0, p1: &self.p1, p2: &self.p2 }
+        let cut: Option<&dyn CutOut> = if self.kinds.5 { Some(self) } else { None };
+        TriangleColumns { cut, ..TriangleColumns::new(&self.p0, &self.p1, &self.p2) }
+    }
+
+    /// How many materials the triangles use have an alpha cut-out ([`crate::material::Opacity`]).
+    #[must_use]
+    pub fn cut_out_materials(&self) -> usize {
+        if !self.kinds.5 {
+            return 0;
+        }
+        let mut used = vec![false; self.materials.len()];
+        for &m in &self.material {
+            used[m as usize] = true;
+        }
+        self.materials.iter().zip(used).filter(|(m, u)| *u && m.opacity.is_some()).count()
     }
 
     /// Closest hit along `o + t·d`, 0 < t < `t_max`.
@@ -198,6 +213,16 @@ impl Scene {
         &self.bvh
     }
 
+    /// Texture coordinates of triangle `i` at barycentrics `b` ((0, 0) in a scene without
+    /// textures).
+    #[inline]
+    fn uv_at(&self, i: usize, b: [f32; 3]) -> Vec2 {
+        match self.uv.get(i) {
+            None => Vec2::ZERO,
+            Some(t) => t[0] * b[0] + t[1] * b[1] + t[2] * b[2],
+        }
+    }
+
     /// The surface point of a hit.
     #[must_use]
     pub fn surface(&self, hit: &Hit) -> SurfacePoint {
@@ -207,12 +232,7 @@ impl Scene {
         let p = a * b[0] + bb * b[1] + c * b[2];
         let n = self.vn[i];
         let mut ns = (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).try_normalize().unwrap_or(self.ng[i]);
-        let uv = if self.uv.is_empty() {
-            Vec2::ZERO
-        } else {
-            let t = self.uv[i];
-            t[0] * b[0] + t[1] * b[1] + t[2] * b[2]
-        };
+        let uv = self.uv_at(i, b);
         if self.kinds.4 && !self.uv.is_empty() {
             if let Some(map) = &self.materials[self.material[i] as usize].normal_map {
                 ns = self.mapped_normal(i, ns, uv, map);
@@ -505,5 +525,18 @@ impl Scene {
             return Vec3::ONE;
         }
         (-sigma * (hit.t * d.length())).exp()
+    }
+}
+
+/// The scene's alpha cut-outs, for every traversal ([`Scene::columns`] hands them over when some
+/// material has one): a hit passes where its material's [`crate::material::Opacity`] lets the
+/// ray through at the hit's texture coordinates.
+impl CutOut for Scene {
+    fn passes(&self, tri: u32, b: [f32; 3], o: Vec3, d: Vec3) -> bool {
+        let i = tri as usize;
+        match &self.materials[self.material[i] as usize].opacity {
+            None => false,
+            Some(opacity) => opacity.passes(self.uv_at(i, b), || coverage_sample(tri, o, d)),
+        }
     }
 }

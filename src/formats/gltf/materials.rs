@@ -15,12 +15,14 @@
 //!
 //! Emission is `emissiveFactor` × `KHR_materials_emissive_strength` (radiance, taken as
 //! photonwave's units, as Blender imports it) times the emissive texture, from the front face.
-//! The normal texture bends the shading normal ([`NormalMap`], glTF's handedness); occlusion
-//! textures, alpha masks and blending are warned of by name.
+//! The normal texture bends the shading normal ([`NormalMap`], glTF's handedness). `alphaMode`
+//! cuts the surface out ([`Opacity`]; α = the base colour factor's alpha times the base colour
+//! texture's alpha channel): `MASK` where α < `alphaCutoff` (0.5 by default), `BLEND` as coverage
+//! (present with probability α); occlusion textures are warned of by name.
 
 use super::Sources;
 use crate::error::Result;
-use crate::material::{Bsdf, Maps, Material, NormalMap, Relief, PHOTON_SPECULAR_ALPHA};
+use crate::material::{AlphaMode, Bsdf, Maps, Material, NormalMap, Opacity, Relief, PHOTON_SPECULAR_ALPHA};
 use crate::microfacet::{alpha_of, Alpha};
 use crate::texture::{Encoding, Texture};
 use glam::{Vec2, Vec3};
@@ -78,7 +80,7 @@ pub(super) fn convert(
     let file = src.path.display().to_string();
     let mut warn = |what: String| warnings.push(format!("{file}: material `{name}`: {what}"));
     let pbr = m.pbr_metallic_roughness();
-    let [r, g, b, _] = pbr.base_color_factor();
+    let [r, g, b, base_alpha] = pbr.base_color_factor();
     let base = Vec3::new(r, g, b).clamp(Vec3::ZERO, Vec3::ONE);
     let (metallic, roughness) = (pbr.metallic_factor().clamp(0.0, 1.0), pbr.roughness_factor().clamp(0.0, 1.0));
     let mut uv = None;
@@ -111,6 +113,15 @@ pub(super) fn convert(
     let base_map = texture(pbr.base_color_texture(), Encoding::Srgb, "base colour texture", src)?;
     let mr_map = texture(pbr.metallic_roughness_texture(), Encoding::Linear, "metallic-roughness texture", src)?;
     let ke_map = texture(m.emissive_texture(), Encoding::Srgb, "emissive texture", src)?;
+    let cut = match m.alpha_mode() {
+        gltf::material::AlphaMode::Opaque => None,
+        gltf::material::AlphaMode::Mask => Some(AlphaMode::Cutoff(m.alpha_cutoff().unwrap_or(0.5))),
+        gltf::material::AlphaMode::Blend => Some(AlphaMode::Coverage),
+    };
+    let alpha_map = match cut {
+        Some(_) => texture(pbr.base_color_texture(), Encoding::Alpha, "base colour texture's alpha", src)?,
+        None => None,
+    };
     for w in transforms {
         warn(w);
     }
@@ -204,13 +215,14 @@ pub(super) fn convert(
     if m.occlusion_texture().is_some() {
         warn("its occlusion texture is ignored (a renderer computes occlusion; it is for rasterisers)".into());
     }
-    match m.alpha_mode() {
-        gltf::material::AlphaMode::Opaque => {}
-        mode => warn(format!("alphaMode {mode:?} is not rendered yet: the surface is opaque")),
-    }
+    // An image without alpha is opaque: no texture to look up.
+    let alpha_map = alpha_map.filter(|t| t.texels.iter().any(|a| a.x < 1.0));
+    let opacity = cut
+        .map(|mode| Opacity { texture: alpha_map, factor: base_alpha.clamp(0.0, 1.0), mode })
+        .filter(|o| !o.is_opaque());
     let emission = if emission.is_finite() { emission } else { Vec3::ZERO };
     Ok(Converted {
-        material: Material { name: name.to_string(), bsdf, emission, maps, interior, normal_map },
+        material: Material { name: name.to_string(), bsdf, emission, maps, interior, normal_map, opacity },
         uv: uv.flatten(),
     })
 }

@@ -12,7 +12,8 @@
 //! | `phong` | normalised Phong (`diffuse_reflectance`, `specular_reflectance`, `exponent`) |
 //! | `normalmap` | its inner BSDF, its texture bending the shading normal ([`NormalMap`], Mitsuba's frame) |
 //! | `bumpmap` | its inner BSDF, its `bitmap` (in any `scale` textures) a height field that bends the shading normal ([`Relief::Heights`]) |
-//! | `mask`, `coating`, `roughcoating`, `blendbsdf`, `mixturebsdf` | the (first) inner BSDF, warned of by name |
+//! | `mask` | its inner BSDF, cut out where its `opacity` (0.5 by default; a bitmap's luminance) says: present with probability equal to the opacity ([`Opacity`], coverage) |
+//! | `coating`, `roughcoating`, `blendbsdf`, `mixturebsdf` | the (first) inner BSDF, warned of by name |
 //! | anything else | grey Lambertian (0.5), warned of with its line |
 //!
 //! `diffuse`, `roughconductor`, `roughdielectric`, `roughplastic` (GGX and Beckmann) and
@@ -31,7 +32,7 @@
 
 use super::Ctx;
 use crate::error::Result;
-use crate::material::{Bsdf, Maps, Material, NormalMap, Relief};
+use crate::material::{AlphaMode, Bsdf, Maps, Material, NormalMap, Opacity, Relief};
 use crate::microfacet::{Alpha, Distribution, MIN_ALPHA};
 use crate::optics::{named_metal, ComplexIor};
 use crate::texture::{Encoding, Texture};
@@ -307,7 +308,35 @@ impl Ctx<'_> {
                 }
                 return Ok((material, uv.or(map.uv)));
             }
-            "mask" => return wrapper(self, Some("the opacity mask is not rendered yet: the surface is opaque")),
+            "mask" => {
+                // A scalar texture (Mitsuba's default 0.5): a bitmap's luminance, decoded from
+                // sRGB unless `raw`, as Mitsuba's `eval_1` reads it.
+                let raw = match self.r.prop(node, "opacity") {
+                    Some(t) if t.tag_name().name() != "ref" => self.r.boolean(t, "raw", false)?,
+                    Some(t) => {
+                        let t = self.referenced(t)?;
+                        self.r.boolean(t, "raw", false)?
+                    }
+                    None => false,
+                };
+                let encoding = if raw { Encoding::Linear } else { Encoding::Srgb };
+                let c = self.coloured(node, "opacity", Vec3::splat(0.5), encoding)?;
+                let (mut material, uv) = wrapper(self, None)?;
+                let luminance = |c: Vec3| c.dot(Vec3::new(0.212_671, 0.715_160, 0.072_169));
+                let texture = c.map.map(|t| {
+                    let texels = t.texels.iter().map(|&x| Vec3::splat(luminance(x))).collect();
+                    Arc::new(Texture { texels, ..(*t).clone() })
+                });
+                let opacity = Opacity { texture, factor: luminance(c.value), mode: AlphaMode::Coverage };
+                material.opacity = (!opacity.is_opaque()).then_some(opacity);
+                if uv.is_some() && c.uv.is_some() && uv != c.uv {
+                    self.warn(
+                        node,
+                        "the opacity's texture transform differs from its BSDF's: the BSDF's is used".into(),
+                    );
+                }
+                return Ok((material, uv.or(c.uv)));
+            }
             "coating" | "roughcoating" => return wrapper(self, Some("the coating is not rendered: its base alone is")),
             "blendbsdf" | "mixturebsdf" => {
                 return wrapper(self, Some("only the first of the blended BSDFs is rendered"))
@@ -394,6 +423,7 @@ impl Ctx<'_> {
                 maps,
                 interior: Vec3::ZERO,
                 normal_map: None,
+                opacity: None,
             },
             uv,
         ))

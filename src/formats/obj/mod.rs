@@ -14,7 +14,7 @@ use crate::files::{read_text, MAX_MATERIAL_FILE, MAX_MESH_FILE};
 use crate::formats::materials::MaterialTable;
 use crate::formats::transform::Transform;
 use crate::geometry::in_range;
-use crate::material::{Bsdf, Maps, NormalMap, Relief};
+use crate::material::{AlphaMode, Bsdf, Maps, NormalMap, Opacity, Relief};
 use crate::scene::{first_out_of_range, out_of_range_message, MeshInput};
 use crate::texture::{Encoding, Texture};
 use glam::{Vec2, Vec3};
@@ -53,6 +53,20 @@ impl MaterialTable {
         let Some(scale) = m.map("bump").map(|st| st.scale) else { return Ok(None) };
         let texture = self.load_statement(mtl_path, m, "bump", Encoding::Linear, "a `bump` height map", inputs)?;
         Ok(texture.map(|texture| NormalMap { texture, relief: Relief::Heights, scale, handed: false }))
+    }
+
+    /// The cut-out of a material's dissolve: `d` (or 1 − `Tr`) times its `map_d` (the image's
+    /// alpha channel, or its grey level without one), read as coverage ([`Opacity`]); `None`
+    /// where it is opaque everywhere.
+    pub fn load_opacity(
+        &mut self,
+        mtl_path: &Path,
+        m: &MtlMaterial,
+        inputs: &mut Vec<PathBuf>,
+    ) -> Result<Option<Opacity>> {
+        let texture = self.load_statement(mtl_path, m, "map_d", Encoding::Opacity, "a `map_d` opacity", inputs)?;
+        let opacity = Opacity { texture, factor: m.d.unwrap_or(1.0), mode: AlphaMode::Coverage };
+        Ok((!opacity.is_opaque()).then_some(opacity))
     }
 
     /// The image of material `m`'s map statement `key` (`None` without one), read as `what` in
@@ -182,6 +196,7 @@ pub fn load_obj(
         let mut material = material_from_mtl(m, file, warnings);
         material.maps = table.load_maps(file, m, inputs)?;
         material.normal_map = table.load_bump(file, m, inputs)?;
+        material.opacity = table.load_opacity(file, m, inputs)?;
         // A PBR metal's colour is its `Kd`: so is its texture's.
         if m.pm.is_some_and(|p| p >= 0.5) && material.maps.ks.is_none() {
             material.maps.ks = material.maps.kd.take();

@@ -49,7 +49,10 @@ pub struct MtlMaterial {
     pub pr: Option<f32>,
     /// `Pm` (PBR metallic, 0–1).
     pub pm: Option<f32>,
-    /// The texture maps simulated (`map_Kd`, `map_Ks`), in file order.
+    /// The dissolve: `d`, or 1 − `Tr` (1: opaque).
+    pub d: Option<f32>,
+    /// The texture maps simulated (`map_Kd`, `map_Ks`, `map_Pr`, `map_Ke`, `map_Pm`, `map_d`,
+    /// `bump`), in file order.
     pub maps: Vec<MapStatement>,
     /// Statements read but not simulated, in order of first appearance (`map_Ke`, `d`, …).
     pub ignored: Vec<String>,
@@ -289,17 +292,21 @@ fn statement(path: &Path, line: usize, kw: &str, words: &[&str], m: &mut MtlMate
             _ => return Err(Error::parse(path, line, "`illum` needs one integer 0–10 (the MTL spec's models)")),
         },
         "d" | "Tr" => {
-            // `d -halo 0.5` is the spec's other form.
-            let v = match words {
-                ["-halo", w] => number(path, line, kw, w)?,
-                _ => one(kw)?,
+            // `d -halo 0.5` is the spec's other form (dissolve by viewing angle: not simulated).
+            let (v, halo) = match words {
+                ["-halo", w] => (number(path, line, kw, w)?, true),
+                _ => (one(kw)?, false),
             };
             if !(0.0..=1.0).contains(&v) {
                 return Err(Error::parse(path, line, format!("`{kw}` must be in [0, 1]")));
             }
-            let opaque = if kw == "d" { v == 1.0 } else { v == 0.0 };
-            if !opaque {
-                m.ignore(kw);
+            let d = if kw == "d" { v } else { 1.0 - v };
+            if halo {
+                if d < 1.0 {
+                    m.ignore("d -halo");
+                }
+            } else {
+                m.d = Some(d);
             }
         }
         "Pr" | "Pm" => {
@@ -326,7 +333,7 @@ fn statement(path: &Path, line: usize, kw: &str, words: &[&str], m: &mut MtlMate
             let Some(file) = texture_file(words) else {
                 return Err(Error::parse(path, line, format!("`{kw}` names no image file")));
             };
-            if matches!(kw, "map_Kd" | "map_Ks" | "map_Pr" | "map_Ke" | "map_Pm") {
+            if matches!(kw, "map_Kd" | "map_Ks" | "map_Pr" | "map_Ke" | "map_Pm" | "map_d") {
                 if words.first().is_some_and(|w| w.starts_with('-')) {
                     m.ignore(&format!("{kw} options"));
                 }
@@ -349,8 +356,14 @@ fn statement(path: &Path, line: usize, kw: &str, words: &[&str], m: &mut MtlMate
 
 /// Drops the maps a material cannot use: `map_Pr` and `map_Pm` without `Pr` > 0 (a smooth
 /// material has no roughness for them to vary), `map_Pm` on a mirror or glass (illum 3–9: no
-/// plastic to mix with).
+/// plastic to mix with), and a glass's dissolve (`d`, `Tr`, `map_d` under illum 4, 6, 7 or 9:
+/// there the spec's transparency is the glass's own, which the dielectric renders).
 fn drop_unusable_maps(m: &mut MtlMaterial) {
+    if matches!(m.illum, Some(4 | 6 | 7 | 9)) && (m.d.is_some_and(|d| d < 1.0) || m.map("map_d").is_some()) {
+        m.d = None;
+        m.maps.retain(|s| s.key != "map_d");
+        m.ignored.push("d or map_d on a glass".into());
+    }
     for key in ["map_Pr", "map_Pm"] {
         if !m.pr.is_some_and(|r| r > 0.0) && m.map(key).is_some() {
             m.maps.retain(|s| s.key != key);
@@ -370,7 +383,7 @@ fn warn_ignored(path: &Path, m: &MtlMaterial, warnings: &mut Vec<String>) {
     }
     warnings.push(format!(
         "{}:{}: material `{}`: {} not simulated yet (of the texture maps only `map_Kd`, `map_Ks`, \
-         `map_Ke`, `map_Pr` and `map_Pm` are, without options; transparency and the PBR keys are ignored); it renders with its constant \
+         `map_Ke`, `map_Pr`, `map_Pm`, `map_d` and `bump` are, without options; the PBR keys are ignored); it renders with its constant \
          colours there",
         path.display(),
         m.line,
@@ -402,15 +415,17 @@ mod tests {
     #[test]
     fn spec_statements_are_accepted_and_reported_once_per_material() {
         let text = "newmtl a\nKd 1 0 0\nsharpness 60\nKm 0.5\nmap_Kd -o 1 1 1 -s 2 2 2 tex.png\nbump -bm 0.5 b.png\n\
-                    d 0.5\nd -halo 1\nmap_Ks spec.png\nnewmtl b\nd 1\nTr 0\n";
+                    d 0.5\nd -halo 0.5\nmap_Ks spec.png\nnewmtl b\nd 1\nTr 0\n";
         let (m, w) = parse(text);
         let m = m.unwrap();
-        assert_eq!(m[0].ignored, ["sharpness", "Km", "map_Kd options", "d"]);
+        // `d` is the dissolve read as coverage; its angle-dependent `-halo` form is not.
+        assert_eq!(m[0].ignored, ["sharpness", "Km", "map_Kd options", "d -halo"]);
+        assert_eq!(m[0].d, Some(0.5));
         assert_eq!(
             m[0].maps.iter().map(|s| (s.key.as_str(), s.file.as_str(), s.line, s.scale)).collect::<Vec<_>>(),
             [("map_Kd", "tex.png", 5, 1.0), ("bump", "b.png", 6, 0.5), ("map_Ks", "spec.png", 9, 1.0)]
         );
-        assert!(m[1].ignored.is_empty(), "opaque `d 1` and `Tr 0` change nothing");
+        assert!(m[1].ignored.is_empty() && m[1].d == Some(1.0), "opaque `d 1` and `Tr 0` change nothing");
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].starts_with("m.mtl:1: material `a`") && w[0].contains("`map_Kd options`"), "{w:?}");
     }
