@@ -61,6 +61,17 @@ impl Opacity {
         }
     }
 
+    /// The share of rays the surface stops at `uv`: the opacity under coverage, 0 or 1 under a
+    /// cutoff (what a density estimate weighs the surface's presence by).
+    #[must_use]
+    pub fn presence(&self, uv: Vec2) -> f32 {
+        let alpha = self.alpha(uv);
+        match self.mode {
+            AlphaMode::Cutoff(c) => f32::from(u8::from(alpha >= c)),
+            AlphaMode::Coverage => alpha,
+        }
+    }
+
     /// True when it lets nothing through anywhere (a constant opacity of one, or a cutoff the
     /// constant meets without a texture): then it is dropped at load.
     #[must_use]

@@ -190,6 +190,26 @@ impl Coverage {
     pub const WHOLE: Coverage = Coverage { fraction: 1.0, bias_weight: 0.0 };
 }
 
+/// The kernel-weighted share of the disk of radius `r` around `p` (in the plane of normal `n`)
+/// where the surface is present, `present` giving the presence (0 to 1) at a point of the disk:
+/// what an estimate on a cut-out surface ([`crate::material::Opacity`]) is divided by, since its
+/// photons land only on the present parts. At least [`MIN_COVERAGE`], as [`Coverage::fraction`].
+#[must_use]
+pub fn presence_share(p: Vec3, n: Vec3, r: f32, kernel: Kernel, present: impl Fn(Vec3) -> f32) -> f32 {
+    if !(r > 0.0) || !r.is_finite() {
+        return 1.0;
+    }
+    let (t, b) = n.any_orthonormal_pair();
+    let table = quadrature(kernel);
+    let mut inside = 0.0f32;
+    for k in 0..RINGS * ANGLES {
+        let (row, lane) = (k / 8, k % 8);
+        let q = p + (t * table.x[row][lane] + b * table.y[row][lane]) * r;
+        inside += table.weight[row][lane] * present(q);
+    }
+    (inside / table.total).clamp(MIN_COVERAGE, 1.0)
+}
+
 /// The quadrature's points in rows of 8 (x, y, kernel weight, bias weight), and the sum of the
 /// kernel weights.
 struct Quadrature {

@@ -182,6 +182,12 @@ impl Scene {
         TriangleColumns { cut, ..TriangleColumns::new(&self.p0, &self.p1, &self.p2) }
     }
 
+    /// Whether any material the triangles use has an alpha cut-out.
+    #[must_use]
+    pub fn has_cut_outs(&self) -> bool {
+        self.kinds.5
+    }
+
     /// How many materials the triangles use have an alpha cut-out ([`crate::material::Opacity`]).
     #[must_use]
     pub fn cut_out_materials(&self) -> usize {
@@ -221,6 +227,26 @@ impl Scene {
             None => Vec2::ZERO,
             Some(t) => t[0] * b[0] + t[1] * b[1] + t[2] * b[2],
         }
+    }
+
+    /// How much of a cut-out surface is present ([`crate::material::Opacity::presence`]) at the
+    /// point `q` of triangle `i`'s plane, its texture coordinates extended across the plane
+    /// affinely (exact on a flat region textured by one affine map, such as a quad); `None` when
+    /// the triangle's material has no cut-out.
+    #[must_use]
+    pub fn presence_at(&self, i: usize, q: Vec3) -> Option<f32> {
+        let opacity = self.materials[self.material[i] as usize].opacity.as_ref()?;
+        // Without texture coordinates (a constant opacity) every point reads the same.
+        let Some(t) = self.uv.get(i) else { return Some(opacity.presence(Vec2::ZERO)) };
+        let (e1, e2, d) = (self.p1[i] - self.p0[i], self.p2[i] - self.p0[i], q - self.p0[i]);
+        let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+        let det = d00 * d11 - d01 * d01;
+        if !(det.abs() > 0.0) {
+            return Some(opacity.presence(t[0]));
+        }
+        let (d20, d21) = (d.dot(e1), d.dot(e2));
+        let (s, v) = ((d11 * d20 - d01 * d21) / det, (d00 * d21 - d01 * d20) / det);
+        Some(opacity.presence(t[0] + (t[1] - t[0]) * s + (t[2] - t[0]) * v))
     }
 
     /// The surface point of a hit.

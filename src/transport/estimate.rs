@@ -16,9 +16,11 @@
 use super::Context;
 use crate::code_path::CodePath;
 use crate::material::Bsdf;
-use crate::photon_map::boundary::{Cut, MAX_EXTRA_CUTS};
+use crate::photon_map::boundary::{presence_share, Cut, MAX_EXTRA_CUTS};
 use crate::photon_map::query_packet::{RadiusQuery, PACKET};
-use crate::photon_map::{flags, position_slack, Estimate, Filter, Lookup, Nearest, PhotonMap, Reflectance, OFF_PLANE};
+use crate::photon_map::{
+    flags, position_slack, Estimate, Filter, Kernel, Lookup, Nearest, PhotonMap, Reflectance, OFF_PLANE,
+};
 use crate::scene::{Scene, SurfacePoint};
 use glam::Vec3;
 use std::sync::atomic::Ordering;
@@ -102,6 +104,11 @@ pub fn run_packet(ctx: &Context, lookups: &[FixedLookup<'_>], out: &mut [Estimat
             out[j] = complete_off_plane(ctx.scene, set, q.map, &fixed, f, out[j], &mut Nearest::default());
         }
     }
+    if ctx.scene.has_cut_outs() {
+        for (j, q) in lookups.iter().enumerate() {
+            out[j] = on_cut_out(ctx.scene, q.tri, q.lookup.p, q.lookup.kernel, out[j]);
+        }
+    }
     let rejected: u64 = out[..n].iter().map(|e| u64::from(e.rejected)).sum();
     if rejected > 0 {
         ctx.filtered.fetch_add(rejected, Ordering::Relaxed);
@@ -181,7 +188,25 @@ fn plan_map<'m>(
     if e.rejected > 0 {
         ctx.filtered.fetch_add(u64::from(e.rejected), Ordering::Relaxed);
     }
+    if ctx.scene.has_cut_outs() {
+        return Planned::Done(on_cut_out(ctx.scene, sp.tri, sp.p, lookup.kernel, e));
+    }
     Planned::Done(e)
+}
+
+/// `e`, an estimate at `p` on triangle `tri`, divided by the kernel-weighted share of its disk
+/// where the surface is present when the triangle's material is cut out
+/// ([`presence_share`]): its photons landed only there, so the whole disk's area would dilute
+/// the estimate beside holes (a checkerboard mask halved it). Unchanged on other surfaces. The
+/// share is taken over the whole disk, apart from any boundary correction's cuts.
+#[inline]
+fn on_cut_out(scene: &Scene, tri: u32, p: Vec3, kernel: Kernel, e: Estimate) -> Estimate {
+    let i = tri as usize;
+    if scene.materials[scene.material[i] as usize].opacity.is_none() {
+        return e;
+    }
+    let share = presence_share(p, scene.ng[i], e.radius, kernel, |q| scene.presence_at(i, q).unwrap_or(1.0));
+    Estimate { radiance: e.radiance / share, bias: e.bias / share, coverage: e.coverage * share, ..e }
 }
 
 /// The open edges of the flat region of triangle `tri` within `r` of the point `p` on it, as cuts
@@ -365,7 +390,10 @@ pub fn map_radiance<'a>(
     scratch: &mut Nearest,
 ) -> Planned<'a> {
     let irr = &ctx.maps.irradiance;
-    if let (Bsdf::Lambert { kd }, false) = (bsdf, irr.is_empty()) {
+    // A cut-out surface's points would need the presence around each: its full estimate is read
+    // and corrected instead.
+    let cut_out = ctx.scene.has_cut_outs() && ctx.scene.materials[sp.material as usize].opacity.is_some();
+    if let (Bsdf::Lambert { kd }, false, false) = (bsdf, irr.is_empty(), cut_out) {
         let (ng, _) = sp.frame.oriented(wo);
         let lookup = Lookup {
             p: sp.p,
