@@ -274,7 +274,7 @@ fn bsdf_samples_are_finite_or_absent() {
         0 => Bsdf::Lambert { kd: Vec3::splat(a) },
         1 => Bsdf::Glossy { kd: Vec3::splat(a * (1.0 - b)), ks: Vec3::splat(b), exponent },
         2 => Bsdf::Mirror { ks: Vec3::splat(a), eta_k: None },
-        _ => Bsdf::Glass { ior },
+        _ => Bsdf::Glass { ior, tint: photonwave::material::Tint::CLEAR },
     });
     let shading = prop_oneof![
         Just(Vec3::ZERO),

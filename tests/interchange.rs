@@ -176,13 +176,13 @@ fn gltf_materials_map_onto_the_bsdfs_they_name() {
             json!({"pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
                 "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_ior": {"ior": 1.33},
                     "KHR_materials_volume": {"thicknessFactor": 0.2}}}),
-            Bsdf::Glass { ior: 1.33 },
+            Bsdf::Glass { ior: 1.33, tint: photonwave::material::Tint::CLEAR },
         ),
         // Without a volume the spec makes it thin-walled: a sheet that does not bend light.
         (
             json!({"pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
                 "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_ior": {"ior": 1.33}}}),
-            Bsdf::ThinGlass { ior: 1.33 },
+            Bsdf::ThinGlass { ior: 1.33, tint: photonwave::material::Tint::CLEAR },
         ),
     ];
     for (material, want) in cases {
@@ -199,7 +199,11 @@ fn gltf_materials_map_onto_the_bsdfs_they_name() {
     let loaded = load_doc(&d, &gltf_doc(node.clone(), tinted(0.1), extra.clone())).unwrap();
     let m = &loaded.scene.materials[loaded.scene.material[0] as usize];
     let want = Vec3::new(2f32.ln() / 2.0, 0.0, 4f32.ln() / 2.0);
-    assert!(m.bsdf == Bsdf::Glass { ior: 1.5 } && (m.interior - want).abs().max_element() < 1e-6, "{m:?}");
+    assert!(
+        m.bsdf == Bsdf::Glass { ior: 1.5, tint: photonwave::material::Tint::CLEAR }
+            && (m.interior - want).abs().max_element() < 1e-6,
+        "{m:?}"
+    );
     let loaded = load_doc(&d, &gltf_doc(node.clone(), tinted(0.0), extra.clone())).unwrap();
     assert_eq!(loaded.scene.materials[loaded.scene.material[0] as usize].interior, Vec3::ZERO);
     let glowing = json!({"emissiveFactor": [1, 0.5, 0.25], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 8}}});
@@ -534,7 +538,8 @@ fn mitsuba_shapes_materials_emitters_and_errors() {
     assert!(
         s.materials
             .iter()
-            .any(|m| m.bsdf == Bsdf::Glass { ior: 1.333 / 1.000277 } && m.emission == Vec3::new(1.0, 2.0, 3.0)),
+            .any(|m| m.bsdf == Bsdf::Glass { ior: 1.333 / 1.000277, tint: photonwave::material::Tint::CLEAR }
+                && m.emission == Vec3::new(1.0, 2.0, 3.0)),
         "{kinds:?}"
     );
     // The sphere: centre (1, 2, 3), radius 0.5. The rectangle: 4 × 6, turned flat at y = −1

@@ -35,20 +35,29 @@ fn materials() -> Vec<(String, Bsdf)> {
     let beckmann = |r: f32| Alpha::beckmann(alpha_of(r));
     for r in [0.3f32, 0.6, 1.0] {
         v.push((format!("conductor r={r}"), Bsdf::RoughConductor { ks: Vec3::ONE, alpha: ggx(r), eta_k: None }));
-        v.push((format!("dielectric r={r}"), Bsdf::RoughDielectric { ior: 1.5, alpha: ggx(r) }));
+        v.push((
+            format!("dielectric r={r}"),
+            Bsdf::RoughDielectric { ior: 1.5, alpha: ggx(r), tint: photonwave::material::Tint::CLEAR },
+        ));
         v.push((format!("plastic r={r}"), Bsdf::rough_plastic(Vec3::new(0.8, 0.5, 0.2), 1.5, ggx(r))));
     }
     // Beckmann, and anisotropic widths of each distribution (x and y along the frame's tangents).
     for r in [0.3f32, 0.7] {
         let b = beckmann(r);
         v.push((format!("Beckmann conductor r={r}"), Bsdf::RoughConductor { ks: Vec3::ONE, alpha: b, eta_k: None }));
-        v.push((format!("Beckmann dielectric r={r}"), Bsdf::RoughDielectric { ior: 1.5, alpha: b }));
+        v.push((
+            format!("Beckmann dielectric r={r}"),
+            Bsdf::RoughDielectric { ior: 1.5, alpha: b, tint: photonwave::material::Tint::CLEAR },
+        ));
         v.push((format!("Beckmann plastic r={r}"), Bsdf::rough_plastic(Vec3::new(0.8, 0.5, 0.2), 1.5, b)));
     }
     let (ggx_aniso, beckmann_aniso) =
         (Alpha::ggx(0.1).anisotropic(0.1, 0.5), Alpha::beckmann(0.1).anisotropic(0.4, 0.08));
     v.push(("anisotropic GGX conductor".into(), Bsdf::RoughConductor { ks: Vec3::ONE, alpha: ggx_aniso, eta_k: None }));
-    v.push(("anisotropic Beckmann dielectric".into(), Bsdf::RoughDielectric { ior: 1.5, alpha: beckmann_aniso }));
+    v.push((
+        "anisotropic Beckmann dielectric".into(),
+        Bsdf::RoughDielectric { ior: 1.5, alpha: beckmann_aniso, tint: photonwave::material::Tint::CLEAR },
+    ));
     v
 }
 
@@ -173,7 +182,7 @@ fn white_furnace_never_gains_energy_and_matches_quadrature() {
         let alpha = Alpha::new(distribution, alpha_of(r));
         for (kind, b) in [
             ("conductor", Bsdf::RoughConductor { ks: Vec3::ONE, alpha, eta_k: None }),
-            ("dielectric", Bsdf::RoughDielectric { ior: 1.5, alpha }),
+            ("dielectric", Bsdf::RoughDielectric { ior: 1.5, alpha, tint: photonwave::material::Tint::CLEAR }),
             ("white plastic", Bsdf::rough_plastic(Vec3::ONE, 1.5, alpha)),
         ] {
             let kind = format!("{distribution:?} {kind}");

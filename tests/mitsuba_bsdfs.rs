@@ -25,7 +25,7 @@
 //! difference itself is at most 0.31 % per G1 (`microfacet::distribution`'s doc).
 
 use glam::Vec3;
-use photonwave::material::{Bsdf, SurfaceFrame, Transport};
+use photonwave::material::{fresnel_dielectric, Bsdf, SurfaceFrame, Tint, Transport};
 use photonwave::microfacet::{Alpha, Distribution};
 use photonwave::optics::{named_metal, thin_slab_reflectance, ComplexIor};
 
@@ -100,6 +100,9 @@ fn alpha(params: &str) -> Alpha {
 /// photonwave's BSDF for a row's Mitsuba BSDF and parameters, as the Mitsuba reader makes it.
 fn ours(bsdf: &str, params: &str) -> Bsdf {
     let v3 = |v: Vec<f32>| Vec3::new(v[0], v[1], v[2]);
+    // A dielectric's `specular_reflectance` and `specular_transmittance` (1 where not given).
+    let scale = |name: &str| if text(params, name).is_some() { v3(param(params, name)) } else { Vec3::ONE };
+    let tint = Tint { reflect: scale("rt"), transmit: scale("tt") };
     match bsdf {
         "diffuse" => Bsdf::Lambert { kd: v3(param(params, "kd")) },
         "roughconductor" | "conductor" => {
@@ -121,11 +124,12 @@ fn ours(bsdf: &str, params: &str) -> Bsdf {
                 Bsdf::RoughConductor { ks, alpha: alpha(params), eta_k: Some(eta_k) }
             }
         }
-        "roughdielectric" => Bsdf::RoughDielectric { ior: param(params, "ior")[0], alpha: alpha(params) },
+        "roughdielectric" => Bsdf::RoughDielectric { ior: param(params, "ior")[0], alpha: alpha(params), tint },
         "roughplastic" => Bsdf::rough_plastic(v3(param(params, "kd")), param(params, "ior")[0], alpha(params))
             .with_nonlinear(param(params, "nonlinear")[0] == 1.0)
             .with_coat_scale(v3(param(params, "ks"))),
-        "thindielectric" => Bsdf::ThinGlass { ior: param(params, "ior")[0] },
+        "thindielectric" => Bsdf::ThinGlass { ior: param(params, "ior")[0], tint },
+        "dielectric" => Bsdf::Glass { ior: param(params, "ior")[0], tint },
         "plastic" | "plastic-coat" => Bsdf::Plastic {
             kd: v3(param(params, "kd")),
             ks: v3(param(params, "ks")),
@@ -198,7 +202,9 @@ fn every_bsdf_evaluates_as_mitsuba_3_does() {
             let s = b.sample(&frame, r.wo, [u, 0.5, 0.5], Transport::Radiance).expect("a delta lobe scatters");
             assert!((s.wi - r.wi).length() < 1e-6, "{} {}: {:?} against {:?}", r.bsdf, r.params, s.wi, r.wi);
             let p = match b {
-                Bsdf::ThinGlass { ior } => thin_slab_reflectance(r.wo.z, ior),
+                Bsdf::ThinGlass { ior, .. } => thin_slab_reflectance(r.wo.z, ior),
+                // Fresnel from wo's side (its index ratio inverted from inside).
+                Bsdf::Glass { ior, .. } => fresnel_dielectric(r.wo.z.abs(), if r.wo.z > 0.0 { ior } else { 1.0 / ior }),
                 _ => 1.0,
             };
             (s.weight, if reflects { p } else { 1.0 - p })

@@ -5,7 +5,7 @@
 //! Reads a [`SurfaceFrame`] and directions (world space, away from the surface); writes
 //! [`BsdfSample`]s and values. The materials themselves are in the parent module.
 
-use super::{Bsdf, BsdfSample, SmoothPlastic, SurfaceFrame, Transport, ZeroPdf, PHOTON_SPECULAR_ALPHA};
+use super::{Bsdf, BsdfSample, SmoothPlastic, SurfaceFrame, Tint, Transport, ZeroPdf, PHOTON_SPECULAR_ALPHA};
 use crate::microfacet;
 use crate::optics::{conductor_reflectance, fresnel_dielectric, reflect, refract, thin_slab_reflectance};
 use crate::sampling::{cosine_hemisphere, Frame};
@@ -271,7 +271,9 @@ impl Bsdf {
                 };
                 (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight, delta: true })
             }
-            Bsdf::Glass { ior } => sample_glass(frame, wo, ior, u[0], transport),
+            Bsdf::Glass { ior, tint } => {
+                sample_glass(frame, wo, ior, u[0], transport).map(|s| tinted(s, &tint, frame, wo))
+            }
             Bsdf::Plastic { kd, ks, eta, nonlinear } => {
                 let (ng, ns) = frame.oriented(wo);
                 let f = Frame::new(ns);
@@ -281,7 +283,9 @@ impl Bsdf {
                 let wi = f.to_world(s.sample.wi);
                 (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: s.sample.weight, delta: s.coat })
             }
-            Bsdf::ThinGlass { ior } => sample_thin_glass(frame, wo, ior, u[0]),
+            Bsdf::ThinGlass { ior, tint } => {
+                sample_thin_glass(frame, wo, ior, u[0]).map(|s| tinted(s, &tint, frame, wo))
+            }
             Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } | Bsdf::RoughPlastic { .. } => {
                 self.sample_rough(frame, wo, u, transport == Transport::Radiance)
             }
@@ -294,7 +298,7 @@ impl Bsdf {
     /// survival probability of 1/1.5² on entering glass would kill most paths for nothing.
     #[must_use]
     pub fn radiance_scale(&self, frame: &SurfaceFrame, wo: Vec3, wi: Vec3) -> f32 {
-        let (Bsdf::Glass { ior } | Bsdf::RoughDielectric { ior, .. }) = *self else { return 1.0 };
+        let (Bsdf::Glass { ior, .. } | Bsdf::RoughDielectric { ior, .. }) = *self else { return 1.0 };
         let (o, i) = (wo.dot(frame.ng), wi.dot(frame.ng));
         if (o > 0.0) == (i > 0.0) {
             return 1.0;
@@ -377,8 +381,9 @@ impl Bsdf {
             }
             Bsdf::RoughPlastic { .. } if wi.dot(ng) > 0.0 => self.plastic().map_or(Vec3::ZERO, |p| p.eval(lo, li)),
             // Reflection stays on wo's geometric side, refraction crosses it.
-            Bsdf::RoughDielectric { alpha, .. } if (wi.dot(ng) > 0.0) == (li.z > 0.0) => {
-                Vec3::splat(microfacet::dielectric_eval(lo, li, eta, alpha))
+            Bsdf::RoughDielectric { alpha, tint, .. } if (wi.dot(ng) > 0.0) == (li.z > 0.0) => {
+                let scale = if li.z > 0.0 { tint.reflect } else { tint.transmit };
+                scale * microfacet::dielectric_eval(lo, li, eta, alpha)
             }
             _ => Vec3::ZERO,
         })
@@ -452,7 +457,11 @@ impl Bsdf {
             Bsdf::RoughConductor { ks, alpha, eta_k } => {
                 microfacet::conductor_sample(lo, |cos| conductor_reflectance(ks, eta_k, cos), alpha, [u[0], u[1]])?
             }
-            Bsdf::RoughDielectric { alpha, .. } => microfacet::dielectric_sample(lo, eta, alpha, u, radiance)?,
+            Bsdf::RoughDielectric { alpha, tint, .. } => {
+                let s = microfacet::dielectric_sample(lo, eta, alpha, u, radiance)?;
+                let scale = if s.wi.z > 0.0 { tint.reflect } else { tint.transmit };
+                microfacet::LocalSample { weight: s.weight * scale, ..s }
+            }
             Bsdf::RoughPlastic { .. } => self.plastic()?.sample(lo, u)?,
             _ => return None,
         };
@@ -505,6 +514,13 @@ fn sample_phong(r: Vec3, n: f32, u: [f32; 2]) -> Vec3 {
 /// A thin sheet: reflection about the shading normal with the slab's reflectance R′
 /// ([`thin_slab_reflectance`]) as its probability, otherwise straight through (wi = −wo); the
 /// weight is 1 either way, and no (η_wo/η_wi)² (the light leaves into the medium it came from).
+/// Sample `s` of a dielectric from `wo`, its weight scaled by `tint`'s reflection or
+/// transmission.
+#[inline]
+fn tinted(s: BsdfSample, tint: &Tint, frame: &SurfaceFrame, wo: Vec3) -> BsdfSample {
+    BsdfSample { weight: s.weight * tint.of(frame.ng, wo, s.wi), ..s }
+}
+
 fn sample_thin_glass(frame: &SurfaceFrame, wo: Vec3, ior: f32, u: f32) -> Option<BsdfSample> {
     let (ng, ns) = frame.oriented(wo);
     if u < thin_slab_reflectance(wo.dot(ns), ior) {

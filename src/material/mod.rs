@@ -42,20 +42,21 @@ pub enum Bsdf {
     /// Perfect mirror: reflectance `ks` at every angle, or with the complex index `eta_k` its
     /// exact Fresnel times `ks` (Mitsuba's `conductor`).
     Mirror { ks: Vec3, eta_k: Option<crate::optics::ComplexIor> },
-    /// Smooth clear dielectric with index of refraction `ior` (relative to the outside, the side
-    /// the geometric normal points to), exact Fresnel.
-    Glass { ior: f32 },
+    /// Smooth dielectric with index of refraction `ior` (relative to the outside, the side the
+    /// geometric normal points to), exact Fresnel, its reflection and transmission scaled by
+    /// `tint` (clear: 1).
+    Glass { ior: f32, tint: Tint },
     /// A thin dielectric sheet of index `ior` (Mitsuba's `thindielectric`, a window pane): light
     /// passes straight through, unbent, or is reflected, with the slab's reflectance
     /// ([`crate::optics::thin_slab_reflectance`]: the two faces and every bounce between them).
-    ThinGlass { ior: f32 },
+    ThinGlass { ior: f32, tint: Tint },
     /// Rough conductor ([`crate::microfacet`]): microfacets `alpha` (GGX or Beckmann), Schlick's
     /// Fresnel from the normal-incidence reflectance `ks`, or with the complex index `eta_k` its
     /// exact Fresnel times `ks` ([`crate::optics::conductor_reflectance`]).
     RoughConductor { ks: Vec3, alpha: microfacet::Alpha, eta_k: Option<crate::optics::ComplexIor> },
-    /// Rough (frosted) clear dielectric: microfacets `alpha`, exact Fresnel, reflection and
-    /// refraction through the microfacets; `ior` as for [`Bsdf::Glass`].
-    RoughDielectric { ior: f32, alpha: microfacet::Alpha },
+    /// Rough (frosted) dielectric: microfacets `alpha`, exact Fresnel, reflection and refraction
+    /// through the microfacets; `ior` and `tint` as for [`Bsdf::Glass`].
+    RoughDielectric { ior: f32, alpha: microfacet::Alpha, tint: Tint },
     /// Rough plastic, Mitsuba 3's `roughplastic` ([`microfacet::Plastic`]): a dielectric coat
     /// of microfacets `alpha` over a Lambertian base `kd`, the coat's reflection scaled by `ks`
     /// (Mitsuba's `specular_reflectance`, 1 elsewhere); `coat` holds its index ratio and its
@@ -67,6 +68,34 @@ pub enum Bsdf {
     /// `nonlinear` as for [`Bsdf::RoughPlastic`]. Its coat is a delta lobe beside a diffuse
     /// base: camera paths follow it with their glossy ray, photons are stored on it.
     Plastic { kd: Vec3, ks: Vec3, eta: f32, nonlinear: bool },
+}
+
+/// A dielectric's scales on what it reflects and what it transmits (Mitsuba's
+/// `specular_reflectance` and `specular_transmittance`; glTF's base colour on transmission). The
+/// sampling probabilities stay Fresnel's: only the sample weights and values are scaled.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tint {
+    /// Scale on reflection.
+    pub reflect: Vec3,
+    /// Scale on transmission.
+    pub transmit: Vec3,
+}
+
+impl Tint {
+    /// No scale.
+    pub const CLEAR: Tint = Tint { reflect: Vec3::ONE, transmit: Vec3::ONE };
+
+    /// The scale of a lobe: reflection where `wo` and `wi` lie on one side of the geometric
+    /// normal `ng`, transmission otherwise.
+    #[inline]
+    #[must_use]
+    pub fn of(&self, ng: Vec3, wo: Vec3, wi: Vec3) -> Vec3 {
+        if (wo.dot(ng) > 0.0) == (wi.dot(ng) > 0.0) {
+            self.reflect
+        } else {
+            self.transmit
+        }
+    }
 }
 
 impl Bsdf {
@@ -297,7 +326,7 @@ impl Material {
                     None => Bsdf::RoughPlastic { kd, ks, alpha, nonlinear, coat },
                 }
             }
-            Bsdf::RoughDielectric { ior, alpha } => Bsdf::RoughDielectric { ior, alpha: alpha_at(alpha) },
+            Bsdf::RoughDielectric { ior, alpha, tint } => Bsdf::RoughDielectric { ior, alpha: alpha_at(alpha), tint },
             Bsdf::Plastic { kd, ks, eta, nonlinear } => {
                 Bsdf::Plastic { kd: kd_at(kd).min(Vec3::ONE), ks, eta, nonlinear }
             }
@@ -448,8 +477,9 @@ mod tests {
         // Inside the glass (wo below the surface), 60° from the normal: past 41.8°.
         let wo = Vec3::new(60f32.to_radians().sin(), 0.0, -60f32.to_radians().cos());
         for k in 0..100 {
-            let s =
-                Bsdf::Glass { ior: 1.5 }.sample(&frame, wo, [k as f32 / 100.0, 0.5, 0.5], Transport::Power).unwrap();
+            let s = Bsdf::Glass { ior: 1.5, tint: Tint::CLEAR }
+                .sample(&frame, wo, [k as f32 / 100.0, 0.5, 0.5], Transport::Power)
+                .unwrap();
             assert_eq!(s.weight, Vec3::ONE);
             assert!(s.wi.z < 0.0, "must stay inside");
         }

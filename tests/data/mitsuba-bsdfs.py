@@ -165,7 +165,18 @@ def smooth():
 
 
 def scaled():
-    """A rough plastic whose coat is scaled by `specular_reflectance`."""
+    """A rough plastic whose coat is scaled by `specular_reflectance`; dielectrics scaled by
+    `specular_reflectance` and `specular_transmittance`."""
+    rt, tt = [0.9, 0.7, 0.5], [0.6, 0.8, 1.0]
+    scales = {"specular_reflectance": {"type": "rgb", "value": rt}, "specular_transmittance": {"type": "rgb", "value": tt}}
+    yield (
+        "roughdielectric",
+        {"alpha": 0.2, "ior": 1.5, "rt": rt, "tt": tt},
+        dict({"type": "roughdielectric", "distribution": "ggx", "alpha": 0.2, "int_ior": 1.5, "ext_ior": 1.0}, **scales),
+    )
+    yield "thindielectric", {"ior": 1.5, "rt": rt, "tt": tt}, dict({"type": "thindielectric", "int_ior": 1.5, "ext_ior": 1.0}, **scales)
+    yield "dielectric", {"ior": 1.5, "rt": rt, "tt": tt}, dict({"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}, **scales)
+    yield "dielectric", {"ior": 1.33}, {"type": "dielectric", "int_ior": 1.33, "ext_ior": 1.0}
     ks = [0.9, 0.6, 0.3]
     yield (
         "roughplastic",
@@ -241,7 +252,7 @@ def main():
                 f = [float(weight[c]) for c in range(3)]
                 rows.append(["plastic-coat", params] + [f"{x:.9g}" for x in wo + wi + f] + [f"{float(bs.pdf):.9g}"])
             continue
-        if name in ("conductor", "thindielectric"):
+        if name in ("conductor", "thindielectric", "dielectric"):
             # Delta lobes: a sample's direction and weight (f·cos/pdf) in f, and the probability
             # of the lobe it chose in pdf (1 for the mirror); the thin sheet's reflection
             # (sample1 = 0) and transmission (sample1 just below 1), from either side.

@@ -7,7 +7,7 @@
 //!   smooth glass (r < 0.05) or a GGX rough dielectric of α = r²; without it thin-walled, as the
 //!   spec has it — a thin sheet (light passes unbent) when smooth, a rough dielectric (warned of)
 //!   when rough; a solid's volume attenuation absorbs inside it (σ_a = −ln(colour)/distance,
-//!   Beer–Lambert), a tint by the base colour is warned of, not rendered;
+//!   Beer–Lambert), and the base colour tints what is transmitted (a texture by its mean, warned of);
 //! - m ≥ ½: a mirror of reflectance b (r < 0.05) or a GGX rough conductor (Schlick from b);
 //! - otherwise a rough plastic (GGX coat of index 1.5 over a Lambertian base b), or Lambertian b
 //!   where r ≥ 0.95 (the 4 % coat at that roughness scatters nearly diffusely itself);
@@ -22,7 +22,7 @@
 
 use super::Sources;
 use crate::error::Result;
-use crate::material::{AlphaMode, Bsdf, Maps, Material, NormalMap, Opacity, Relief, PHOTON_SPECULAR_ALPHA};
+use crate::material::{AlphaMode, Bsdf, Maps, Material, NormalMap, Opacity, Relief, Tint, PHOTON_SPECULAR_ALPHA};
 use crate::microfacet::{alpha_of, Alpha};
 use crate::texture::{Encoding, Texture};
 use glam::{Vec2, Vec3};
@@ -131,11 +131,17 @@ pub(super) fn convert(
     let mut maps = Maps::default();
     let mut interior = Vec3::ZERO;
     let bsdf = if transmission >= 0.5 {
-        if base.min_element() < 0.999 || base_map.is_some() {
-            warn(
-                "its glass is tinted by its base colour; photonwave's glass is clear (the tint is not rendered)".into(),
-            );
-        }
+        // The spec tints what is transmitted by the base colour (a texture by its mean here).
+        let tint = Tint {
+            reflect: Vec3::ONE,
+            transmit: match &base_map {
+                Some(t) => {
+                    warn("its base colour texture tints the transmission by its mean".into());
+                    base * t.mean().min(Vec3::ONE)
+                }
+                None => base,
+            },
+        };
         // The spec's rule: without KHR_materials_volume (or with a zero thickness) the surface
         // is thin-walled — light passes through unbent — and with it the boundary of a solid,
         // whose attenuation colour c is what remains after `attenuationDistance` d inside:
@@ -152,13 +158,13 @@ pub(super) fn convert(
             }
         }
         match (roughness < SMOOTH, solid) {
-            (true, true) => Bsdf::Glass { ior },
-            (true, false) => Bsdf::ThinGlass { ior },
+            (true, true) => Bsdf::Glass { ior, tint },
+            (true, false) => Bsdf::ThinGlass { ior, tint },
             (false, solid) => {
                 if !solid {
                     warn("rough thin-walled transmission is rendered as a solid rough dielectric".into());
                 }
-                Bsdf::RoughDielectric { ior, alpha }
+                Bsdf::RoughDielectric { ior, alpha, tint }
             }
         }
     } else {

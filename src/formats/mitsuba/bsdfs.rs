@@ -7,6 +7,7 @@
 //! | `dielectric` | smooth glass of index `int_ior` / `ext_ior` (numbers or Mitsuba's names) |
 //! | `thindielectric` | a thin sheet: straight through or reflected with the slab's reflectance |
 //! | `roughdielectric` | rough dielectric of `distribution` (Beckmann unless `ggx`) and `alpha` |
+//! | the three dielectrics' `specular_reflectance`, `specular_transmittance` | scales on what they reflect and transmit ([`Tint`]; a texture as its mean, warned of) |
 //! | `conductor`, `roughconductor` | mirror or rough conductor (Beckmann unless `ggx`), the exact Fresnel of `eta`, `k` or the named `material` ([`crate::optics::METALS`]), times `specular_reflectance` |
 //! | `plastic`, `roughplastic` | Mitsuba's smooth (a mirror coat) or rough plastic over `diffuse_reflectance`, with `nonlinear` and `specular_reflectance` (a texture as its mean, warned of) |
 //! | `phong` | normalised Phong (`diffuse_reflectance`, `specular_reflectance`, `exponent`) |
@@ -32,7 +33,7 @@
 
 use super::Ctx;
 use crate::error::Result;
-use crate::material::{AlphaMode, Bsdf, Maps, Material, NormalMap, Opacity, Relief};
+use crate::material::{AlphaMode, Bsdf, Maps, Material, NormalMap, Opacity, Relief, Tint};
 use crate::microfacet::{Alpha, Distribution, MIN_ALPHA};
 use crate::optics::{named_metal, ComplexIor};
 use crate::texture::{Encoding, Texture};
@@ -113,6 +114,19 @@ impl Ctx<'_> {
                     IORS.map(|x| x.0)[..6].join(", ")
                 ),
             )
+        })
+    }
+
+    /// A BSDF's scale `name` (`specular_reflectance`, `specular_transmittance`; 1 by default), a
+    /// texture read as its mean (warned of), at most 1 per channel.
+    fn scale_colour(&mut self, node: Node, kind: &str, name: &str) -> Result<Vec3> {
+        let s = self.coloured(node, name, Vec3::ONE, Encoding::Srgb)?;
+        Ok(match &s.map {
+            Some(t) => {
+                self.warn(node, format!("{kind}: a textured `{name}` is rendered as its mean"));
+                t.mean().min(Vec3::ONE)
+            }
+            None => s.value.min(Vec3::ONE),
         })
     }
 
@@ -347,10 +361,14 @@ impl Ctx<'_> {
             }
             "dielectric" | "thindielectric" | "roughdielectric" => {
                 let ior = self.ior_ratio(node, 1.5046)?;
+                let tint = Tint {
+                    reflect: self.scale_colour(node, kind, "specular_reflectance")?,
+                    transmit: self.scale_colour(node, kind, "specular_transmittance")?,
+                };
                 let bsdf = match kind {
-                    "roughdielectric" => Bsdf::RoughDielectric { ior, alpha: self.alpha(node, kind)? },
-                    "thindielectric" => Bsdf::ThinGlass { ior },
-                    _ => Bsdf::Glass { ior },
+                    "roughdielectric" => Bsdf::RoughDielectric { ior, alpha: self.alpha(node, kind)?, tint },
+                    "thindielectric" => Bsdf::ThinGlass { ior, tint },
+                    _ => Bsdf::Glass { ior, tint },
                 };
                 (bsdf, Maps::default(), None)
             }
@@ -385,14 +403,7 @@ impl Ctx<'_> {
                 let c = self.coloured(node, "diffuse_reflectance", Vec3::splat(0.5), Encoding::Srgb)?;
                 let alpha = if kind == "plastic" { None } else { Some(self.alpha(node, kind)?) };
                 let nonlinear = self.r.boolean(node, "nonlinear", false)?;
-                let s = self.coloured(node, "specular_reflectance", Vec3::ONE, Encoding::Srgb)?;
-                let ks = match &s.map {
-                    Some(t) => {
-                        self.warn(node, format!("{kind}: a textured `specular_reflectance` is rendered as its mean"));
-                        t.mean()
-                    }
-                    None => s.value,
-                };
+                let ks = self.scale_colour(node, kind, "specular_reflectance")?;
                 let kd = c.value.min(Vec3::ONE);
                 let bsdf = match alpha {
                     Some(alpha) => Bsdf::rough_plastic(kd, ior, alpha),

@@ -21,7 +21,7 @@
 
 use super::validate::number;
 use crate::error::{Error, Result};
-use crate::material::{Bsdf, Material};
+use crate::material::{Bsdf, Material, Tint};
 use crate::microfacet::{alpha_of, Alpha};
 use glam::Vec3;
 use std::path::Path;
@@ -211,8 +211,8 @@ pub fn material_from_mtl(m: &MtlMaterial, file: &Path, warnings: &mut Vec<String
         (3 | 5 | 8, Some(alpha)) => {
             Bsdf::RoughConductor { ks: m.ks.unwrap_or(Vec3::ONE).min(Vec3::ONE), alpha, eta_k: None }
         }
-        (4 | 6 | 7 | 9, None) => Bsdf::Glass { ior: m.ni.unwrap_or(1.5) },
-        (4 | 6 | 7 | 9, Some(alpha)) => Bsdf::RoughDielectric { ior: m.ni.unwrap_or(1.5), alpha },
+        (4 | 6 | 7 | 9, None) => Bsdf::Glass { ior: m.ni.unwrap_or(1.5), tint: Tint::CLEAR },
+        (4 | 6 | 7 | 9, Some(alpha)) => Bsdf::RoughDielectric { ior: m.ni.unwrap_or(1.5), alpha, tint: Tint::CLEAR },
         // The PBR extension's metals take their colour from `Kd` (the base colour).
         (_, None) if metal => Bsdf::Mirror { ks: kd.min(Vec3::ONE), eta_k: None },
         (_, Some(alpha)) if metal => Bsdf::RoughConductor { ks: kd.min(Vec3::ONE), alpha, eta_k: None },
@@ -444,7 +444,7 @@ mod tests {
             Bsdf::RoughConductor { ks: Vec3::new(0.9, 0.6, 0.3), alpha: Alpha::ggx(alpha_of(0.4)), eta_k: None }
         );
         assert!(m[0].map("map_Pr").is_some(), "map_Pr before Pr is kept");
-        assert_eq!(b[1], Bsdf::RoughDielectric { ior: 1.4, alpha: Alpha::ggx(alpha_of(0.5)) });
+        assert_eq!(b[1], Bsdf::RoughDielectric { ior: 1.4, alpha: Alpha::ggx(alpha_of(0.5)), tint: Tint::CLEAR });
         assert_eq!(b[2], Bsdf::Mirror { ks: Vec3::splat(0.8), eta_k: None });
         assert_eq!(b[3], Bsdf::rough_plastic(Vec3::splat(0.5), 1.5, Alpha::ggx(alpha_of(0.3))));
         assert!(w.is_empty(), "{w:?}");

@@ -7,7 +7,7 @@
 //! head-on, the rise toward grazing angles Schlick's (within a few per cent for metals).
 
 use crate::error::{Error, Result};
-use crate::material::{Bsdf, Material};
+use crate::material::{Bsdf, Material, Tint};
 use crate::optics::{named_metal, ComplexIor, METALS};
 use glam::Vec3;
 use serde::Deserialize;
@@ -174,7 +174,14 @@ impl MaterialEntry {
                 if !(ior > 0.0 && ior.is_finite() && outside_ior > 0.0 && outside_ior.is_finite()) {
                     return Err(Error::setting(f("ior"), "`ior` and `outside_ior` must be positive numbers"));
                 }
-                (Bsdf::RoughDielectric { ior: finite_ratio(&f("ior"), ior / outside_ior)?, alpha }, emission)
+                (
+                    Bsdf::RoughDielectric {
+                        ior: finite_ratio(&f("ior"), ior / outside_ior)?,
+                        alpha,
+                        tint: Tint::CLEAR,
+                    },
+                    emission,
+                )
             }
             MaterialEntry::Conductor { eta, k, ref metal, roughness, emission } => {
                 let eta_k = match (eta, k, metal) {
@@ -210,7 +217,7 @@ impl MaterialEntry {
                 if !(outside_ior > 0.0 && outside_ior.is_finite()) {
                     return Err(Error::setting(f("outside_ior"), "must be a positive number"));
                 }
-                (Bsdf::Glass { ior: finite_ratio(&f("ior"), ior / outside_ior)? }, emission)
+                (Bsdf::Glass { ior: finite_ratio(&f("ior"), ior / outside_ior)?, tint: Tint::CLEAR }, emission)
             }
         };
         let emission = match emission {
