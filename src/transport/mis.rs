@@ -58,7 +58,9 @@ impl Strategies {
         Strategies::Split { gather, glossy: bsdf.has_glossy_lobe() }
     }
 
-    /// Density of the final-gather rays toward `wi` (rays × pdf); 0 without them.
+    /// Density of the final-gather rays toward `wi` (rays × pdf); 0 without them. Inline: out of
+    /// line it cost `spawn_gather_rays` 13–21 % (a call per gather ray).
+    #[inline]
     #[must_use]
     pub fn gather_density(&self, sp: &SurfacePoint, wo: Vec3, wi: Vec3) -> f32 {
         match *self {
