@@ -65,7 +65,7 @@ impl MaterialTable {
         inputs: &mut Vec<PathBuf>,
     ) -> Result<Option<Opacity>> {
         let texture = self.load_statement(mtl_path, m, "map_d", Encoding::Opacity, "a `map_d` opacity", inputs)?;
-        let opacity = Opacity { texture, factor: m.d.unwrap_or(1.0), mode: AlphaMode::Coverage };
+        let opacity = Opacity { texture, factor: m.dissolve().unwrap_or(1.0), mode: AlphaMode::Coverage };
         Ok((!opacity.is_opaque()).then_some(opacity))
     }
 

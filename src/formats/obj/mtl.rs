@@ -49,8 +49,10 @@ pub struct MtlMaterial {
     pub pr: Option<f32>,
     /// `Pm` (PBR metallic, 0–1).
     pub pm: Option<f32>,
-    /// The dissolve: `d`, or 1 − `Tr` (1: opaque).
+    /// `d`, the dissolve (1: opaque).
     pub d: Option<f32>,
+    /// `Tr`, the transparency (the spec's 1 − `d`).
+    pub tr: Option<f32>,
     /// The texture maps simulated (`map_Kd`, `map_Ks`, `map_Pr`, `map_Ke`, `map_Pm`, `map_d`,
     /// `bump`), in file order.
     pub maps: Vec<MapStatement>,
@@ -76,6 +78,14 @@ impl MtlMaterial {
     #[must_use]
     pub fn map(&self, key: &str) -> Option<&MapStatement> {
         self.maps.iter().rev().find(|m| m.key == key)
+    }
+
+    /// The dissolve the material states: `d`, else 1 − `Tr`. A lone `Tr 1`, which would make the
+    /// surface vanish, is taken as the exporters' inverted convention (1 = opaque) and ignored
+    /// ([`drop_unusable_maps`] notes it).
+    #[must_use]
+    pub fn dissolve(&self) -> Option<f32> {
+        self.d.or(self.tr.filter(|t| *t < 1.0).map(|t| 1.0 - t))
     }
 
     /// Notes the statement `what` as read but not simulated (once).
@@ -300,13 +310,15 @@ fn statement(path: &Path, line: usize, kw: &str, words: &[&str], m: &mut MtlMate
             if !(0.0..=1.0).contains(&v) {
                 return Err(Error::parse(path, line, format!("`{kw}` must be in [0, 1]")));
             }
-            let d = if kw == "d" { v } else { 1.0 - v };
             if halo {
+                let d = if kw == "d" { v } else { 1.0 - v };
                 if d < 1.0 {
                     m.ignore("d -halo");
                 }
+            } else if kw == "d" {
+                m.d = Some(v);
             } else {
-                m.d = Some(d);
+                m.tr = Some(v);
             }
         }
         "Pr" | "Pm" => {
@@ -359,8 +371,12 @@ fn statement(path: &Path, line: usize, kw: &str, words: &[&str], m: &mut MtlMate
 /// plastic to mix with), and a glass's dissolve (`d`, `Tr`, `map_d` under illum 4, 6, 7 or 9:
 /// there the spec's transparency is the glass's own, which the dielectric renders).
 fn drop_unusable_maps(m: &mut MtlMaterial) {
-    if matches!(m.illum, Some(4 | 6 | 7 | 9)) && (m.d.is_some_and(|d| d < 1.0) || m.map("map_d").is_some()) {
+    if m.d.is_none() && m.tr == Some(1.0) {
+        m.ignore("Tr 1 (read as opaque: exporters write it for d 1)");
+    }
+    if matches!(m.illum, Some(4 | 6 | 7 | 9)) && (m.dissolve().is_some_and(|d| d < 1.0) || m.map("map_d").is_some()) {
         m.d = None;
+        m.tr = None;
         m.maps.retain(|s| s.key != "map_d");
         m.ignored.push("d or map_d on a glass".into());
     }
@@ -428,6 +444,17 @@ mod tests {
         assert!(m[1].ignored.is_empty() && m[1].d == Some(1.0), "opaque `d 1` and `Tr 0` change nothing");
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].starts_with("m.mtl:1: material `a`") && w[0].contains("`map_Kd options`"), "{w:?}");
+    }
+
+    /// `d` is the dissolve, `Tr` its complement where `d` is absent; a lone `Tr 1` (exporters'
+    /// inverted opaque) is said to be ignored rather than making the surface vanish.
+    #[test]
+    fn dissolve_reads_d_then_tr() {
+        let (m, w) = parse("newmtl a\nTr 0.25\nnewmtl b\nTr 1\nd 0.5\nnewmtl c\nTr 1\n");
+        let m = m.unwrap();
+        assert_eq!([m[0].dissolve(), m[1].dissolve(), m[2].dissolve()], [Some(0.75), Some(0.5), None]);
+        assert!(m[2].ignored.iter().any(|s| s.starts_with("Tr 1")), "{:?}", m[2].ignored);
+        assert!(w.len() == 1 && w[0].contains("material `c`"), "{w:?}");
     }
 
     #[test]
