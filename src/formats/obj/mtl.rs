@@ -82,7 +82,7 @@ impl MtlMaterial {
 
     /// The dissolve the material states: `d`, else 1 − `Tr`. A lone `Tr 1`, which would make the
     /// surface vanish, is taken as the exporters' inverted convention (1 = opaque) and ignored
-    /// ([`drop_unusable_maps`] notes it).
+    /// (the material's warning says so).
     #[must_use]
     pub fn dissolve(&self) -> Option<f32> {
         self.d.or(self.tr.filter(|t| *t < 1.0).map(|t| 1.0 - t))
