@@ -162,8 +162,12 @@ pub struct RenderStats {
     pub scene: String,
     /// Triangles after dropping degenerate ones.
     pub triangles: usize,
-    /// Light sources (each emissive triangle counts).
+    /// Light sources: each emissive material once, however many triangles it covers
+    /// ([`crate::scene::Scene::light_sources`]), and every other light.
     pub lights: usize,
+    /// Emissive triangles (each sampled as a light; absent from summaries written before it).
+    #[serde(default)]
+    pub emissive_triangles: usize,
     /// Image size and sampling.
     pub width: u32,
     /// Image height.
@@ -245,7 +249,8 @@ impl RenderStats {
         RenderStats {
             engine: engine.into(),
             triangles: scene.triangle_count(),
-            lights: scene.lights.len(),
+            lights: scene.light_sources().0,
+            emissive_triangles: scene.light_sources().1,
             width: settings.width,
             height: settings.height,
             spp: settings.spp,

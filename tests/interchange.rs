@@ -758,3 +758,32 @@ fn engines_agree_on_mitsuba_plastics_conductors_and_a_thin_sheet() {
     // The camera sees the room through the sheet (the only delta surface): a specular term.
     assert!(a.pixels.iter().filter(|p| p.specular != Vec3::ZERO).count() > 10, "the sheet is in view");
 }
+
+/// An emitter is one light source however many triangles it has: two Mitsuba rectangles that
+/// emit (two triangles each) and a point light are three sources of four emissive triangles, in
+/// the scene and in the render summary.
+#[test]
+fn an_emitting_shape_is_one_light_source() {
+    let d = scratch_dir("light-sources");
+    let lamp = |x: f32| {
+        format!(
+            "<shape type=\"rectangle\"><transform name=\"to_world\"><translate x=\"{x}\" z=\"2\"/></transform>\
+<emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter></shape>"
+        )
+    };
+    let xml = format!(
+        "<scene version=\"3.0.0\">\n<shape type=\"rectangle\"/>\n{}\n{}\n\
+<emitter type=\"point\"><point name=\"position\" x=\"0\" y=\"0\" z=\"1\"/></emitter>\n</scene>\n",
+        lamp(-3.0),
+        lamp(3.0)
+    );
+    let loaded = load_doc_xml(&d, &xml);
+    assert_eq!(loaded.scene.light_sources(), (3, 4));
+    let stats = photonwave::stats::RenderStats::new("path", &loaded.scene, &Settings::default(), 1);
+    assert_eq!((stats.lights, stats.emissive_triangles), (3, 4));
+}
+
+/// Loads Mitsuba XML text written into `dir`.
+fn load_doc_xml(dir: &Path, xml: &str) -> LoadedScene {
+    load_scene(&write(dir, "s.xml", xml)).unwrap()
+}

@@ -368,12 +368,11 @@ fn describe(say: Say, scene: &photonwave::scene::Scene, job: &Job, engine: Engin
             job.threads
         ));
     }
+    let (sources, emissive) = scene.light_sources();
     say.info(format!(
-        "scene: {} triangles, {} materials, lights: {} ({} emissive triangles), total power {} W\n",
+        "scene: {} triangles, {} materials, lights: {sources} ({emissive} emissive triangles), total power {} W\n",
         scene.triangle_count(),
         scene.materials.len(),
-        scene.lights.len(),
-        scene.area_lights.len(),
         significant(scene.total_power().element_sum() / 3.0)
     ));
     if scene.origin != Vec3::ZERO {

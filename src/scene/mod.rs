@@ -182,6 +182,25 @@ impl Scene {
         TriangleColumns { cut, ..TriangleColumns::new(&self.p0, &self.p1, &self.p2) }
     }
 
+    /// The light sources as a user counts them, and the emissive triangles among them: an
+    /// emissive material is one source however many triangles it covers (a Mitsuba shape's
+    /// emitter gets a material of its own, so each shape is one), every other light one.
+    #[must_use]
+    pub fn light_sources(&self) -> (usize, usize) {
+        let mut emitters: Vec<u32> = self
+            .lights
+            .iter()
+            .filter_map(|l| match l {
+                Light::Area { tri, .. } => Some(self.material[*tri as usize]),
+                _ => None,
+            })
+            .collect();
+        let triangles = emitters.len();
+        emitters.sort_unstable();
+        emitters.dedup();
+        (emitters.len() + self.lights.len() - triangles, triangles)
+    }
+
     /// Whether any material the triangles use has an alpha cut-out.
     #[must_use]
     pub fn has_cut_outs(&self) -> bool {
