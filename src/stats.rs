@@ -246,11 +246,12 @@ impl RenderStats {
         settings: &crate::settings::Settings,
         threads: usize,
     ) -> Self {
+        let (lights, emissive_triangles) = scene.light_sources();
         RenderStats {
             engine: engine.into(),
             triangles: scene.triangle_count(),
-            lights: scene.light_sources().0,
-            emissive_triangles: scene.light_sources().1,
+            lights,
+            emissive_triangles,
             width: settings.width,
             height: settings.height,
             spp: settings.spp,

@@ -38,6 +38,13 @@ pub struct Texture {
     pub texels: Vec<Vec3>,
 }
 
+/// The luminance (CIE Y) of linear RGB with Mitsuba 3's weights: what a grey reading of a
+/// colour texture takes (a bump map's heights, an opacity mask, an RGB image's grey level).
+#[must_use]
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.212_671, 0.715_160, 0.072_169))
+}
+
 /// The sRGB transfer curve undone (IEC 61966-2-1): an encoded value in [0, 1] to linear.
 #[must_use]
 pub fn srgb_to_linear(c: f32) -> f32 {

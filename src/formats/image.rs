@@ -9,7 +9,7 @@
 
 use crate::error::{Error, Result};
 use crate::files::{bytes, read_input, read_input_len};
-use crate::texture::{srgb_to_linear, Encoding, Texture};
+use crate::texture::{luminance, srgb_to_linear, Encoding, Texture};
 use glam::Vec3;
 use std::path::Path;
 
@@ -169,11 +169,6 @@ fn check_size(w: u32, h: u32) -> std::result::Result<(), String> {
     } else {
         Ok(())
     }
-}
-
-/// The luminance of linear RGB (Rec. 709 weights).
-fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.212_671, 0.715_160, 0.072_169))
 }
 
 /// Samples of 1–4 channels as linear RGB (grey repeated, alpha dropped), or as an opacity in

@@ -12,6 +12,7 @@
 //! in a closest-hit and an any-hit walk, on any thread and in any split of the render.
 
 use glam::Vec3;
+use wide::f32x8;
 
 /// What decides whether a ray passes through a hit (implemented by the scene, which knows the
 /// materials and their textures).
@@ -33,6 +34,23 @@ pub fn passes(cut: CutOuts<'_>, tri: u32, b: [f32; 3], o: Vec3, d: Vec3) -> bool
         None => false,
         Some(c) => c.passes(tri, b, o, d),
     }
+}
+
+/// The lanes of `hit` (an 8-wide triangle test's hit mask, barycentrics `bary` per lane) whose
+/// hit `kept` says stands: the cut-out test lane by lane, for the SIMD kernels' rare hits on a
+/// scene with cut-outs.
+#[cold]
+pub(super) fn kept_lanes(hit: u32, bary: [f32x8; 3], kept: impl Fn(usize, [f32; 3]) -> bool) -> u32 {
+    let bary = bary.map(f32x8::to_array);
+    let (mut m, mut out) = (hit, 0);
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        if kept(l, [bary[0][l], bary[1][l], bary[2][l]]) {
+            out |= 1 << l;
+        }
+    }
+    out
 }
 
 /// A number in [0, 1) drawn from the ray's origin and direction bits and the triangle: the

@@ -14,6 +14,7 @@
 //! lower triangle index), so hits are identical lane by lane; tests/packet.rs checks it.
 
 use super::bvh::{Bvh, Hit, TriangleColumns};
+use super::cut_out::kept_lanes;
 use super::slab::{intersect_settled, settle8, slab8, triangle_box};
 use super::traverse::{closest_from, occluded_from, Best, RayQuery, Stack};
 use super::triangle::is_degenerate;
@@ -333,7 +334,11 @@ pub(super) fn any_leaf(
         let (hit, mut fallback, t, b) = intersect8(p, open, v, t_max);
         if hit != 0 {
             let hit = hit & bits(p.settle(t, v, pad).simd_lt(t_max));
-            blocked |= if tris.cut.is_none() { hit } else { kept(p, tris, id, hit, b) };
+            blocked |= if tris.cut.is_none() {
+                hit
+            } else {
+                kept_lanes(hit, b, |l, b| !tris.passes(id, b, p.origin(l), p.dir(l)))
+            };
         }
         while fallback != 0 {
             let l = fallback.trailing_zeros() as usize;
@@ -345,22 +350,6 @@ pub(super) fn any_leaf(
         }
     }
     blocked
-}
-
-/// The lanes of `hit` (lanes that hit triangle `id` at barycentrics `b`) that its cut-out does
-/// not let through.
-#[cold]
-fn kept(p: &Packet, tris: TriangleColumns<'_>, id: u32, hit: u32, b: [f32x8; 3]) -> u32 {
-    let b = b.map(f32x8::to_array);
-    let (mut m, mut kept) = (hit, 0);
-    while m != 0 {
-        let l = m.trailing_zeros() as usize;
-        m &= m - 1;
-        if !tris.passes(id, [b[0][l], b[1][l], b[2][l]], p.origin(l), p.dir(l)) {
-            kept |= 1 << l;
-        }
-    }
-    kept
 }
 
 /// Any-hit tests of 8 rays.

@@ -23,7 +23,7 @@
 //! two keys, without the key array and its loop (issue 18, seventeenth part).
 
 use super::bvh::Hit;
-use super::cut_out::{passes, CutOuts};
+use super::cut_out::{kept_lanes, passes, CutOuts};
 use super::slab::{intersect_settled, inverse_direction};
 use super::traverse::{Best, RayQuery, Stack};
 use super::triangle8::{intersect_block, ShearedRay, TriBlock};
@@ -120,7 +120,8 @@ fn any_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, t_max: f32, cut: CutO
         let (hit, mut fallback, t, bary) = intersect_block(r, b, t_max);
         if hit != 0 {
             let hit = hit & ray.wide.settle(t, b, pad).simd_lt(f32x8::splat(t_max)).to_bitmask();
-            if hit != 0 && (cut.is_none() || any_kept(b, hit, bary, r, cut)) {
+            let kept = |l: usize, bl| !passes(cut, b.ids[l], bl, r.origin, r.dir);
+            if hit != 0 && (cut.is_none() || kept_lanes(hit, bary, kept) != 0) {
                 return true;
             }
         }
@@ -136,22 +137,6 @@ fn any_leaf(blocks: &[TriBlock], ray: &Prepared, pad: f32, t_max: f32, cut: CutO
         }
         false
     })
-}
-
-/// Whether a lane of `hit` (lanes of block `b` hit at barycentrics `bary`) is not let through
-/// by its cut-out.
-#[cold]
-fn any_kept(b: &TriBlock, hit: u32, bary: [f32x8; 3], r: &ShearedRay, cut: CutOuts<'_>) -> bool {
-    let bary = bary.map(f32x8::to_array);
-    let mut m = hit;
-    while m != 0 {
-        let l = m.trailing_zeros() as usize;
-        m &= m - 1;
-        if !passes(cut, b.ids[l], [bary[0][l], bary[1][l], bary[2][l]], r.origin, r.dir) {
-            return true;
-        }
-    }
-    false
 }
 
 /// The bit mask of the children of `node` that the ray enters within `t_max`, and their entry

@@ -140,10 +140,7 @@ impl Scene {
     /// Which kinds of material the scene's triangles use: (any passed as specular by photons,
     /// any glass, any non-delta, any absorbing interior, any normal map, any cut-out).
     fn find_kinds(&mut self) {
-        let mut used = vec![false; self.materials.len()];
-        for &m in &self.material {
-            used[m as usize] = true;
-        }
+        let used = self.used_materials();
         for (m, _) in self.materials.iter().zip(&used).filter(|(_, u)| **u) {
             self.kinds.0 |= m.bsdf.photon_specular();
             self.kinds.1 |= matches!(m.bsdf, Bsdf::Glass { .. } | Bsdf::ThinGlass { .. });

@@ -19,6 +19,7 @@ use crate::geometry::triangle::is_degenerate;
 use crate::geometry::{in_range, normal_and_area, Bvh, Hit, MAX_COORDINATE};
 use crate::material::{Bsdf, Material, NormalMap, Relief, SurfaceFrame};
 use crate::sampling::Distribution1D;
+use crate::texture::luminance;
 pub use camera::Camera;
 pub use environment::Environment;
 use glam::{Vec2, Vec3};
@@ -213,11 +214,16 @@ impl Scene {
         if !self.kinds.5 {
             return 0;
         }
+        self.materials.iter().zip(self.used_materials()).filter(|(m, u)| *u && m.opacity.is_some()).count()
+    }
+
+    /// Whether each material is used by some triangle.
+    fn used_materials(&self) -> Vec<bool> {
         let mut used = vec![false; self.materials.len()];
         for &m in &self.material {
             used[m as usize] = true;
         }
-        self.materials.iter().zip(used).filter(|(m, u)| *u && m.opacity.is_some()).count()
+        used
     }
 
     /// Closest hit along `o + t·d`, 0 < t < `t_max`.
@@ -248,24 +254,28 @@ impl Scene {
         }
     }
 
-    /// How much of a cut-out surface is present ([`crate::material::Opacity::presence`]) at the
-    /// point `q` of triangle `i`'s plane, its texture coordinates extended across the plane
-    /// affinely (exact on a flat region textured by one affine map, such as a quad); `None` when
-    /// the triangle's material has no cut-out.
+    /// How much of triangle `i`'s cut-out surface is present
+    /// ([`crate::material::Opacity::presence`]) at a point of its plane, its texture coordinates
+    /// extended across the plane affinely (exact on a flat region textured by one affine map,
+    /// such as a quad): the triangle's map prepared once, for the many points of a quadrature;
+    /// `None` when the triangle's material has no cut-out.
     #[must_use]
-    pub fn presence_at(&self, i: usize, q: Vec3) -> Option<f32> {
+    pub fn presence_on(&self, i: usize) -> Option<impl Fn(Vec3) -> f32 + '_> {
         let opacity = self.materials[self.material[i] as usize].opacity.as_ref()?;
-        // Without texture coordinates (a constant opacity) every point reads the same.
-        let Some(t) = self.uv.get(i) else { return Some(opacity.presence(Vec2::ZERO)) };
-        let (e1, e2, d) = (self.p1[i] - self.p0[i], self.p2[i] - self.p0[i], q - self.p0[i]);
+        // Without texture coordinates (a constant opacity) every point reads (0, 0).
+        let t = self.uv.get(i).copied().unwrap_or([Vec2::ZERO; 3]);
+        let (p0, e1, e2) = (self.p0[i], self.p1[i] - self.p0[i], self.p2[i] - self.p0[i]);
         let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
         let det = d00 * d11 - d01 * d01;
-        if !(det.abs() > 0.0) {
-            return Some(opacity.presence(t[0]));
-        }
-        let (d20, d21) = (d.dot(e1), d.dot(e2));
-        let (s, v) = ((d11 * d20 - d01 * d21) / det, (d00 * d21 - d01 * d20) / det);
-        Some(opacity.presence(t[0] + (t[1] - t[0]) * s + (t[2] - t[0]) * v))
+        Some(move |q: Vec3| {
+            if !(det.abs() > 0.0) {
+                return opacity.presence(t[0]);
+            }
+            let d = q - p0;
+            let (d20, d21) = (d.dot(e1), d.dot(e2));
+            let (s, v) = ((d11 * d20 - d01 * d21) / det, (d00 * d21 - d01 * d20) / det);
+            opacity.presence(t[0] + (t[1] - t[0]) * s + (t[2] - t[0]) * v)
+        })
     }
 
     /// The surface point of a hit.
@@ -310,8 +320,6 @@ impl Scene {
         let dpdu = (e1 * d2.y - e2 * d1.y) / det;
         let dpdv = (e2 * d1.x - e1 * d2.x) / det;
         if map.relief == Relief::Heights {
-            // Luminance weights of the texture's linear RGB (Mitsuba's).
-            let luminance = |c: Vec3| c.dot(Vec3::new(0.212_671, 0.715_160, 0.072_169));
             let (gu, gv) = map.texture.gradient(uv);
             let du = dpdu + n * (map.scale * luminance(gu) - n.dot(dpdu));
             let dv = dpdv + n * (map.scale * luminance(gv) - n.dot(dpdv));

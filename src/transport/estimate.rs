@@ -202,10 +202,8 @@ fn plan_map<'m>(
 #[inline]
 fn on_cut_out(scene: &Scene, tri: u32, p: Vec3, kernel: Kernel, e: Estimate) -> Estimate {
     let i = tri as usize;
-    if scene.materials[scene.material[i] as usize].opacity.is_none() {
-        return e;
-    }
-    let share = presence_share(p, scene.ng[i], e.radius, kernel, |q| scene.presence_at(i, q).unwrap_or(1.0));
+    let Some(present) = scene.presence_on(i) else { return e };
+    let share = presence_share(p, scene.ng[i], e.radius, kernel, present);
     Estimate { radiance: e.radiance / share, bias: e.bias / share, coverage: e.coverage * share, ..e }
 }
 

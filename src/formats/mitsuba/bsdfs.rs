@@ -36,7 +36,7 @@ use crate::error::Result;
 use crate::material::{AlphaMode, Bsdf, Maps, Material, NormalMap, Opacity, Relief, Tint};
 use crate::microfacet::{Alpha, Distribution, MIN_ALPHA};
 use crate::optics::{named_metal, ComplexIor};
-use crate::texture::{Encoding, Texture};
+use crate::texture::{luminance, Encoding, Texture};
 use glam::{Vec2, Vec3};
 use roxmltree::Node;
 use std::sync::Arc;
@@ -115,6 +115,14 @@ impl Ctx<'_> {
                 ),
             )
         })
+    }
+
+    /// The `raw` flag of the texture property `name` of `node` (inline or by `<ref>`), `default`
+    /// where it says nothing or there is no texture.
+    fn raw(&mut self, node: Node, name: &str, default: bool) -> Result<bool> {
+        let Some(t) = self.r.prop(node, name) else { return Ok(default) };
+        let t = if t.tag_name().name() == "ref" { self.referenced(t)? } else { t };
+        self.r.boolean(t, "raw", default)
     }
 
     /// A BSDF's scale `name` (`specular_reflectance`, `specular_transmittance`; 1 by default), a
@@ -301,10 +309,7 @@ impl Ctx<'_> {
             }
             "normalmap" => {
                 // Its texture is data (Mitsuba reads it `raw`), a normal in the shading frame.
-                if let Some(t) = self.r.prop(node, "normalmap") {
-                    let t = if t.tag_name().name() == "ref" { self.referenced(t)? } else { t };
-                    self.r.boolean(t, "raw", true)?;
-                }
+                self.raw(node, "normalmap", true)?;
                 let map = self.coloured(node, "normalmap", Vec3::new(0.5, 0.5, 1.0), Encoding::Linear)?;
                 let (mut material, uv) = wrapper(self, None)?;
                 match map.map {
@@ -325,18 +330,9 @@ impl Ctx<'_> {
             "mask" => {
                 // A scalar texture (Mitsuba's default 0.5): a bitmap's luminance, decoded from
                 // sRGB unless `raw`, as Mitsuba's `eval_1` reads it.
-                let raw = match self.r.prop(node, "opacity") {
-                    Some(t) if t.tag_name().name() != "ref" => self.r.boolean(t, "raw", false)?,
-                    Some(t) => {
-                        let t = self.referenced(t)?;
-                        self.r.boolean(t, "raw", false)?
-                    }
-                    None => false,
-                };
-                let encoding = if raw { Encoding::Linear } else { Encoding::Srgb };
+                let encoding = if self.raw(node, "opacity", false)? { Encoding::Linear } else { Encoding::Srgb };
                 let c = self.coloured(node, "opacity", Vec3::splat(0.5), encoding)?;
                 let (mut material, uv) = wrapper(self, None)?;
-                let luminance = |c: Vec3| c.dot(Vec3::new(0.212_671, 0.715_160, 0.072_169));
                 let texture = c.map.map(|t| {
                     let texels = t.texels.iter().map(|&x| Vec3::splat(luminance(x))).collect();
                     Arc::new(Texture { texels, ..(*t).clone() })
