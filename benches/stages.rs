@@ -47,6 +47,7 @@ fn setup(threads: usize) -> World {
         classified: Classified::default(),
         shadows: ShadowQueue::default(),
         terms: Vec::new(),
+        receivers: Vec::new(),
         film: Vec::new(),
         open: Default::default(),
         rays: Default::default(),

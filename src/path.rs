@@ -17,12 +17,12 @@ use crate::job::Job;
 use crate::progress::Progress;
 use crate::rng::Sampler;
 use crate::scene::camera::CameraRays;
-use crate::scene::Scene;
+use crate::scene::{Receiver, Scene};
 use crate::settings::Settings;
 use crate::stats::{MapStats, Numerics, PhaseTimes, RayCounts, RenderStats};
 use crate::transport::camera::render_pixels;
 use crate::transport::direct::weighted_direct_light;
-use crate::transport::mis::{emission_found, Strategies};
+use crate::transport::mis::{emission_found, receiver, Strategies};
 use crate::transport::specular::{continue_ray, emission_toward};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
@@ -95,6 +95,8 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
     let mut last_delta = true;
     // The density with which the last non-delta bounce picked this ray's direction (0: MIS off).
     let mut bsdf_density = 0.0;
+    // The point that bounce left from, for the light-sampling density of what it finds.
+    let mut from = Receiver::default();
     let mis = if ctx.settings.mis { Strategies::Whole } else { Strategies::LightOnly };
     for depth in 0..=ctx.settings.max_depth {
         rays.camera += 1;
@@ -115,7 +117,7 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
                 terms.add(path_term(Term::Emitted, depth, via_specular), beta * e);
             } else {
                 // Found by the previous bounce's BSDF sample: light sampling's partner there.
-                let found = emission_found(ctx, &hit, d, bsdf_density);
+                let found = emission_found(ctx, &from, &hit, d, bsdf_density);
                 terms.add(path_term(Term::Direct, depth - 1, via_specular), beta * found);
             }
         }
@@ -131,6 +133,7 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
         last_delta = bs.delta;
         if ctx.settings.mis && !bs.delta {
             bsdf_density = bsdf.pdf(&sp.frame, wo, bs.dir);
+            from = receiver(&sp, &bsdf, wo);
         }
         if depth == 0 && bs.delta {
             via_specular = true;

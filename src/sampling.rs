@@ -139,6 +139,80 @@ impl Distribution1D {
     }
 }
 
+/// Solid angles (sr) within which a triangle's light is sampled by the solid angle it subtends
+/// ([`spherical_triangle`]); outside, by area. Below the lower bound the triangle is far and
+/// small, where area sampling is already uniform in solid angle; above the upper one (near 2π)
+/// the point lies almost in the triangle's plane, inside it, where the spherical triangle is a
+/// near-hemisphere whose sampling loses precision. The bounds are pbrt-v4's.
+pub const SPHERICAL_SAMPLING: std::ops::RangeInclusive<f64> = 3e-4..=6.22;
+
+/// The solid angle (sr) triangle `v` subtends at `p` (Van Oosterom and Strackee 1983:
+/// tan(Ω/2) = |a·(b×c)| / (1 + a·b + b·c + c·a) for the unit vectors a, b, c toward the
+/// vertices), in f64: exact to rounding for triangles of any size or distance. 0 where `p` lies
+/// on a vertex.
+#[must_use]
+pub fn solid_angle(v: [Vec3; 3], p: Vec3) -> f64 {
+    let p = p.as_dvec3();
+    let [a, b, c] = v.map(|q| (q.as_dvec3() - p).normalize_or_zero());
+    let num = a.dot(b.cross(c)).abs();
+    let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
+    let omega = 2.0 * num.atan2(den);
+    if omega.is_finite() {
+        omega
+    } else {
+        0.0
+    }
+}
+
+/// The angle between unit vectors `a` and `b`, accurate near 0 and π alike (the half chord's
+/// arcsine instead of the dot product's arccosine).
+fn angle_between(a: glam::DVec3, b: glam::DVec3) -> f64 {
+    if a.dot(b) < 0.0 {
+        std::f64::consts::PI - 2.0 * ((a + b).length() / 2.0).min(1.0).asin()
+    } else {
+        2.0 * ((b - a).length() / 2.0).min(1.0).asin()
+    }
+}
+
+/// A direction from `p` uniform in the solid angle triangle `v` subtends, with two uniform
+/// numbers (Arvo 1995, "Stratified Sampling of Spherical Triangles": the first number picks the
+/// sub-triangle A B Ĉ of area u₀·Ω, whose far vertex Ĉ lies on the arc A C, the second a point
+/// on the arc B Ĉ whose cosine to B is uniform). pdf = 1/[`solid_angle`]. In f64, as the
+/// sub-area's angle sum α + β + γ − π cancels for small triangles. `None` where the spherical
+/// triangle is degenerate (a vertex at `p`, or `p` in the triangle's plane).
+#[must_use]
+pub fn spherical_triangle(v: [Vec3; 3], p: Vec3, u: [f32; 2]) -> Option<Vec3> {
+    use glam::DVec3;
+    let pd = p.as_dvec3();
+    let [a, b, c] = v.map(|q| (q.as_dvec3() - pd).normalize_or_zero());
+    // The great circles' plane normals, and the triangle's angles between them.
+    let (n_ab, n_bc, n_ca) = (a.cross(b), b.cross(c), c.cross(a));
+    if n_ab.length_squared() == 0.0 || n_bc.length_squared() == 0.0 || n_ca.length_squared() == 0.0 {
+        return None;
+    }
+    let (n_ab, n_bc, n_ca) = (n_ab.normalize(), n_bc.normalize(), n_ca.normalize());
+    let alpha = angle_between(n_ab, -n_ca);
+    let beta = angle_between(n_bc, -n_ab);
+    let gamma = angle_between(n_ca, -n_bc);
+    let area = alpha + beta + gamma - std::f64::consts::PI;
+    if !(area > 0.0) {
+        return None;
+    }
+    // The sub-triangle of area u₀·Ω: where Ĉ lies on the arc A C (its cosine q to A).
+    let sub = f64::from(u[0]) * area;
+    let (s, t) = (sub - alpha).sin_cos();
+    let (sin_alpha, cos_alpha) = alpha.sin_cos();
+    let (k1, k2) = (t - cos_alpha, s + sin_alpha * a.dot(b));
+    let q = (((k2 * t - k1 * s) * cos_alpha - k2) / ((k2 * s + k1 * t) * sin_alpha)).clamp(-1.0, 1.0);
+    let across = |x: DVec3, from: DVec3| (x - x.dot(from) * from).normalize_or_zero();
+    let c_hat = q * a + (1.0 - q * q).max(0.0).sqrt() * across(c, a);
+    // Along the arc B Ĉ, cosine to B uniform between 1 and B·Ĉ.
+    let z = 1.0 - f64::from(u[1]) * (1.0 - c_hat.dot(b));
+    let w = z * b + (1.0 - z * z).max(0.0).sqrt() * across(c_hat, b);
+    let w = w.as_vec3();
+    (w.is_finite() && w != Vec3::ZERO).then(|| w.normalize())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -162,5 +236,64 @@ mod tests {
         }
         assert!((d.pmf(2) - 0.75).abs() < 1e-12);
         assert!(Distribution1D::try_new(&[0.0, 0.0]).is_none());
+    }
+
+    /// Lambert's formula for the projected solid angle of a polygon seen from the origin about
+    /// unit normal `n`: ½ Σ θᵢ n·(vᵢ × vᵢ₊₁)/|vᵢ × vᵢ₊₁|, θᵢ the angle between consecutive vertices
+    /// (signed by the winding: its magnitude is taken).
+    fn projected_solid_angle(v: [Vec3; 3], n: Vec3) -> f64 {
+        (0..3)
+            .map(|i| {
+                let (a, b) = (v[i].as_dvec3().normalize(), v[(i + 1) % 3].as_dvec3().normalize());
+                let g = a.cross(b);
+                0.5 * a.dot(b).clamp(-1.0, 1.0).acos() * n.as_dvec3().dot(g.normalize())
+            })
+            .sum::<f64>()
+            .abs()
+    }
+
+    #[test]
+    fn spherical_triangle_samples_are_uniform_in_solid_angle() {
+        // Near and wide (Ω ≈ 1.4 sr), oblique and far (Ω ≈ 3e-3): the samples hit the triangle,
+        // and Ω times their mean cosine about a normal is Lambert's projected solid angle within
+        // 4 standard errors of the mean.
+        let n = Vec3::new(0.1, 0.2, 1.0).normalize();
+        let cases = [
+            [Vec3::new(-1.0, -1.0, 1.0), Vec3::new(1.5, -0.5, 1.2), Vec3::new(0.0, 1.0, 0.8)],
+            [Vec3::new(3.0, 0.5, 9.0), Vec3::new(3.4, 0.6, 9.5), Vec3::new(3.1, 0.9, 9.1)],
+        ];
+        for v in cases {
+            let omega = solid_angle(v, Vec3::ZERO);
+            assert!(SPHERICAL_SAMPLING.contains(&omega), "Ω {omega}");
+            let m = 20_000;
+            let mut sum = 0.0f64;
+            let mut sum2 = 0.0f64;
+            for i in 0..m {
+                let u = [(i as f32 + 0.5) / m as f32, ((i as u64 * 2_654_435_761) % 65_521) as f32 / 65_521.0];
+                let w = spherical_triangle(v, Vec3::ZERO, u).expect("a direction");
+                // The direction crosses the triangle: its barycentrics are all ≥ 0.
+                let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
+                let pv = w.cross(e2);
+                let det = e1.dot(pv);
+                let b1 = (-v[0]).dot(pv) / det;
+                let b2 = w.dot((-v[0]).cross(e1)) / det;
+                assert!(b1 > -1e-4 && b2 > -1e-4 && b1 + b2 < 1.0 + 1e-4, "{w} misses: {b1} {b2}");
+                let f = f64::from(w.dot(n).max(0.0)) * omega;
+                sum += f;
+                sum2 += f * f;
+            }
+            let mean = sum / m as f64;
+            let se = ((sum2 / m as f64 - mean * mean) / m as f64).sqrt();
+            let exact = projected_solid_angle(v, n);
+            assert!((mean - exact).abs() < 4.0 * se + 1e-9, "estimate {mean} against {exact} (se {se})");
+        }
+    }
+
+    #[test]
+    fn solid_angle_of_a_far_triangle_is_its_area_over_distance_squared() {
+        let v = [Vec3::new(0.0, 0.0, 1000.0), Vec3::new(1.0, 0.0, 1000.0), Vec3::new(0.0, 1.0, 1000.0)];
+        let omega = solid_angle(v, Vec3::ZERO);
+        assert!((omega / 5e-7 - 1.0).abs() < 2e-3, "{omega}");
+        assert_eq!(solid_angle(v, v[0]), 0.0, "seen from a vertex");
     }
 }

@@ -5,6 +5,7 @@ use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 pub use crate::photon_map::Kernel;
+pub use crate::scene::LightSampler;
 
 /// Names of the effects plan's parts, as `force` accepts them.
 pub const PART_NAMES: [&str; 5] = ["caustic_map", "global_map", "final_gather", "refraction", "shadow_rays"];
@@ -109,6 +110,9 @@ pub struct Settings {
     /// tracer: its next bounce), which add the emission they hit, weighted likewise. On by
     /// default; `false` leaves emitters to light sampling alone, for comparison.
     pub mis: bool,
+    /// How direct light picks each area-light sample's light: by the light tree's bound of its
+    /// contribution at the shading point (`tree`, the default) or by power alone (`power`).
+    pub light_sampler: LightSampler,
     /// The user's seed: a single render and the first progressive pass draw every random
     /// stream from it; later passes and the pilot pass mix their own from it.
     pub seed: u64,
@@ -182,6 +186,7 @@ impl Default for Settings {
             max_depth: DEFAULT_MAX_DEPTH,
             light_samples: 1,
             mis: true,
+            light_sampler: LightSampler::Tree,
             seed: 1,
             threads: 0,
             force: Vec::new(),
@@ -266,6 +271,8 @@ pub struct Overrides {
     pub no_aim_caustics: bool,
     /// `--no-mis`.
     pub no_mis: bool,
+    /// `--light-sampler`.
+    pub light_sampler: Option<LightSampler>,
     /// `--diagnostics` (turns them on; the scene file may too).
     pub diagnostics: bool,
     /// `--force`, added to the scene file's.
@@ -296,7 +303,7 @@ impl Overrides {
             ($($f:ident),*) => { $( if let Some(v) = self.$f { s.$f = v; } )* };
         }
         set!(width, height, spp, photons, caustic_photons, gather_rays, max_depth, seed, threads, kernel, code_path);
-        set!(passes, alpha, target_error, secondary_gather);
+        set!(passes, alpha, target_error, secondary_gather, light_sampler);
         if let Some(k) = self.k {
             s.k = k;
             s.caustic_k = k;

@@ -17,7 +17,7 @@ use photonwave::scene::{Light, MeshInput, Scene, SurfacePoint};
 use photonwave::settings::{Kernel, Settings};
 use photonwave::transport::direct::{direct_light, weighted_direct_light};
 use photonwave::transport::gather::{gather_rays, glossy_ray};
-use photonwave::transport::mis::{emission_found, Strategies};
+use photonwave::transport::mis::{emission_found, receiver, Strategies};
 use photonwave::transport::photon::first_hit_power;
 use photonwave::transport::{Context, PhotonMaps};
 
@@ -202,18 +202,6 @@ fn knn_estimate_is_unbiased_on_a_uniform_plane() {
     assert!((mean - 1.0).abs() < 0.013, "mean density ratio {mean}");
 }
 
-/// Irradiance at `p` (normal `n`) from a uniform Lambertian polygon of radiance `le`:
-/// E = le/2 · Σ θ_i (n · unit(v_i × v_{i+1})) (Lambert's formula).
-fn polygon_irradiance(p: Vec3, n: Vec3, corners: &[Vec3], le: f32) -> f32 {
-    let v: Vec<Vec3> = corners.iter().map(|c| (*c - p).normalize()).collect();
-    let mut sum = 0.0;
-    for i in 0..v.len() {
-        let (a, b) = (v[i], v[(i + 1) % v.len()]);
-        sum += a.dot(b).clamp(-1.0, 1.0).acos() * n.dot(a.cross(b).normalize());
-    }
-    0.5 * le * sum.abs()
-}
-
 /// The quad light of radiance `le` the next two tests sit under: 1 × 1 at height 1, facing down
 /// (wound (c0, c1, c2) and (c0, c2, c3)); returns the scene and its corners.
 fn quad_light(le: f32) -> (Scene, [Vec3; 4]) {
@@ -251,7 +239,7 @@ fn quad_light_irradiance_matches_lamberts_formula() {
             })
             .collect();
         let (mean, se) = mean_and_se(&values);
-        let want = polygon_irradiance(p, Vec3::Y, &corners, le) as f64;
+        let want = common::polygon_irradiance(p, Vec3::Y, &corners, le) as f64;
         assert!((mean - want).abs() < 4.0 * se + 1e-5 * want, "at {p}: {mean} vs {want} (se {se})");
     }
 }
@@ -262,9 +250,10 @@ fn quad_light_irradiance_matches_lamberts_formula() {
 /// estimates; weights that did not sum to one, such as a density missing its sample count, would
 /// be off by far more). On a Phong surface whose lobe points at the light, the light sample
 /// weighed against the gather rays and the glossy ray, plus both kinds' emission, agrees with the
-/// light sample alone (2 048 estimates each, 4 standard errors of the difference), and is the
-/// less noisy of the two (measured: standard error 0.014 against 0.033): the one shadow ray is
-/// the same, the gather and glossy rays are those the camera hit sends anyway.
+/// light sample alone (4 096 estimates each, 4 standard errors of the difference), and on the
+/// narrow lobes (Phong, rough plastic) is the less noisy of the two (measured: standard error
+/// 0.0095 against 0.0216, 0.0019 against 0.0049): the one shadow ray is the same, the gather
+/// and glossy rays are those the camera hit sends anyway.
 #[test]
 fn light_samples_weighed_against_gather_and_glossy_rays_keep_the_direct_light() {
     let le = 3.0f32;
@@ -282,9 +271,10 @@ fn light_samples_weighed_against_gather_and_glossy_rays_keep_the_direct_light() 
         let s = Sampler::new(9, Domain::Camera, i);
         let mis = Strategies::Split { gather: n, glossy: bsdf.has_glossy_lobe() };
         let mut value = weighted_direct_light(&ctx, sp, bsdf, wo, &s.fork(1), &mis, &mut Default::default()).x;
+        let r = receiver(sp, bsdf, wo);
         gather_rays(sp, wo, n, &s.fork(2), |_, o, d| {
             if let Some(hit) = scene.intersect(o, d, f32::INFINITY) {
-                let e = emission_found(&ctx, &hit, d, mis.gather_density(sp, wo, d));
+                let e = emission_found(&ctx, &r, &hit, d, mis.gather_density(sp, wo, d));
                 let w = if bsdf.gather_varies() { bsdf.gather_weight(&sp.frame, wo, d) } else { bsdf.diffuse() };
                 value += w.x / n as f32 * e.x;
             }
@@ -292,7 +282,7 @@ fn light_samples_weighed_against_gather_and_glossy_rays_keep_the_direct_light() 
         if let Some(ray) = glossy_ray(sp, bsdf, wo, &s.fork(3)) {
             if let Some(hit) = scene.intersect(ray.origin, ray.dir, f32::INFINITY) {
                 value +=
-                    ray.weight.x * emission_found(&ctx, &hit, ray.dir, mis.glossy_density(sp, bsdf, wo, ray.dir)).x;
+                    ray.weight.x * emission_found(&ctx, &r, &hit, ray.dir, mis.glossy_density(sp, bsdf, wo, ray.dir)).x;
             }
         }
         value
@@ -302,7 +292,7 @@ fn light_samples_weighed_against_gather_and_glossy_rays_keep_the_direct_light() 
         let values: Vec<f32> =
             (0..512).map(|i| std::f32::consts::PI * mis_sample(&point(p), &white, Vec3::Y, i)).collect();
         let (mean, se) = mean_and_se(&values);
-        let want = polygon_irradiance(p, Vec3::Y, &corners, le) as f64;
+        let want = common::polygon_irradiance(p, Vec3::Y, &corners, le) as f64;
         assert!((mean - want).abs() < 4.0 * se + 1e-5 * want, "at {p}: {mean} vs {want} (se {se})");
     }
     // The glossy point: its mirror direction toward the light's centre.
@@ -325,7 +315,13 @@ fn light_samples_weighed_against_gather_and_glossy_rays_keep_the_direct_light() 
         let (b, sb) = mean_and_se(&without);
         println!("{name}: MIS {a:.4} ± {sa:.4}, light samples alone {b:.4} ± {sb:.4}");
         assert!((a - b).abs() < 4.0 * (sa * sa + sb * sb).sqrt(), "{name}: MIS {a} ± {sa} against {b} ± {sb}");
-        assert!(sa < sb, "{name}: MIS is noisier ({sa}) than light samples alone ({sb})");
+        // The narrow lobes are where light sampling alone draws badly. Under this light of
+        // about 0.7 sr, sampled by its solid angle, the wide conductor lobe (α 0.4) is lit well
+        // by light samples alone, and the power heuristic, which hands part of the weight to the
+        // glossy ray, measured 17 % noisier there (0.0022 against 0.0019): not a claim to make.
+        if name != "rough conductor" {
+            assert!(sa < sb, "{name}: MIS is noisier ({sa}) than light samples alone ({sb})");
+        }
     }
 }
 

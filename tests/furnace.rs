@@ -98,16 +98,22 @@ fn median(v: &[f64]) -> f64 {
 /// must be listed. Before MIS, white and glossy were 6.5 and 10 times noisier (σ 0.1756 and
 /// 0.4067, smooth): their direct light came from light samples alone, and one across a crease
 /// of the tessellated sphere or in the glossy lobe's peak weighed tens of times the mean.
+/// Recorded again when the light tree and solid-angle sampling came (issue 56): every object
+/// within 0.82–1.16 of its figure before, but the flat-shaded glossy sphere 1.32 (0.0400 →
+/// 0.0527; with power's picks it measured 0.0363): inside an emitting sphere, picking by power
+/// is already ideal (uniform area on a sphere is uniform in cos·cos/d²), and the tree's bound,
+/// which prefers lights toward the normal, lights a glossy lobe less well (1.45 times power's
+/// σ with a quarter of the picks left to power).
 const SIGMA: &[(&str, &[(&str, f64)])] = &[
-    ("smooth", &[("furnace", 0.0075), ("white", 0.0269), ("mirror", 0.0188), ("glass", 0.0221), ("glossy", 0.0402)]),
-    ("flat", &[("furnace", 0.0073), ("white", 0.0192), ("mirror", 0.0145), ("glass", 0.0178), ("glossy", 0.0400)]),
-    ("one ulp", &[("furnace", 0.0075), ("white", 0.0269), ("mirror", 0.0188), ("glass", 0.0221), ("glossy", 0.0403)]),
+    ("smooth", &[("furnace", 0.0076), ("white", 0.0294), ("mirror", 0.0162), ("glass", 0.0234), ("glossy", 0.0420)]),
+    ("flat", &[("furnace", 0.0071), ("white", 0.0198), ("mirror", 0.0130), ("glass", 0.0213), ("glossy", 0.0527)]),
+    ("one ulp", &[("furnace", 0.0076), ("white", 0.0294), ("mirror", 0.0159), ("glass", 0.0234), ("glossy", 0.0420)]),
     (
         "f64 normals",
-        &[("furnace", 0.0075), ("white", 0.0269), ("mirror", 0.0188), ("glass", 0.0221), ("glossy", 0.0403)],
+        &[("furnace", 0.0076), ("white", 0.0290), ("mirror", 0.0162), ("glass", 0.0234), ("glossy", 0.0420)],
     ),
-    ("rough", &[("furnace", 0.0111), ("white", 0.0259), ("mirror", 0.0906), ("glass", 0.0729), ("glossy", 0.0090)]),
-    ("nested", &[("furnace", 0.0277), ("glass", 0.0242), ("water", 0.0055)]),
+    ("rough", &[("furnace", 0.0101), ("white", 0.0267), ("mirror", 0.0901), ("glass", 0.0672), ("glossy", 0.0101)]),
+    ("nested", &[("furnace", 0.0275), ("glass", 0.0238), ("water", 0.0046)]),
 ];
 
 /// Renders `scene` at every seed and checks the claims of the module notes per object; returns

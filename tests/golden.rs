@@ -18,16 +18,16 @@ use std::sync::Arc;
 
 /// (scene, engine, passes) → FNV-1a 64 of the film's f32 bits.
 const GOLDEN: &[(&str, &str, u32, u64)] = &[
-    ("cornell-box.toml", "wavefront", 1, 0x77270da02c783bb8),
-    ("cornell-box.toml", "reference", 1, 0xea1d6280e26210f7),
-    ("cornell-box.toml", "path", 1, 0x9d75264d7f03385e),
-    ("cornell-spheres.toml", "wavefront", 1, 0xcd9797a83e22b176),
-    ("cornell-spheres.toml", "reference", 1, 0xbc327d29dcf86e3d),
-    ("cornell-spheres.toml", "wavefront", 3, 0x2ffacae15b787cc5),
-    ("cornell-spheres.toml", "reference", 3, 0x92288ea3e94ad440),
-    ("hard/furnace-materials.toml", "wavefront", 1, 0xfbbb4cc2c50e7f2a),
-    ("hard/furnace-materials.toml", "reference", 1, 0x3c0f1cdf74dba9e3),
-    ("hard/nested.toml", "wavefront", 2, 0xdbb7587d3d2f46d0),
+    ("cornell-box.toml", "wavefront", 1, 0x73564a7835fda6cf),
+    ("cornell-box.toml", "reference", 1, 0x06479470161e4c11),
+    ("cornell-box.toml", "path", 1, 0xb2e8d4765d127368),
+    ("cornell-spheres.toml", "wavefront", 1, 0x452a5b76c2f225ef),
+    ("cornell-spheres.toml", "reference", 1, 0x5e40e89365bc71fb),
+    ("cornell-spheres.toml", "wavefront", 3, 0xc5f72ace8746ed0d),
+    ("cornell-spheres.toml", "reference", 3, 0x55d571118c183f8e),
+    ("hard/furnace-materials.toml", "wavefront", 1, 0xc3ebd9a5ae1d66b1),
+    ("hard/furnace-materials.toml", "reference", 1, 0xb20cd7116331caa4),
+    ("hard/nested.toml", "wavefront", 2, 0x5297a2f963c0a976),
 ];
 
 /// FNV-1a over the bits of every term of every pixel, in film order.

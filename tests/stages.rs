@@ -184,6 +184,7 @@ fn camera_world(segments: &[(usize, PathKind)]) -> World {
         classified: Classified::default(),
         shadows: ShadowQueue::default(),
         terms: vec![Terms::default(); 8],
+        receivers: vec![Default::default(); 8],
         film: Vec::new(),
         open: Default::default(),
         rays: Default::default(),

@@ -89,6 +89,12 @@ pub struct RenderArgs {
     /// sampling (for comparison) [MIS on].
     #[arg(long)]
     pub no_mis: bool,
+    /// How each area-light sample of direct light picks its light: `tree`, by a light tree's
+    /// bound of each emitter's contribution at the shading point (near lights more often than
+    /// far ones of equal power, none behind the surface), or `power`, by emitted power alone
+    /// (for comparison); suns and environments are picked by power beside the tree [tree].
+    #[arg(long, value_enum)]
+    pub light_sampler: Option<photonwave::settings::LightSampler>,
     /// Add diagnostic EXR layers: per pixel, the radius and photon count of the caustic and the
     /// global density estimates (`radius.caustic`, `photons.caustic`, `radius.global`,
     /// `photons.global`), probed at one camera sample of the last pass; costs one pass's photon
@@ -213,6 +219,7 @@ fn overrides(args: &RenderArgs) -> Overrides {
         no_final_gather: args.no_final_gather,
         no_aim_caustics: args.no_aim_caustics,
         no_mis: args.no_mis,
+        light_sampler: args.light_sampler,
         secondary_gather: args.secondary_gather,
         visibility: args.visibility,
         no_boundary_correction: args.no_boundary_correction,

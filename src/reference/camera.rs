@@ -24,7 +24,7 @@ use crate::transport::camera::render_pixels;
 use crate::transport::direct::{delta_light, direct_light, weighted_direct_light};
 use crate::transport::estimate::{camera_indirect_estimate, caustic_estimate, indirect_estimate, map_radiance};
 use crate::transport::gather::{glossy_density, glossy_ray, lands_near, trace_gather_rays};
-use crate::transport::mis::{emission_found, Strategies};
+use crate::transport::mis::{emission_found, receiver, Strategies};
 use crate::transport::specular::{continue_chain, emission_toward, first_non_specular, ChainEnd};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
@@ -167,13 +167,14 @@ pub fn final_gather(
     // A rough plastic weighs each ray by its base's share seen through the coat; for the others
     // the weight is kd for every ray, applied once at the end.
     let varies = bsdf.gather_varies();
+    let r = receiver(sp, bsdf, wo);
     trace_gather_rays(ctx, sp, wo, n, s, rays, |end, wi, chain, rays| {
         let e = gather_hit(ctx, end, chain, rays, scratch);
         let w = if varies { bsdf.gather_weight(&sp.frame, wo, wi) * end.beta } else { end.beta };
         sum += w * e.radiance;
         bias += w * e.bias;
         if end.bounces == 0 {
-            emission += w * emission_found(ctx, &end.hit, end.dir, mis.gather_density(sp, wo, wi));
+            emission += w * emission_found(ctx, &r, &end.hit, end.dir, mis.gather_density(sp, wo, wi));
         }
     });
     let scale = if varies { Vec3::ONE } else { kd };
@@ -240,7 +241,7 @@ pub fn glossy_reflection(
     let rest = indirect_estimate(ctx, &y, b, -d, None, scratch).finish(ctx);
     let w = ray.weight * beta;
     let emission = if bounces == 0 {
-        w * emission_found(ctx, &hit, d, glossy_density(&ray, mis, sp, bsdf, wo))
+        w * emission_found(ctx, &receiver(sp, bsdf, wo), &hit, d, glossy_density(&ray, mis, sp, bsdf, wo))
     } else {
         Vec3::ZERO
     };

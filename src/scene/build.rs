@@ -5,6 +5,7 @@
 //! Reads [`MeshInput`]s (from the readers of [`crate::formats`], or made in code),
 //! [`Material`]s and [`Light`]s; writes the [`Scene`] the engines trace.
 
+use super::light_tree::{LightTree, TreeLight};
 use super::*;
 
 impl Scene {
@@ -114,6 +115,8 @@ impl Scene {
             light_power: Distribution1D::default(),
             area_lights: vec![],
             area_power: None,
+            light_tree: None,
+            infinite_power: None,
             delta_lights: vec![],
             suns: vec![],
             bounds: (lo, hi),
@@ -178,6 +181,27 @@ impl Scene {
         self.suns = lights.filter(|&i| matches!(self.lights[i as usize], Light::Sun { .. })).collect();
         let area_w: Vec<f64> = self.area_lights.iter().map(|&i| powers[i as usize]).collect();
         self.area_power = Distribution1D::try_new(&area_w);
+        // The emissive triangles in a light tree, beside the suns and the environment.
+        let emitters: Vec<TreeLight> = (0..self.lights.len())
+            .filter_map(|i| match self.lights[i] {
+                Light::Area { tri, .. } => {
+                    let t = self.triangle(tri);
+                    Some(TreeLight { light: i as u32, p: t.p, n: t.n, power: powers[i] as f32 })
+                }
+                _ => None,
+            })
+            .collect();
+        let infinite: Vec<u32> = self
+            .area_lights
+            .iter()
+            .copied()
+            .filter(|&i| !matches!(self.lights[i as usize], Light::Area { .. }))
+            .collect();
+        let tree_power: f64 = emitters.iter().map(|l| powers[l.light as usize]).sum();
+        let share = tree_power / area_w.iter().sum::<f64>();
+        self.light_tree = LightTree::build(&emitters, self.lights.len()).map(|t| (t, share));
+        let infinite_w: Vec<f64> = infinite.iter().map(|&i| powers[i as usize]).collect();
+        self.infinite_power = Distribution1D::try_new(&infinite_w).map(|d| (infinite, d));
         Ok(())
     }
 }

@@ -2,8 +2,12 @@
 //! directional lights of the scene file; their power, emission sampling (photons) and
 //! illumination sampling (direct light).
 
+use super::light_tree::near;
 use crate::geometry::offset::barycentric_error;
-use crate::sampling::{concentric_disk, uniform_cone, uniform_sphere, uniform_triangle, Frame};
+use crate::sampling::{
+    concentric_disk, solid_angle, spherical_triangle, uniform_cone, uniform_sphere, uniform_triangle, Frame,
+    SPHERICAL_SAMPLING,
+};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -50,6 +54,9 @@ pub struct Incident {
     pub wi: Vec3,
     /// Radiance or irradiance-like contribution divided by the sample pdf (f·cos not applied).
     pub value: Vec3,
+    /// The sample's density per steradian (an emissive triangle's: [`area_light_pdf`]; the
+    /// environment's mixture); 0 for delta lights and the sun (never weighed by MIS).
+    pub pdf: f32,
     /// Distance to the light sample (infinite for directional lights).
     pub distance: f32,
     /// The light-side point and its geometric normal, for shadow rays (None for distant lights).
@@ -82,6 +89,51 @@ pub fn spot_falloff(cos_theta: f32, cos_inner: f32, cos_outer: f32) -> f32 {
     } else {
         (cos_theta - cos_outer) / (cos_inner - cos_outer)
     }
+}
+
+/// How an emissive triangle is sampled from `p`: `Some(Ω)` by the solid angle Ω it subtends
+/// there where it is near ([`near`]: closer than 5 bounding radii, where area sampling's 1/d²
+/// would vary more than 2.25× over it) and Ω lies within [`SPHERICAL_SAMPLING`]; `None` by area
+/// (uniform in area is nearly uniform in solid angle for a far triangle, and much cheaper).
+/// Light sampling and MIS's density ([`area_light_pdf`]) decide alike, so their weights sum to
+/// one.
+#[must_use]
+pub fn area_light_sampling(t: &TriangleGeom, p: Vec3) -> Option<f64> {
+    if !near(&t.p, p) {
+        return None;
+    }
+    let omega = solid_angle(t.p, p);
+    SPHERICAL_SAMPLING.contains(&omega).then_some(omega)
+}
+
+/// The density per steradian with which light sampling from `p` picks the direction `wi`
+/// toward a point of triangle `t` at `distance`: 1/Ω where it samples the solid angle,
+/// d²/(A·cos θ_light) where it samples the area ([`area_light_sampling`]).
+#[must_use]
+pub fn area_light_pdf(t: &TriangleGeom, p: Vec3, wi: Vec3, distance: f32) -> f32 {
+    match area_light_sampling(t, p) {
+        Some(omega) => (1.0 / omega) as f32,
+        None => distance * distance / (t.area * wi.dot(t.n).abs()),
+    }
+}
+
+/// Barycentrics of the point where the ray from `p` along `w` crosses triangle `t`'s plane,
+/// moved onto the triangle where rounding put it just outside (f64: a far or thin triangle's
+/// edge products cancel in f32). `None` for a ray along the plane.
+fn crossing(t: &TriangleGeom, p: Vec3, w: Vec3) -> Option<[f32; 3]> {
+    let [a, b, c] = t.p.map(|q| q.as_dvec3() - p.as_dvec3());
+    let w = w.as_dvec3();
+    let (e1, e2) = (b - a, c - a);
+    let pv = w.cross(e2);
+    let det = e1.dot(pv);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let b1 = ((-a).dot(pv) / det).max(0.0);
+    let b2 = (w.dot((-a).cross(e1)) / det).max(0.0);
+    let s = (b1 + b2).max(1.0);
+    let (b1, b2) = (b1 / s, b2 / s);
+    Some([(1.0 - b1 - b2) as f32, b1 as f32, b2 as f32])
 }
 
 impl Light {
@@ -192,8 +244,16 @@ impl Light {
         match *self {
             Light::Area { radiance, .. } => {
                 let t = tri?;
-                let (b1, b2) = uniform_triangle(u);
-                let b = [1.0 - b1 - b2, b1, b2];
+                let omega = area_light_sampling(t, p);
+                let b = match omega {
+                    // Uniform in the solid angle it subtends: the point where the sampled
+                    // direction crosses the triangle.
+                    Some(_) => crossing(t, p, spherical_triangle(t.p, p, u)?)?,
+                    None => {
+                        let (b1, b2) = uniform_triangle(u);
+                        [1.0 - b1 - b2, b1, b2]
+                    }
+                };
                 let q = t.p[0] * b[0] + t.p[1] * b[1] + t.p[2] * b[2];
                 let d = q - p;
                 let dist2 = d.length_squared();
@@ -203,10 +263,12 @@ impl Light {
                 if !(cos_l > 0.0) || !(dist2 > 0.0) || !wi.is_finite() {
                     return None;
                 }
-                // Area measure → solid angle: Le·cos_l·A/d².
-                Some(Incident {
+                // Area measure → solid angle: d²/(A·cos θ_light).
+                let pdf = omega.map_or(dist2 / (t.area * cos_l), |o| (1.0 / o) as f32);
+                (pdf > 0.0 && pdf.is_finite()).then(|| Incident {
                     wi,
-                    value: radiance * (cos_l * t.area / dist2),
+                    value: radiance / pdf,
+                    pdf,
                     distance: dist,
                     point: Some((q, t.n)),
                     point_error: barycentric_error(b, t.p[0], t.p[1], t.p[2]),
@@ -219,6 +281,7 @@ impl Light {
                 (dist2 > 0.0).then(|| Incident {
                     wi: d / dist,
                     value: intensity / dist2,
+                    pdf: 0.0,
                     distance: dist,
                     point: Some((position, Vec3::ZERO)),
                     point_error: Vec3::ZERO,
@@ -236,6 +299,7 @@ impl Light {
                 (fall > 0.0).then(|| Incident {
                     wi,
                     value: intensity * fall / dist2,
+                    pdf: 0.0,
                     distance: dist,
                     point: Some((position, Vec3::ZERO)),
                     point_error: Vec3::ZERO,
@@ -244,6 +308,7 @@ impl Light {
             Light::Directional { direction, irradiance } => Some(Incident {
                 wi: -direction,
                 value: irradiance,
+                pdf: 0.0,
                 distance: f32::INFINITY,
                 point: None,
                 point_error: Vec3::ZERO,
@@ -255,7 +320,7 @@ impl Light {
                 let phi = 2.0 * PI * u[1];
                 let wi = Frame::new(-direction).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos));
                 let value = Self::sun_radiance(irradiance, one_minus_cos) * (2.0 * PI * one_minus_cos);
-                Some(Incident { wi, value, distance: f32::INFINITY, point: None, point_error: Vec3::ZERO })
+                Some(Incident { wi, value, pdf: 0.0, distance: f32::INFINITY, point: None, point_error: Vec3::ZERO })
             }
             // Sampled by the scene (`Scene::sample_incident`).
             Light::Environment => None,

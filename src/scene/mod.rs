@@ -8,6 +8,8 @@ pub mod camera;
 mod checks;
 pub mod environment;
 pub mod light;
+mod light_choice;
+pub mod light_tree;
 pub mod open_edges;
 pub mod targets;
 
@@ -24,6 +26,7 @@ pub use camera::Camera;
 pub use environment::Environment;
 use glam::{Vec2, Vec3};
 pub use light::{Light, LightPreset, TriangleGeom};
+pub use light_tree::{LightSampler, Receiver, DEFENSIVE_SHARE};
 
 /// Triangles of one mesh before the scene is assembled.
 #[derive(Clone, Debug, Default)]
@@ -113,6 +116,12 @@ pub struct Scene {
     pub area_lights: Vec<u32>,
     /// Distribution over `area_lights` by power.
     pub area_power: Option<Distribution1D>,
+    /// The light tree over the emissive triangles ([`light_tree::LightTree`]), and the share of
+    /// `area_lights`' power they hold: direct light picks the tree with that probability, else
+    /// a sun or the environment by power.
+    pub light_tree: Option<(light_tree::LightTree, f64)>,
+    /// The suns and the environment among `area_lights`, by power.
+    infinite_power: Option<(Vec<u32>, Distribution1D)>,
     /// Indices of delta lights in `lights`.
     pub delta_lights: Vec<u32>,
     /// Indices of suns in `lights` (seen by rays that leave the scene).
@@ -436,20 +445,19 @@ impl Scene {
                 (pdf > 0.0 && wi.is_finite()).then(|| light::Incident {
                     wi,
                     value: radiance / pdf,
+                    pdf,
                     distance: f32::INFINITY,
                     point: None,
                     point_error: Vec3::ZERO,
                 })
             }
             (Light::Area { tri, .. }, _) if self.textured_emitter(*tri) => {
-                // The sample's point and geometry as for a constant emitter, its radiance read
-                // from the texture where it lands: L(q)·cos·A/d².
+                // The sample's point and density as for a constant emitter, its radiance read
+                // from the texture where it lands: L(q)/pdf.
                 let t = self.triangle(*tri);
                 let mut inc = l.sample_incident(Some(&t), p, u)?;
                 let (q, _) = inc.point?;
-                let dist2 = (q - p).length_squared();
-                let cos_l = -inc.wi.dot(t.n);
-                inc.value = self.emitted_at(*tri, self.barycentrics(*tri, q)) * (cos_l * t.area / dist2);
+                inc.value = self.emitted_at(*tri, self.barycentrics(*tri, q)) / inc.pdf;
                 Some(inc)
             }
             _ => l.sample_incident(self.light_triangle(l).as_ref(), p, u),

@@ -1,9 +1,11 @@
 //! Direct light by light sampling (Jensen's first term): at a non-specular point, every delta
-//! light once and `light_samples` area-light samples chosen by power, each a shadow ray that
+//! light once and `light_samples` area-light samples, each light chosen by the light tree or by
+//! power ([`crate::scene::Scene::choose_light`]) and each triangle's point by the solid angle it
+//! subtends or by area ([`crate::scene::light`]), each a shadow ray that
 //! carries its contribution if nothing blocks it. Where BSDF samples can find the same emitters
 //! ([`super::mis::Strategies`]), an emissive triangle's sample is weighted against them.
 
-use super::mis::{light_density, weighed_light, Strategies};
+use super::mis::{light_density, receiver, weighed_light, Strategies};
 use super::Context;
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::Bsdf;
@@ -30,7 +32,7 @@ pub struct ShadowRay {
 }
 
 /// The shadow rays of direct light at `sp` toward `wo`: every delta light once, then (unless
-/// `delta_only`) `light_samples` area-light samples chosen by power, an emissive triangle's
+/// `delta_only`) `light_samples` area-light samples ([`crate::scene::Scene::choose_light`]), an emissive triangle's
 /// weighted by MIS against `mis`. Lights that cannot contribute (behind the surface, back
 /// faces, outside a spot cone) get no ray.
 #[allow(clippy::too_many_arguments)]
@@ -46,6 +48,7 @@ pub fn direct_light_rays(
 ) {
     let scene = ctx.scene;
     let (_, ns) = sp.frame.oriented(wo);
+    let r = receiver(sp, bsdf, wo);
     let mut add = |light_index: u32, u: [f32; 2], weight: f32| {
         let light = &scene.lights[light_index as usize];
         let Some(inc) = scene.sample_incident(light, sp.p, ns, u) else { return };
@@ -56,7 +59,7 @@ pub fn direct_light_rays(
         };
         let f = match weighed {
             Some((k, tri)) => {
-                let density = light_density(scene, ctx.settings.light_samples, k, tri, inc.distance, inc.wi);
+                let density = light_density(ctx, &r, k, tri, inc.distance, inc.wi);
                 mis.weighted_f(sp, bsdf, wo, inc.wi, density)
             }
             None => bsdf.eval(&sp.frame, wo, inc.wi),
@@ -87,12 +90,10 @@ pub fn direct_light_rays(
     if delta_only {
         return;
     }
-    if let Some(dist) = &scene.area_power {
-        let n = ctx.settings.light_samples;
-        for j in 0..n {
-            let pick = dist.sample(s.get(j, 0));
-            let pmf = dist.pmf(pick) as f32;
-            add(scene.area_lights[pick], [s.get(j, 1), s.get(j, 2)], 1.0 / (pmf * n as f32));
+    let n = ctx.settings.light_samples;
+    for j in 0..n {
+        if let Some((light, pmf)) = scene.choose_light(ctx.settings.light_sampler, &r, s.get(j, 0)) {
+            add(light, [s.get(j, 1), s.get(j, 2)], 1.0 / (pmf * n as f32));
         }
     }
 }

@@ -10,8 +10,10 @@
 //! where the BSDF's own sampling is.
 //!
 //! The weights come from densities (samples × pdf per steradian): light sampling's is
-//! `light_samples × pmf(light) × d² / (A·cos θ_light)` ([`light_density`]); a BSDF kind's is
-//! given by [`Strategies`]. Only emissive triangles whose surface ends a camera-side chain
+//! `light_samples × pmf(light | receiver) × pdf(direction)` ([`light_density`]: the light
+//! tree's or the power's pick, and 1/Ω or d²/(A·cos θ_light) for the point on it); a BSDF
+//! kind's is given by [`Strategies`]. Both depend on the receiver — the shading point and its
+//! normal — so a BSDF sample's weight is computed for the receiver it left. Only emissive triangles whose surface ends a camera-side chain
 //! (neither mirror, glass nor what photons pass as specular) are weighed: those are the ones a
 //! BSDF ray can find. The environment and the sun stay with light sampling alone.
 //!
@@ -21,7 +23,8 @@
 use super::Context;
 use crate::geometry::Hit;
 use crate::material::Bsdf;
-use crate::scene::{Scene, SurfacePoint};
+use crate::scene::light::area_light_pdf;
+use crate::scene::{Receiver, Scene, SurfacePoint};
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
 
@@ -139,25 +142,36 @@ pub fn weighed_light(scene: &Scene, tri: u32) -> Option<usize> {
     scene.area_light_of(tri)
 }
 
-/// Light sampling's density toward a point of emissive triangle `tri` (light `light`, see
-/// [`weighed_light`]) at `distance` along unit `wi`: `light_samples` × the light's pick
-/// probability × the solid-angle pdf d²/(A·|cos θ_light|) of a uniform point on it.
+/// The receiver light sampling works for at `sp` on `bsdf`, seen from `wo`: its point, its
+/// shading normal on `wo`'s side, and whether it takes light through itself.
 #[must_use]
 #[inline]
-pub fn light_density(scene: &Scene, light_samples: u32, light: usize, tri: u32, distance: f32, wi: Vec3) -> f32 {
-    let Some(dist) = &scene.area_power else { return 0.0 };
-    let t = tri as usize;
-    let cos = wi.dot(scene.ng[t]).abs();
-    let pmf = dist.pmf(light) as f32;
-    light_samples as f32 * pmf * (distance * distance) / (scene.area[t] * cos)
+pub fn receiver(sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3) -> Receiver {
+    let (_, ns) = sp.frame.oriented(wo);
+    Receiver { p: sp.p, n: ns, two_sided: bsdf.transmits() }
 }
 
-/// Emission a BSDF-sampled ray finds at its first hit `hit` (no mirror or glass before it),
-/// arriving along unit `d`, weighted against light sampling; `density` is the BSDF kind's
-/// density for `d` at the ray's origin. Zero from a back face, a non-emitter, an emitter that
+/// Light sampling's density at receiver `r` toward a point of emissive triangle `tri` (light
+/// `light` of the scene, see [`weighed_light`]) at `distance` along unit `wi`: `light_samples`
+/// × the light's pick probability there ([`Scene::light_pmf`]) × the density per steradian of
+/// its point ([`area_light_pdf`]: by solid angle or by area, as the sample was drawn).
+#[must_use]
+#[inline]
+pub fn light_density(ctx: &Context, r: &Receiver, light: usize, tri: u32, distance: f32, wi: Vec3) -> f32 {
+    let scene = ctx.scene;
+    let pmf = scene.light_pmf(ctx.settings.light_sampler, r, light as u32);
+    if !(pmf > 0.0) {
+        return 0.0;
+    }
+    ctx.settings.light_samples as f32 * pmf * area_light_pdf(&scene.triangle(tri), r.p, wi, distance)
+}
+
+/// Emission a BSDF-sampled ray from receiver `r` finds at its first hit `hit` (no mirror or
+/// glass before it), arriving along unit `d`, weighted against light sampling; `density` is the
+/// BSDF kind's density for `d` at the ray's origin. Zero from a back face, a non-emitter, an emitter that
 /// light sampling does not weigh, or with no density.
 #[must_use]
-pub fn emission_found(ctx: &Context, hit: &Hit, d: Vec3, density: f32) -> Vec3 {
+pub fn emission_found(ctx: &Context, r: &Receiver, hit: &Hit, d: Vec3, density: f32) -> Vec3 {
     if !(density > 0.0) {
         return Vec3::ZERO;
     }
@@ -167,6 +181,6 @@ pub fn emission_found(ctx: &Context, hit: &Hit, d: Vec3, density: f32) -> Vec3 {
     if e == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let p_light = light_density(scene, ctx.settings.light_samples, light, hit.tri, hit.t, d);
+    let p_light = light_density(ctx, r, light, hit.tri, hit.t, d);
     e * power_heuristic(density, p_light)
 }

@@ -78,6 +78,7 @@ fn worker_world(scene: &Arc<Scene>, job: &Job, maps: &Arc<PhotonMaps>, camera: &
         classified: Classified::default(),
         shadows: ShadowQueue::default(),
         terms: Vec::new(),
+        receivers: Vec::new(),
         film: Vec::new(),
         open: PixelMean::default(),
         rays: RayCounts::default(),

@@ -61,7 +61,8 @@ pub fn deposit_emission(
                 continue;
             }
             let Some(hit) = w.paths.hits.get(i) else { continue };
-            let found = emission_found(&ctx, &hit, w.paths.rays.direction(i), density);
+            let r = &w.receivers[w.paths.sample[i] as usize];
+            let found = emission_found(&ctx, r, &hit, w.paths.rays.direction(i), density);
             if found != Vec3::ZERO {
                 n += 1;
                 let term = Term::Direct.seen(w.paths.through_specular[i]);

@@ -5,6 +5,7 @@ use super::queues::{PathKind, PhotonLane, Segment};
 use super::{CameraWork, PhotonWork, Shared, StageClock, StageStats};
 use crate::film::{Term, Terms};
 use crate::rng::Domain;
+use crate::scene::Receiver;
 use crate::transport::camera::camera_ray;
 use crate::transport::photon::{start_photon, PathCounts, PathEnd, Start};
 use crate::transport::streams;
@@ -52,6 +53,8 @@ pub fn emit_camera_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut s
     w.shadows.clear();
     w.terms.clear();
     w.terms.resize(w.count, Terms::default());
+    w.receivers.clear();
+    w.receivers.resize(w.count, Receiver::default());
     for lane in 0..w.count {
         let (sampler, origin, dir) = camera_ray(&shared.job, &w.camera, w.first_sample + lane as u64);
         w.paths.push(Segment {

@@ -7,6 +7,7 @@ use crate::job::Job;
 use crate::photon_map::Photon;
 use crate::rng::Domain;
 use crate::scene::camera::CameraRays;
+use crate::scene::Receiver;
 use crate::scene::Scene;
 use crate::stats::{Numerics, RayCounts};
 use crate::transport::photon::PathCounts;
@@ -71,6 +72,10 @@ pub struct CameraWork {
     pub shadows: ShadowQueue,
     /// Per-sample terms of the wave.
     pub terms: Vec<Terms>,
+    /// Per sample, the receiver its camera path's non-specular hit sampled light for: the
+    /// gather and glossy rays that leave it weigh the emission they find for that point
+    /// (`transport::mis::emission_found`). A camera path has at most one such hit.
+    pub receivers: Vec<Receiver>,
     /// The tile's pixels, resolved after each wave's bounce loop (a tile of one pixel with more
     /// samples than a wave holds takes several waves: [`super::camera_pass::camera_pass`]).
     pub film: Vec<Terms>,

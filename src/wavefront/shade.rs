@@ -11,7 +11,7 @@ use crate::film::Term;
 use crate::rng::{Domain, Sampler};
 use crate::transport::direct::{direct_light_rays, ShadowRay};
 use crate::transport::gather::{gather_rays, glossy_density, glossy_ray};
-use crate::transport::mis::Strategies;
+use crate::transport::mis::{receiver, Strategies};
 use crate::transport::photon::{scatter_photon, PathEnd, Scattered};
 use crate::transport::specular::continue_chain;
 use crate::transport::{streams, Context};
@@ -155,7 +155,7 @@ pub fn spawn_gather_rays(
     let scene = &*shared.scene;
     let n = shared.job.settings.gather_rays;
     // Rays go straight into the next queue (disjoint fields of the work resource).
-    let CameraWork { paths, classified, next, .. } = &mut *work;
+    let CameraWork { paths, classified, next, receivers, .. } = &mut *work;
     let w = &*paths;
     let lanes: Vec<u32> = classified
         .diffuse
@@ -186,6 +186,9 @@ pub fn spawn_gather_rays(
             _ => (s.fork(streams::SECONDARY_GATHER), 1, PathKind::SecondaryGather, w.term[i], Strategies::LightOnly),
         };
         let wo = -w.rays.direction(i);
+        if kind == PathKind::Gather {
+            receivers[w.sample[i] as usize] = receiver(&sp, &bsdf, wo);
+        }
         let weight = w.beta[i] * kd / rays as f32;
         gather_rays(&sp, wo, rays, &gs, |g, origin, dir| {
             // A rough plastic weighs each ray by its base's share (as the reference).
@@ -223,7 +226,7 @@ pub fn spawn_glossy_rays(
     let t = StageClock::start();
     let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
     let scene = &*shared.scene;
-    let CameraWork { paths, classified, next, .. } = &mut *work;
+    let CameraWork { paths, classified, next, receivers, .. } = &mut *work;
     let before = next.len();
     for &l in &classified.diffuse {
         let i = l as usize;
@@ -241,6 +244,7 @@ pub fn spawn_glossy_rays(
         let wo = -paths.rays.direction(i);
         let Some(ray) = glossy_ray(&sp, bsdf, wo, &gls) else { continue };
         let mis = Strategies::at_camera_hit(&ctx, bsdf);
+        receivers[paths.sample[i] as usize] = receiver(&sp, bsdf, wo);
         next.push(Segment {
             origin: ray.origin,
             dir: ray.dir,
