@@ -452,7 +452,7 @@ mod tests {
     fn ceiling() -> Vec<TreeLight> {
         (0..200u32)
             .map(|i| {
-                let h = |k: u32| ((i * 2_654_435_761u32.wrapping_add(k * 40_503)) % 10_007) as f32 / 10_007.0;
+                let h = |k: u32| (i.wrapping_mul(2_654_435_761u32.wrapping_add(k * 40_503)) % 10_007) as f32 / 10_007.0;
                 let c = Vec3::new(10.0 * h(1) - 5.0, 2.0, 10.0 * h(2) - 5.0);
                 let up = i % 17 == 0;
                 let (a, b) = (Vec3::new(0.1, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.1));
