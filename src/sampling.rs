@@ -135,32 +135,91 @@ impl Distribution1D {
         let lo = if i == 0 { 0.0 } else { self.cdf[i - 1] };
         let width = self.cdf[i] - lo;
         let r = if width > 0.0 { (u as f64 * self.total - lo) / width } else { 0.5 };
-        (i, (r as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0))
+        (i, (r as f32).clamp(0.0, ONE_BELOW))
     }
 }
 
+/// The largest f32 below 1: where a uniform number rescaled into [0, 1) is clamped.
+pub const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
+
 /// Solid angles (sr) within which a triangle's light is sampled by the solid angle it subtends
-/// ([`spherical_triangle`]); outside, by area. Below the lower bound the triangle is far and
+/// ([`SphericalTriangle`]); outside, by area. Below the lower bound the triangle is far and
 /// small, where area sampling is already uniform in solid angle; above the upper one (near 2π)
 /// the point lies almost in the triangle's plane, inside it, where the spherical triangle is a
 /// near-hemisphere whose sampling loses precision. The bounds are pbrt-v4's.
 pub const SPHERICAL_SAMPLING: std::ops::RangeInclusive<f64> = 3e-4..=6.22;
 
-/// The solid angle (sr) triangle `v` subtends at `p` (Van Oosterom and Strackee 1983:
-/// tan(Ω/2) = |a·(b×c)| / (1 + a·b + b·c + c·a) for the unit vectors a, b, c toward the
-/// vertices), in f64: exact to rounding for triangles of any size or distance. 0 where `p` lies
-/// on a vertex.
-#[must_use]
-pub fn solid_angle(v: [Vec3; 3], p: Vec3) -> f64 {
-    let p = p.as_dvec3();
-    let [a, b, c] = v.map(|q| (q.as_dvec3() - p).normalize_or_zero());
-    let num = a.dot(b.cross(c)).abs();
-    let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
-    let omega = 2.0 * num.atan2(den);
-    if omega.is_finite() {
-        omega
-    } else {
-        0.0
+/// A triangle seen from a point: the unit vectors a, b, c toward its vertices, in f64, computed
+/// once for both its solid angle and a direction sampled in it.
+#[derive(Clone, Copy, Debug)]
+pub struct SphericalTriangle {
+    a: glam::DVec3,
+    b: glam::DVec3,
+    c: glam::DVec3,
+}
+
+impl SphericalTriangle {
+    /// Triangle `v` seen from `p`.
+    #[must_use]
+    pub fn new(v: [Vec3; 3], p: Vec3) -> Self {
+        let p = p.as_dvec3();
+        let [a, b, c] = v.map(|q| (q.as_dvec3() - p).normalize_or_zero());
+        SphericalTriangle { a, b, c }
+    }
+
+    /// Its solid angle (sr) (Van Oosterom and Strackee 1983: tan(Ω/2) = |a·(b×c)| / (1 + a·b +
+    /// b·c + c·a)): exact to rounding for triangles of any size or distance. 0 where the point
+    /// lies on a vertex.
+    #[must_use]
+    pub fn solid_angle(&self) -> f64 {
+        let (a, b, c) = (self.a, self.b, self.c);
+        let num = a.dot(b.cross(c)).abs();
+        let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
+        let omega = 2.0 * num.atan2(den);
+        if omega.is_finite() {
+            omega
+        } else {
+            0.0
+        }
+    }
+
+    /// A direction uniform in its solid angle, with two uniform numbers (Arvo 1995, "Stratified
+    /// Sampling of Spherical Triangles": the first number picks the sub-triangle A B Ĉ of area
+    /// u₀·Ω, whose far vertex Ĉ lies on the arc A C, the second a point on the arc B Ĉ whose
+    /// cosine to B is uniform). pdf = 1/[`SphericalTriangle::solid_angle`]. In f64, as the
+    /// sub-area's angle sum α + β + γ − π cancels for small triangles. `None` where the
+    /// spherical triangle is degenerate (a vertex at the point, or the point in the triangle's
+    /// plane).
+    #[must_use]
+    pub fn sample(&self, u: [f32; 2]) -> Option<Vec3> {
+        use glam::DVec3;
+        let (a, b, c) = (self.a, self.b, self.c);
+        // The great circles' plane normals, and the triangle's angles between them.
+        let (n_ab, n_bc, n_ca) = (a.cross(b), b.cross(c), c.cross(a));
+        if n_ab.length_squared() == 0.0 || n_bc.length_squared() == 0.0 || n_ca.length_squared() == 0.0 {
+            return None;
+        }
+        let (n_ab, n_bc, n_ca) = (n_ab.normalize(), n_bc.normalize(), n_ca.normalize());
+        let alpha = angle_between(n_ab, -n_ca);
+        let beta = angle_between(n_bc, -n_ab);
+        let gamma = angle_between(n_ca, -n_bc);
+        let area = alpha + beta + gamma - std::f64::consts::PI;
+        if !(area > 0.0) {
+            return None;
+        }
+        // The sub-triangle of area u₀·Ω: where Ĉ lies on the arc A C (its cosine q to A).
+        let sub = f64::from(u[0]) * area;
+        let (s, t) = (sub - alpha).sin_cos();
+        let (sin_alpha, cos_alpha) = alpha.sin_cos();
+        let (k1, k2) = (t - cos_alpha, s + sin_alpha * a.dot(b));
+        let q = (((k2 * t - k1 * s) * cos_alpha - k2) / ((k2 * s + k1 * t) * sin_alpha)).clamp(-1.0, 1.0);
+        let across = |x: DVec3, from: DVec3| (x - x.dot(from) * from).normalize_or_zero();
+        let c_hat = q * a + (1.0 - q * q).max(0.0).sqrt() * across(c, a);
+        // Along the arc B Ĉ, cosine to B uniform between 1 and B·Ĉ.
+        let z = 1.0 - f64::from(u[1]) * (1.0 - c_hat.dot(b));
+        let w = z * b + (1.0 - z * z).max(0.0).sqrt() * across(c_hat, b);
+        let w = w.as_vec3();
+        (w.is_finite() && w != Vec3::ZERO).then(|| w.normalize())
     }
 }
 
@@ -172,45 +231,6 @@ fn angle_between(a: glam::DVec3, b: glam::DVec3) -> f64 {
     } else {
         2.0 * ((b - a).length() / 2.0).min(1.0).asin()
     }
-}
-
-/// A direction from `p` uniform in the solid angle triangle `v` subtends, with two uniform
-/// numbers (Arvo 1995, "Stratified Sampling of Spherical Triangles": the first number picks the
-/// sub-triangle A B Ĉ of area u₀·Ω, whose far vertex Ĉ lies on the arc A C, the second a point
-/// on the arc B Ĉ whose cosine to B is uniform). pdf = 1/[`solid_angle`]. In f64, as the
-/// sub-area's angle sum α + β + γ − π cancels for small triangles. `None` where the spherical
-/// triangle is degenerate (a vertex at `p`, or `p` in the triangle's plane).
-#[must_use]
-pub fn spherical_triangle(v: [Vec3; 3], p: Vec3, u: [f32; 2]) -> Option<Vec3> {
-    use glam::DVec3;
-    let pd = p.as_dvec3();
-    let [a, b, c] = v.map(|q| (q.as_dvec3() - pd).normalize_or_zero());
-    // The great circles' plane normals, and the triangle's angles between them.
-    let (n_ab, n_bc, n_ca) = (a.cross(b), b.cross(c), c.cross(a));
-    if n_ab.length_squared() == 0.0 || n_bc.length_squared() == 0.0 || n_ca.length_squared() == 0.0 {
-        return None;
-    }
-    let (n_ab, n_bc, n_ca) = (n_ab.normalize(), n_bc.normalize(), n_ca.normalize());
-    let alpha = angle_between(n_ab, -n_ca);
-    let beta = angle_between(n_bc, -n_ab);
-    let gamma = angle_between(n_ca, -n_bc);
-    let area = alpha + beta + gamma - std::f64::consts::PI;
-    if !(area > 0.0) {
-        return None;
-    }
-    // The sub-triangle of area u₀·Ω: where Ĉ lies on the arc A C (its cosine q to A).
-    let sub = f64::from(u[0]) * area;
-    let (s, t) = (sub - alpha).sin_cos();
-    let (sin_alpha, cos_alpha) = alpha.sin_cos();
-    let (k1, k2) = (t - cos_alpha, s + sin_alpha * a.dot(b));
-    let q = (((k2 * t - k1 * s) * cos_alpha - k2) / ((k2 * s + k1 * t) * sin_alpha)).clamp(-1.0, 1.0);
-    let across = |x: DVec3, from: DVec3| (x - x.dot(from) * from).normalize_or_zero();
-    let c_hat = q * a + (1.0 - q * q).max(0.0).sqrt() * across(c, a);
-    // Along the arc B Ĉ, cosine to B uniform between 1 and B·Ĉ.
-    let z = 1.0 - f64::from(u[1]) * (1.0 - c_hat.dot(b));
-    let w = z * b + (1.0 - z * z).max(0.0).sqrt() * across(c_hat, b);
-    let w = w.as_vec3();
-    (w.is_finite() && w != Vec3::ZERO).then(|| w.normalize())
 }
 
 #[cfg(test)]
@@ -263,14 +283,15 @@ mod tests {
             [Vec3::new(3.0, 0.5, 9.0), Vec3::new(3.4, 0.6, 9.5), Vec3::new(3.1, 0.9, 9.1)],
         ];
         for v in cases {
-            let omega = solid_angle(v, Vec3::ZERO);
+            let seen = SphericalTriangle::new(v, Vec3::ZERO);
+            let omega = seen.solid_angle();
             assert!(SPHERICAL_SAMPLING.contains(&omega), "Ω {omega}");
             let m = 20_000;
             let mut sum = 0.0f64;
             let mut sum2 = 0.0f64;
             for i in 0..m {
                 let u = [(i as f32 + 0.5) / m as f32, ((i as u64 * 2_654_435_761) % 65_521) as f32 / 65_521.0];
-                let w = spherical_triangle(v, Vec3::ZERO, u).expect("a direction");
+                let w = seen.sample(u).expect("a direction");
                 // The direction crosses the triangle: its barycentrics are all ≥ 0.
                 let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
                 let pv = w.cross(e2);
@@ -292,8 +313,8 @@ mod tests {
     #[test]
     fn solid_angle_of_a_far_triangle_is_its_area_over_distance_squared() {
         let v = [Vec3::new(0.0, 0.0, 1000.0), Vec3::new(1.0, 0.0, 1000.0), Vec3::new(0.0, 1.0, 1000.0)];
-        let omega = solid_angle(v, Vec3::ZERO);
+        let omega = SphericalTriangle::new(v, Vec3::ZERO).solid_angle();
         assert!((omega / 5e-7 - 1.0).abs() < 2e-3, "{omega}");
-        assert_eq!(solid_angle(v, v[0]), 0.0, "seen from a vertex");
+        assert_eq!(SphericalTriangle::new(v, v[0]).solid_angle(), 0.0, "seen from a vertex");
     }
 }

@@ -198,7 +198,7 @@ impl Scene {
             .filter(|&i| !matches!(self.lights[i as usize], Light::Area { .. }))
             .collect();
         let tree_power: f64 = emitters.iter().map(|l| powers[l.light as usize]).sum();
-        let share = tree_power / area_w.iter().sum::<f64>();
+        let share = tree_power / self.area_power.as_ref().map_or(1.0, Distribution1D::total);
         self.light_tree = LightTree::build(&emitters, self.lights.len()).map(|t| (t, share));
         let infinite_w: Vec<f64> = infinite.iter().map(|&i| powers[i as usize]).collect();
         self.infinite_power = Distribution1D::try_new(&infinite_w).map(|d| (infinite, d));

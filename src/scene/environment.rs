@@ -133,7 +133,7 @@ impl Environment {
         if u[0] < UNIFORM_SHARE {
             return Some(uniform_sphere([u[0] / UNIFORM_SHARE, u[1]]));
         }
-        let u0 = ((u[0] - UNIFORM_SHARE) / (1.0 - UNIFORM_SHARE)).min(1.0 - f32::EPSILON / 2.0);
+        let u0 = ((u[0] - UNIFORM_SHARE) / (1.0 - UNIFORM_SHARE)).min(crate::sampling::ONE_BELOW);
         let (k, ux) = dist.sample_remapped(u0);
         let (w, h) = (map.width as usize, map.height as usize);
         let (i, j) = (k % w, k / w);

@@ -5,8 +5,7 @@
 use super::light_tree::near;
 use crate::geometry::offset::barycentric_error;
 use crate::sampling::{
-    concentric_disk, solid_angle, spherical_triangle, uniform_cone, uniform_sphere, uniform_triangle, Frame,
-    SPHERICAL_SAMPLING,
+    concentric_disk, uniform_cone, uniform_sphere, uniform_triangle, Frame, SphericalTriangle, SPHERICAL_SAMPLING,
 };
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -91,19 +90,20 @@ pub fn spot_falloff(cos_theta: f32, cos_inner: f32, cos_outer: f32) -> f32 {
     }
 }
 
-/// How an emissive triangle is sampled from `p`: `Some(Ω)` by the solid angle Ω it subtends
-/// there where it is near ([`near`]: closer than 5 bounding radii, where area sampling's 1/d²
-/// would vary more than 2.25× over it) and Ω lies within [`SPHERICAL_SAMPLING`]; `None` by area
-/// (uniform in area is nearly uniform in solid angle for a far triangle, and much cheaper).
-/// Light sampling and MIS's density ([`area_light_pdf`]) decide alike, so their weights sum to
-/// one.
+/// How an emissive triangle is sampled from `p`: by the solid angle Ω it subtends there
+/// (`Some`: the triangle as seen from `p`, and Ω) where it is near ([`near`]: closer than 5
+/// bounding radii, where area sampling's 1/d² would vary more than 2.25× over it) and Ω lies
+/// within [`SPHERICAL_SAMPLING`]; `None` by area (uniform in area is nearly uniform in solid
+/// angle for a far triangle, and much cheaper). Light sampling and MIS's density
+/// ([`area_light_pdf`]) decide alike, so their weights sum to one.
 #[must_use]
-pub fn area_light_sampling(t: &TriangleGeom, p: Vec3) -> Option<f64> {
+pub fn area_light_sampling(t: &TriangleGeom, p: Vec3) -> Option<(SphericalTriangle, f64)> {
     if !near(&t.p, p) {
         return None;
     }
-    let omega = solid_angle(t.p, p);
-    SPHERICAL_SAMPLING.contains(&omega).then_some(omega)
+    let seen = SphericalTriangle::new(t.p, p);
+    let omega = seen.solid_angle();
+    SPHERICAL_SAMPLING.contains(&omega).then_some((seen, omega))
 }
 
 /// The density per steradian with which light sampling from `p` picks the direction `wi`
@@ -112,7 +112,7 @@ pub fn area_light_sampling(t: &TriangleGeom, p: Vec3) -> Option<f64> {
 #[must_use]
 pub fn area_light_pdf(t: &TriangleGeom, p: Vec3, wi: Vec3, distance: f32) -> f32 {
     match area_light_sampling(t, p) {
-        Some(omega) => (1.0 / omega) as f32,
+        Some((_, omega)) => (1.0 / omega) as f32,
         None => distance * distance / (t.area * wi.dot(t.n).abs()),
     }
 }
@@ -244,11 +244,11 @@ impl Light {
         match *self {
             Light::Area { radiance, .. } => {
                 let t = tri?;
-                let omega = area_light_sampling(t, p);
-                let b = match omega {
+                let spherical = area_light_sampling(t, p);
+                let b = match &spherical {
                     // Uniform in the solid angle it subtends: the point where the sampled
                     // direction crosses the triangle.
-                    Some(_) => crossing(t, p, spherical_triangle(t.p, p, u)?)?,
+                    Some((seen, _)) => crossing(t, p, seen.sample(u)?)?,
                     None => {
                         let (b1, b2) = uniform_triangle(u);
                         [1.0 - b1 - b2, b1, b2]
@@ -264,7 +264,7 @@ impl Light {
                     return None;
                 }
                 // Area measure → solid angle: d²/(A·cos θ_light).
-                let pdf = omega.map_or(dist2 / (t.area * cos_l), |o| (1.0 / o) as f32);
+                let pdf = spherical.map_or(dist2 / (t.area * cos_l), |(_, o)| (1.0 / o) as f32);
                 (pdf > 0.0 && pdf.is_finite()).then(|| Incident {
                     wi,
                     value: radiance / pdf,

@@ -7,6 +7,7 @@
 use super::light::Light;
 use super::light_tree::{LightSampler, LightTree, Receiver, DEFENSIVE_SHARE};
 use super::Scene;
+use crate::sampling::ONE_BELOW;
 
 impl Scene {
     /// Picks the light of a shadow ray toward receiver `r` with uniform `u`, among the lights
@@ -24,7 +25,6 @@ impl Scene {
             let k = power.sample(u);
             return Some((self.area_lights[k], power.pmf(k) as f32));
         };
-        const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
         let d = DEFENSIVE_SHARE;
         let (light, by_tree) = if u < d {
             let k = power.sample(u / d);

@@ -10,6 +10,7 @@
 //! probability of any light at any point ([`LightTree::pmf`]) follows the same walk, so MIS
 //! weighs light samples and BSDF samples with the density light sampling really had.
 
+use crate::sampling::ONE_BELOW;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use std::f32::consts::PI;
@@ -136,12 +137,13 @@ struct Node {
     sin_o: f32,
     /// Index in the scene's `lights` for a leaf; the second child's node index otherwise.
     index: u32,
-    /// A leaf's triangle (its vertices); `None` for an inner node.
-    leaf: Option<[Vec3; 3]>,
+    /// A point of a leaf's triangle (its first vertex), which with `axis` gives its plane;
+    /// `None` for an inner node.
+    leaf: Option<Vec3>,
 }
 
 impl Node {
-    fn new(b: &Bounds, index: u32, leaf: Option<[Vec3; 3]>) -> Node {
+    fn new(b: &Bounds, index: u32, leaf: Option<Vec3>) -> Node {
         Node {
             centre: b.centroid(),
             radius2: 0.25 * (b.hi - b.lo).length_squared(),
@@ -200,8 +202,8 @@ impl Node {
         // plane — next to nothing for a neighbour almost in the receiver's plane (a triangle of
         // the wall a receiver lies on), which the cone and sphere cannot tell from a facing one.
         let cos_light = match self.leaf {
-            Some(v) => {
-                let h = (r.p - v[0]).dot(self.axis);
+            Some(v0) => {
+                let h = (r.p - v0).dot(self.axis);
                 if !(h > 0.0) {
                     return 0.0;
                 }
@@ -282,29 +284,29 @@ impl LightTree {
         if items.is_empty() {
             return None;
         }
-        let mut vertices = vec![[Vec3::ZERO; 3]; light_count];
+        let mut corners = vec![Vec3::ZERO; light_count];
         for l in lights {
-            vertices[l.light as usize] = l.p;
+            corners[l.light as usize] = l.p[0];
         }
         let mut tree = LightTree { nodes: Vec::with_capacity(2 * items.len()), paths: vec![None; light_count] };
-        tree.build_node(&mut items, &vertices, 0, 0);
+        tree.build_node(&mut items, &corners, 0, 0);
         Some(tree)
     }
 
-    fn build_node(&mut self, items: &mut [(u32, Bounds)], vertices: &[[Vec3; 3]], depth: u32, path: u128) -> Bounds {
+    fn build_node(&mut self, items: &mut [(u32, Bounds)], corners: &[Vec3], depth: u32, path: u128) -> Bounds {
         let bounds = items[1..].iter().fold(items[0].1, |b, i| b.union(&i.1));
         let at = self.nodes.len();
         if items.len() == 1 {
-            self.nodes.push(Node::new(&bounds, items[0].0, Some(vertices[items[0].0 as usize])));
+            self.nodes.push(Node::new(&bounds, items[0].0, Some(corners[items[0].0 as usize])));
             self.paths[items[0].0 as usize] = Some(path);
             return bounds;
         }
         self.nodes.push(Node::new(&bounds, 0, None));
         let mid = if depth >= BALANCED_FROM { items.len() / 2 } else { split(items, &bounds) };
         let (first, second) = items.split_at_mut(mid);
-        self.build_node(first, vertices, depth + 1, path);
+        self.build_node(first, corners, depth + 1, path);
         self.nodes[at].index = self.nodes.len() as u32;
-        self.build_node(second, vertices, depth + 1, path | (1u128 << depth));
+        self.build_node(second, corners, depth + 1, path | (1u128 << depth));
         bounds
     }
 
@@ -374,9 +376,6 @@ impl LightTree {
         self.nodes.is_empty()
     }
 }
-
-/// The largest f32 below 1.
-const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Orders `items` and returns where to split them: the bucket boundary of least cost (power ×
 /// orientation measure × surface area of each side, Conty Estevez and Kulla's SAOH, the axis's

@@ -438,7 +438,7 @@ impl Scene {
                     let local = crate::sampling::cosine_hemisphere([(2.0 * u[0]).min(1.0), u[1]]);
                     crate::sampling::Frame::new(n).to_world(local)
                 } else {
-                    env.sample_direction([(2.0 * u[0] - 1.0).min(1.0 - f32::EPSILON / 2.0), u[1]])?
+                    env.sample_direction([(2.0 * u[0] - 1.0).min(crate::sampling::ONE_BELOW), u[1]])?
                 };
                 let (radiance, env_pdf) = env.radiance_pdf(wi);
                 let pdf = 0.5 * wi.dot(n).max(0.0) * std::f32::consts::FRAC_1_PI + 0.5 * env_pdf;

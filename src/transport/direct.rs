@@ -47,8 +47,9 @@ pub fn direct_light_rays(
     mut emit: impl FnMut(ShadowRay),
 ) {
     let scene = ctx.scene;
-    let (_, ns) = sp.frame.oriented(wo);
+    // The point, its shading normal on wo's side, and whether it takes light from behind.
     let r = receiver(sp, bsdf, wo);
+    let ns = r.n;
     let mut add = |light_index: u32, u: [f32; 2], weight: f32| {
         let light = &scene.lights[light_index as usize];
         let Some(inc) = scene.sample_incident(light, sp.p, ns, u) else { return };
