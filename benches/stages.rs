@@ -48,6 +48,8 @@ fn setup(threads: usize) -> World {
         shadows: ShadowQueue::default(),
         terms: Vec::new(),
         receivers: Vec::new(),
+        lobe_receivers: Vec::new(),
+        narrow_hits: Vec::new(),
         film: Vec::new(),
         open: Default::default(),
         rays: Default::default(),

@@ -185,6 +185,8 @@ fn camera_world(segments: &[(usize, PathKind)]) -> World {
         shadows: ShadowQueue::default(),
         terms: vec![Terms::default(); 8],
         receivers: vec![Default::default(); 8],
+        lobe_receivers: vec![Default::default(); 8],
+        narrow_hits: vec![false; 8],
         film: Vec::new(),
         open: Default::default(),
         rays: Default::default(),

@@ -137,6 +137,11 @@ impl Bsdf {
 /// could never light what lies behind it). The effects plan says which surfaces are which.
 pub const PHOTON_SPECULAR_ALPHA: f32 = 0.09;
 
+/// The Phong exponent as narrow as a GGX lobe of [`PHOTON_SPECULAR_ALPHA`]: 2/α² − 2, the usual
+/// match of the two lobes' widths (Walter et al. 2007); above it a Phong lobe is
+/// [`Bsdf::narrow_lobe`].
+pub const NARROW_PHONG_EXPONENT: f32 = 2.0 / (PHOTON_SPECULAR_ALPHA * PHOTON_SPECULAR_ALPHA) - 2.0;
+
 /// A named material: scattering plus emitted radiance from the front face.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -254,6 +259,15 @@ impl Material {
             Some(t) => self.emission * t.lookup(uv),
             None => self.emission,
         }
+    }
+
+    /// Whether some point of the material may have a narrow lobe ([`Bsdf::narrow_lobe`]): its
+    /// constant BSDF has one, or a roughness or metallic map may give one (a cheap test before
+    /// the point's own BSDF is built).
+    #[inline]
+    #[must_use]
+    pub fn may_have_narrow_lobe(&self) -> bool {
+        self.bsdf.narrow_lobe() || self.maps.roughness.is_some() || self.maps.metallic.is_some()
     }
 
     /// The scattering at texture coordinates `uv`: the constant BSDF with its textured colours

@@ -22,10 +22,11 @@ use crate::scene::{Scene, SurfacePoint};
 use crate::stats::{Numerics, RayCounts};
 use crate::transport::camera::render_pixels;
 use crate::transport::direct::{delta_light, direct_light, weighted_direct_light};
-use crate::transport::estimate::{camera_indirect_estimate, caustic_estimate, indirect_estimate, map_radiance};
+use crate::transport::estimate::{camera_indirect_estimate, caustic_estimate, indirect_estimate};
 use crate::transport::gather::{glossy_density, glossy_ray, lands_near, trace_gather_rays};
+use crate::transport::lobe::{gather_landing, lobe_escape, lobe_ray, Found};
 use crate::transport::mis::{emission_found, receiver, Strategies};
-use crate::transport::specular::{continue_chain, emission_toward, first_non_specular, ChainEnd};
+use crate::transport::specular::{continue_chain, emission_toward, follow_chain, Chain, ChainEnd};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
 
@@ -194,7 +195,8 @@ fn gather_hit(
     let (y, wo) = (&end.point, -end.dir);
     let bsdf = &ctx.scene.bsdf(y);
     if !lands_near(end.hit.t, end.bounces, bsdf, ctx.secondary_gather) {
-        return map_radiance(ctx, y, bsdf, wo, scratch).finish(ctx).into();
+        let e = gather_landing(ctx, end, chain, rays, scratch);
+        return Estimated { radiance: e.radiance, bias: e.bias, emission: Vec3::ZERO };
     }
     let direct = direct_light(ctx, y, bsdf, wo, &chain.fork(streams::SECONDARY_LIGHT), rays);
     let caustic = caustic_estimate(ctx, y, bsdf, wo, None, scratch).finish(ctx);
@@ -202,8 +204,8 @@ fn gather_hit(
     let mut far = Estimated::default();
     // A black surface sends no gather ray (as in `final_gather` and the wavefront engine).
     if kd != Vec3::ZERO {
-        trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, _, _| {
-            let e = map_radiance(ctx, &z.point, &ctx.scene.bsdf(&z.point), -z.dir, scratch).finish(ctx);
+        trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, stream, rays| {
+            let e = gather_landing(ctx, z, stream, rays, scratch);
             far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias, emission: Vec3::ZERO };
         });
     }
@@ -216,8 +218,9 @@ fn gather_hit(
 
 /// The glossy lobe's reflection: one ray sampled from the lobe; at its first non-specular hit,
 /// direct light, caustics and the global map without direct and caustic photons (so each path
-/// is counted once), and the emission it hits straight away, weighted against light sampling by
-/// `mis` (the direct term's). The bias is that of the two estimates.
+/// is counted once) — on a narrow lobe there, the base's and the lobe's own ray
+/// (`transport::lobe`) — and the emission it hits straight away, weighted against light
+/// sampling by `mis` (the direct term's). The bias is that of the estimates.
 #[allow(clippy::too_many_arguments)]
 pub fn glossy_reflection(
     ctx: &Context,
@@ -230,24 +233,45 @@ pub fn glossy_reflection(
     scratch: &mut Nearest,
 ) -> Estimated {
     let Some(ray) = glossy_ray(sp, bsdf, wo, s) else { return Estimated::default() };
-    let Some(ChainEnd { point: y, dir: d, beta, hit, bounces }) =
-        first_non_specular(ctx, ray.origin, ray.dir, s, streams::GLOSSY_CHAIN_BOUNCE, rays)
-    else {
-        return Estimated::default();
+    let density = glossy_density(&ray, mis, sp, bsdf, wo);
+    // From a narrow lobe, whose caustic estimate reads its base alone, the ray also counts what
+    // it finds through mirrors and glass, and the sky where nothing else finds it
+    // (`transport::lobe`).
+    let narrow = bsdf.narrow_lobe();
+    let (y, d, beta, hit, bounces) = match follow_chain(ctx, ray.origin, ray.dir, s, streams::GLOSSY_CHAIN_BOUNCE, rays)
+    {
+        Chain::Hit(ChainEnd { point, dir, beta, hit, bounces }) => (point, dir, beta, hit, bounces),
+        Chain::Escaped { dir, beta, bounces } if narrow => {
+            let sky = ray.weight * beta * lobe_escape(ctx.scene, dir, bounces, density);
+            return Estimated { radiance: sky, ..Default::default() };
+        }
+        _ => return Estimated::default(),
     };
     let b = &ctx.scene.bsdf(&y);
-    let direct = direct_light(ctx, &y, b, -d, &s.fork(streams::GLOSSY_HIT_LIGHT), rays);
+    // On a narrow lobe the maps read the base and the lobe sends its own ray (`transport::lobe`),
+    // against which the light samples there are weighed.
+    let lit = Strategies::at_landing(ctx, b);
+    let direct = weighted_direct_light(ctx, &y, b, -d, &s.fork(streams::GLOSSY_HIT_LIGHT), &lit, rays);
     let caustic = caustic_estimate(ctx, &y, b, -d, None, scratch).finish(ctx);
-    let rest = indirect_estimate(ctx, &y, b, -d, None, scratch).finish(ctx);
-    let w = ray.weight * beta;
-    let emission = if bounces == 0 {
-        w * emission_found(ctx, &receiver(sp, bsdf, wo), &hit, d, glossy_density(&ray, mis, sp, bsdf, wo))
+    let (rest, lobe) = if b.narrow_lobe() {
+        (
+            camera_indirect_estimate(ctx, &y, b, -d, None, scratch).finish(ctx),
+            lobe_ray(ctx, &y, b, -d, &s.fork(streams::LANDING_LOBE), Some(&lit), rays, scratch),
+        )
     } else {
-        Vec3::ZERO
+        (indirect_estimate(ctx, &y, b, -d, None, scratch).finish(ctx), Found::default())
+    };
+    let w = ray.weight * beta;
+    let (emission, through) = if bounces == 0 {
+        (w * emission_found(ctx, &receiver(sp, bsdf, wo), &hit, d, density), Vec3::ZERO)
+    } else if narrow {
+        (Vec3::ZERO, emission_toward(ctx.scene, &hit, -d))
+    } else {
+        (Vec3::ZERO, Vec3::ZERO)
     };
     Estimated {
-        radiance: w * (direct + caustic.radiance + rest.radiance),
-        bias: w * (caustic.bias + rest.bias),
+        radiance: w * (direct + caustic.radiance + rest.radiance + lobe.radiance + through),
+        bias: w * (caustic.bias + rest.bias + lobe.bias),
         emission,
     }
 }

@@ -296,7 +296,10 @@ pub fn photon_visibility(scene: &Scene, q: Vec3, n: Vec3, r: f32) -> impl Fn(Vec
 }
 
 /// Caustic-map radiance estimate at `sp` toward `wo`; `pixel` when `sp` is a camera path's first
-/// non-specular hit (progressive passes may give each pixel its own radius).
+/// non-specular hit (progressive passes may give each pixel its own radius). On a narrow lobe
+/// ([`Bsdf::narrow_lobe`]) photons are weighed by the base alone: the lobe's own ray (the
+/// camera hit's glossy ray, a landing's lobe ray, `super::lobe`) finds the light that mirrors
+/// and glass bring into it.
 #[inline]
 pub fn caustic_estimate<'a>(
     ctx: &Context<'a>,
@@ -308,7 +311,8 @@ pub fn caustic_estimate<'a>(
 ) -> Planned<'a> {
     let fixed = ctx.fixed.map(|r| r.caustic_at(pixel));
     let map: &'a PhotonMap = &ctx.maps.caustic;
-    plan_map(ctx, map, ctx.settings.caustic_k, ctx.caustic_radius, sp, bsdf, wo, 0, fixed, false, scratch)
+    let base = bsdf.narrow_lobe();
+    plan_map(ctx, map, ctx.settings.caustic_k, ctx.caustic_radius, sp, bsdf, wo, 0, fixed, base, scratch)
 }
 
 /// Global-map radiance estimate at `sp` toward `wo`, ignoring photons with any `mask` flag;
@@ -360,10 +364,11 @@ pub fn indirect_estimate<'a>(
     global_part(ctx, sp, bsdf, wo, flags::OWN_TERMS, pixel, false, scratch)
 }
 
-/// [`indirect_estimate`] at a camera path's own vertex, where a glossy lobe is followed by its
-/// own ray ([`crate::transport::gather::glossy_ray`]): photons are weighed by the part of the
-/// BSDF that ray does not sample (a Phong material's kd/π, a rough plastic's base; nothing for
-/// a rough conductor or dielectric), so no path is counted twice.
+/// [`indirect_estimate`] at a vertex whose glossy lobe is followed by its own ray (a camera
+/// path's, [`crate::transport::gather::glossy_ray`], or a glossy ray's landing on a narrow
+/// lobe, `super::lobe`): photons are weighed by the part of the BSDF that ray does not sample (a
+/// Phong material's kd/π, a rough plastic's base; nothing for a rough conductor or dielectric),
+/// so no path is counted twice.
 #[inline]
 pub fn camera_indirect_estimate<'a>(
     ctx: &Context<'a>,
@@ -374,6 +379,19 @@ pub fn camera_indirect_estimate<'a>(
     scratch: &mut Nearest,
 ) -> Planned<'a> {
     global_part(ctx, sp, bsdf, wo, flags::OWN_TERMS, pixel, true, scratch)
+}
+
+/// The global map's whole estimate at `sp` toward `wo` with photons weighed by the base alone:
+/// where a gather ray lands on a narrow lobe, whose own ray reads the rest (`super::lobe`).
+#[inline]
+pub fn base_radiance<'a>(
+    ctx: &Context<'a>,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    scratch: &mut Nearest,
+) -> Planned<'a> {
+    global_part(ctx, sp, bsdf, wo, 0, None, true, scratch)
 }
 
 /// Radiance leaving a non-specular point toward `wo` as the photon maps see it: kd/π × the

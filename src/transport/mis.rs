@@ -32,11 +32,12 @@ use std::f32::consts::FRAC_1_PI;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Strategies {
     /// None: light sampling carries all direct light, unweighted (a secondary vertex of the
-    /// photon mapper, whose rays read the maps instead; or MIS turned off).
+    /// photon mapper without a narrow lobe, whose rays read the maps instead; or MIS turned
+    /// off).
     LightOnly,
     /// The photon mapper's camera hit: `gather` cosine-weighted final-gather rays over the
     /// diffuse base ([`Bsdf::eval_base`]) and, with `glossy`, the glossy ray over the lobe
-    /// ([`Bsdf::eval_lobe`]).
+    /// ([`Bsdf::eval_lobe`]); at a glossy ray's landing on a narrow lobe, that lobe's ray alone.
     Split {
         /// Final-gather rays (0 where none are sent).
         gather: u32,
@@ -59,6 +60,18 @@ impl Strategies {
         let gather =
             if ctx.effects.final_gather.on && bsdf.diffuse() != Vec3::ZERO { ctx.settings.gather_rays } else { 0 };
         Strategies::Split { gather, glossy: bsdf.has_glossy_lobe() }
+    }
+
+    /// What the landing point of a glossy ray sends on `bsdf`: the lobe's own ray where the lobe
+    /// is narrow ([`Bsdf::narrow_lobe`], `super::lobe`); light sampling alone elsewhere, or with
+    /// `mis = false`.
+    #[must_use]
+    pub fn at_landing(ctx: &Context, bsdf: &Bsdf) -> Self {
+        if ctx.settings.mis && bsdf.narrow_lobe() {
+            Strategies::Split { gather: 0, glossy: true }
+        } else {
+            Strategies::LightOnly
+        }
     }
 
     /// Density of the final-gather rays toward `wi` (rays × pdf); 0 without them. Inline: out of

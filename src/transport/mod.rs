@@ -10,6 +10,7 @@
 //! - [`mis`]: multiple importance sampling of emitters, light samples against BSDF samples;
 //! - [`gather`]: final-gather and glossy ray generation, and where the secondary gather applies;
 //! - [`estimate`]: photon-map density estimates at a surface point;
+//! - [`lobe`]: where gather and glossy rays land on a narrow lobe, its own ray;
 //! - [`maps`]: the photon maps of a render and Christensen's precomputed irradiance.
 //!
 //! Each function handles one vertex, except two loops every one-ray engine shares: the pixel
@@ -22,6 +23,7 @@ pub mod camera;
 pub mod direct;
 pub mod estimate;
 pub mod gather;
+pub mod lobe;
 pub mod maps;
 pub mod mis;
 pub mod photon;

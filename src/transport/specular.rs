@@ -89,40 +89,76 @@ pub struct ChainEnd {
     pub bounces: u32,
 }
 
+/// How a chain through mirrors and glass ended.
+#[derive(Clone, Copy, Debug)]
+pub enum Chain {
+    /// At its first non-specular hit.
+    Hit(ChainEnd),
+    /// Leaving the scene along `dir` with throughput `beta`.
+    Escaped {
+        /// Direction of the last segment.
+        dir: Vec3,
+        /// Throughput of the chain.
+        beta: Vec3,
+        /// Mirrors and glass on the way.
+        bounces: u32,
+    },
+    /// Absorbed, ended by roulette, or cut at `max_depth` (counted in the context).
+    Lost,
+}
+
 /// Follows a ray through mirrors and glass (at most `max_depth` bounces, sampling each with `s`
 /// at bounce `first_bounce + depth`, [`continue_chain`]'s roulette included) to its first
-/// non-specular hit. `None` if it escapes, is absorbed, or is cut at `max_depth` (counted in
-/// `ctx`). It also passes what photons pass ([`Bsdf::photon_specular`]: frosted glass, smooth
-/// rough metal), sampling their BSDF: every path ends where photons are stored, so the maps
-/// read there hold the light that came through.
-pub fn first_non_specular(
+/// non-specular hit, or out of the scene. It also passes what photons pass
+/// ([`Bsdf::photon_specular`]: frosted glass, smooth rough metal), sampling their BSDF: every
+/// path ends where photons are stored, so the maps read there hold the light that came through.
+pub fn follow_chain(
     ctx: &Context,
     mut o: Vec3,
     mut d: Vec3,
     s: &Sampler,
     first_bounce: u32,
     rays: &mut RayCounts,
-) -> Option<ChainEnd> {
+) -> Chain {
     let scene = ctx.scene;
     let mut beta = Vec3::ONE;
     for depth in 0..=ctx.settings.max_depth {
         rays.gather += 1;
-        let hit = scene.intersect(o, d, f32::INFINITY)?;
+        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else {
+            return Chain::Escaped { dir: d, beta, bounces: depth };
+        };
         beta *= scene.interior_transmittance(&hit, d);
         let sp = scene.surface(&hit);
         let bsdf = &scene.bsdf(&sp);
         if !(bsdf.is_delta() || bsdf.photon_specular()) {
-            return Some(ChainEnd { point: sp, dir: d, beta, hit, bounces: depth });
+            return Chain::Hit(ChainEnd { point: sp, dir: d, beta, hit, bounces: depth });
         }
         if depth == ctx.settings.max_depth {
             ctx.cut();
-            return None;
+            return Chain::Lost;
         }
-        let next = continue_chain(&sp, bsdf, -d, s, first_bounce + depth, depth)?;
+        let Some(next) = continue_chain(&sp, bsdf, -d, s, first_bounce + depth, depth) else { return Chain::Lost };
         beta *= next.weight;
         (o, d) = (next.origin, next.dir);
     }
-    None
+    Chain::Lost
+}
+
+/// [`follow_chain`]'s first non-specular hit; `None` if the chain escapes, is absorbed, or is
+/// cut at `max_depth` (counted in `ctx`).
+#[inline]
+pub fn first_non_specular(
+    ctx: &Context,
+    o: Vec3,
+    d: Vec3,
+    s: &Sampler,
+    first_bounce: u32,
+    rays: &mut RayCounts,
+) -> Option<ChainEnd> {
+    match follow_chain(ctx, o, d, s, first_bounce, rays) {
+        Chain::Hit(end) => Some(end),
+        _ => None,
+    }
 }
 
 /// Radiance emitted at `hit` toward `wo` (zero from its back face or a non-emitter; an

@@ -17,7 +17,9 @@
 //!   of a one-ray final gather;
 //! - fork [`glossy`]`(d)`: the glossy lobe at the `d`-th hit, bounce 0 dims 0–1 = its direction;
 //!   its specular chain samples from bounce 1; direct light where it lands forks
-//!   [`GLOSSY_HIT_LIGHT`].
+//!   [`GLOSSY_HIT_LIGHT`];
+//! - where a gather ray (its own stream) or the glossy ray lands on a narrow lobe, that lobe's
+//!   ray forks [`LANDING_LOBE`] from the landing ray's stream.
 //!
 //! Photon path `i` (`Domain::GlobalPhoton` or `Domain::CausticPhoton`, index `i`): bounce 0
 //! dim 0 picks the light, dims 1–4 sample its emission; bounce `b + 1` dims 0–2 sample the BSDF
@@ -44,6 +46,11 @@ pub const GLOSSY_HIT_LIGHT: u64 = 7;
 pub const SECONDARY_LIGHT: u64 = 8;
 /// Fork of a gather ray's stream for the one-ray gather where it lands near its origin.
 pub const SECONDARY_GATHER: u64 = 9;
+
+/// Fork of a gather or glossy ray's stream for the ray of the narrow lobe it landed on
+/// (`super::lobe`), drawn as a glossy ray: bounce 0 its direction, its chain from
+/// [`GLOSSY_CHAIN_BOUNCE`].
+pub const LANDING_LOBE: u64 = 10;
 
 /// Fork tag of direct light at a camera path's `depth`-th hit.
 #[must_use]

@@ -79,6 +79,8 @@ fn worker_world(scene: &Arc<Scene>, job: &Job, maps: &Arc<PhotonMaps>, camera: &
         shadows: ShadowQueue::default(),
         terms: Vec::new(),
         receivers: Vec::new(),
+        lobe_receivers: Vec::new(),
+        narrow_hits: Vec::new(),
         film: Vec::new(),
         open: PixelMean::default(),
         rays: RayCounts::default(),

@@ -8,6 +8,7 @@ use super::{CameraWork, PhotonWork, Shared, StageClock, StageStats};
 use crate::film::Term;
 use crate::photon_map::Photon;
 use crate::rng::Domain;
+use crate::transport::lobe::{lobe_emission, lobe_escape};
 use crate::transport::mis::emission_found;
 use crate::transport::photon::deposit_photon;
 use crate::transport::specular::emission_toward;
@@ -42,7 +43,8 @@ pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
 /// Camera rays add the radiance of emitters whose front face they hit, and of the environment
 /// and the sun when they leave the scene; gather and glossy rays add the emission they hit
 /// straight away, weighted against light sampling ([`emission_found`]), to the direct term of
-/// the path they left.
+/// the path they left; a narrow lobe's ray adds what it finds to its landing's term
+/// (`transport::lobe`).
 pub fn deposit_emission(
     shared: Res<Shared>,
     maps: Res<super::Maps>,
@@ -55,22 +57,39 @@ pub fn deposit_emission(
     let w = &mut *work;
     let mut n = 0;
     for i in 0..w.paths.len() {
-        if w.paths.kind[i] != PathKind::Camera {
-            let density = w.paths.mis[i];
-            if !(density > 0.0 && w.paths.depth[i] == 0) {
-                continue;
-            }
-            let Some(hit) = w.paths.hits.get(i) else { continue };
-            let r = &w.receivers[w.paths.sample[i] as usize];
-            let found = emission_found(&ctx, r, &hit, w.paths.rays.direction(i), density);
+        let (kind, sample, depth) = (w.paths.kind[i], w.paths.sample[i] as usize, w.paths.depth[i]);
+        let hit = w.paths.hits.get(i);
+        // Rays from a narrow lobe — a landing's lobe ray, or a camera hit's glossy ray on one —
+        // also count what they find through mirrors and glass and leaving the scene, in the term
+        // they carry (`transport::lobe`); a glossy ray's emitter hit straight away goes below.
+        let from_narrow = kind == PathKind::Lobe || (kind == PathKind::Glossy && w.narrow_hits[sample]);
+        if from_narrow && !(kind == PathKind::Glossy && depth == 0 && hit.is_some()) {
+            let (density, dir) = (w.paths.mis[i], w.paths.rays.direction(i));
+            let found = match hit {
+                Some(hit) => {
+                    let from = if kind == PathKind::Lobe { &w.lobe_receivers[sample] } else { &w.receivers[sample] };
+                    lobe_emission(&ctx, from, &hit, dir, depth, density)
+                }
+                None => lobe_escape(scene, dir, depth, density),
+            };
             if found != Vec3::ZERO {
                 n += 1;
-                let term = Term::Direct.seen(w.paths.through_specular[i]);
-                w.terms[w.paths.sample[i] as usize].add(term, w.paths.beta[i] * found);
+                w.terms[sample].add(w.paths.term[i], w.paths.beta[i] * found);
             }
             continue;
         }
-        let emission = match w.paths.hits.get(i) {
+        if kind != PathKind::Camera {
+            let density = w.paths.mis[i];
+            let Some(hit) = hit.filter(|_| density > 0.0 && depth == 0) else { continue };
+            let found = emission_found(&ctx, &w.receivers[sample], &hit, w.paths.rays.direction(i), density);
+            if found != Vec3::ZERO {
+                n += 1;
+                let term = Term::Direct.seen(w.paths.through_specular[i]);
+                w.terms[sample].add(term, w.paths.beta[i] * found);
+            }
+            continue;
+        }
+        let emission = match hit {
             Some(hit) => emission_toward(scene, &hit, -w.paths.rays.direction(i)),
             // Leaving the scene: the environment and the sun.
             None if scene.has_background() => scene.background(w.paths.rays.direction(i)),
@@ -81,7 +100,7 @@ pub fn deposit_emission(
         }
         n += 1;
         let term = Term::Emitted.seen(w.paths.through_specular[i]);
-        w.terms[w.paths.sample[i] as usize].add(term, w.paths.beta[i] * emission);
+        w.terms[sample].add(term, w.paths.beta[i] * emission);
     }
     stats.record("deposit_emission", n, t);
 }

@@ -55,6 +55,10 @@ pub fn emit_camera_rays(shared: Res<Shared>, mut work: ResMut<CameraWork>, mut s
     w.terms.resize(w.count, Terms::default());
     w.receivers.clear();
     w.receivers.resize(w.count, Receiver::default());
+    w.lobe_receivers.clear();
+    w.lobe_receivers.resize(w.count, Receiver::default());
+    w.narrow_hits.clear();
+    w.narrow_hits.resize(w.count, false);
     for lane in 0..w.count {
         let (sampler, origin, dir) = camera_ray(&shared.job, &w.camera, w.first_sample + lane as u64);
         w.paths.push(Segment {

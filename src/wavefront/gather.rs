@@ -13,7 +13,8 @@ use crate::photon_map::query_packet::PACKET;
 use crate::photon_map::{Estimate, Nearest};
 use crate::scene::SurfacePoint;
 use crate::transport::estimate::{
-    camera_indirect_estimate, caustic_estimate, indirect_estimate, map_radiance, run_packet, FixedLookup, Planned,
+    base_radiance, camera_indirect_estimate, caustic_estimate, indirect_estimate, map_radiance, run_packet,
+    FixedLookup, Planned,
 };
 use crate::transport::Context;
 use bevy_ecs::prelude::*;
@@ -175,7 +176,8 @@ pub fn gather_caustics(
 /// Global-map estimates at diffuse hits: gather rays read the maps' radiance (not those that
 /// landed near, whose secondary gather reads them a bounce later); glossy rays, and camera rays
 /// when final gathering is off, read the global map without direct and caustic photons (those
-/// terms are computed separately).
+/// terms are computed separately). Where gather and glossy rays land on a narrow lobe they read
+/// its base, and the lobe's ray reads the maps' radiance where it lands (`transport::lobe`).
 pub fn gather_global(
     shared: Res<Shared>,
     maps: Res<Maps>,
@@ -195,9 +197,14 @@ pub fn gather_global(
         },
         Term::Indirect,
         |ctx, sp, bsdf, wo, kind, pixel, scratch| {
-            if kind.reads_maps() {
+            // On a narrow lobe gather and glossy rays read the base; the lobe's own ray
+            // (`PathKind::Lobe`) reads the rest.
+            let narrow = kind != PathKind::Lobe && bsdf.narrow_lobe();
+            if kind.reads_maps() && narrow {
+                base_radiance(ctx, sp, bsdf, wo, scratch)
+            } else if kind.reads_maps() {
                 map_radiance(ctx, sp, bsdf, wo, scratch)
-            } else if kind == PathKind::Camera {
+            } else if kind == PathKind::Camera || narrow {
                 camera_indirect_estimate(ctx, sp, bsdf, wo, pixel, scratch)
             } else {
                 indirect_estimate(ctx, sp, bsdf, wo, pixel, scratch)

@@ -294,13 +294,17 @@ pub enum PathKind {
     NearGather = 3,
     /// The secondary gather's one more gather ray: reads the photon maps where it lands.
     SecondaryGather = 4,
+    /// The ray of a narrow lobe where a gather or glossy ray landed (`transport::lobe`): the
+    /// emission it finds and the photon maps where it lands.
+    Lobe = 5,
 }
 
 impl PathKind {
-    /// Reads the photon maps' radiance where it lands (a gather ray that did not land near).
+    /// Reads the photon maps' radiance where it lands (a gather ray that did not land near, a
+    /// narrow lobe's ray).
     #[must_use]
     pub fn reads_maps(self) -> bool {
-        matches!(self, PathKind::Gather | PathKind::SecondaryGather)
+        matches!(self, PathKind::Gather | PathKind::SecondaryGather | PathKind::Lobe)
     }
 }
 

@@ -76,6 +76,13 @@ pub struct CameraWork {
     /// gather and glossy rays that leave it weigh the emission they find for that point
     /// (`transport::mis::emission_found`). A camera path has at most one such hit.
     pub receivers: Vec<Receiver>,
+    /// Per sample, the receiver where its glossy ray landed on a narrow lobe: that lobe's ray
+    /// weighs the emission it finds for it (`transport::lobe`). A sample has at most one.
+    pub lobe_receivers: Vec<Receiver>,
+    /// Per sample, whether its camera path's non-specular hit is a narrow lobe: its glossy ray
+    /// then also counts what it finds through mirrors and glass and leaving the scene
+    /// (`transport::lobe`).
+    pub narrow_hits: Vec<bool>,
     /// The tile's pixels, resolved after each wave's bounce loop (a tile of one pixel with more
     /// samples than a wave holds takes several waves: [`super::camera_pass::camera_pass`]).
     pub film: Vec<Terms>,

@@ -124,6 +124,7 @@ pub fn camera_schedules() -> [Schedule; 2] {
             shade::shade_direct.run_if(shadow_rays_on),
             shade::spawn_gather_rays.run_if(final_gather_on),
             shade::spawn_glossy_rays,
+            shade::spawn_lobe_rays,
             shade::reflect_paths,
             shade::refract_paths.run_if(refraction_on),
         )

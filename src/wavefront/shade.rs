@@ -1,7 +1,8 @@
 //! Shade: what each lane does next. Photons scatter (BSDF sample, Russian roulette) into the
 //! next photon queue. Camera-pass lanes at diffuse hits queue shadow rays (direct light) and
 //! spawn final-gather and glossy rays; gather lanes that landed near queue shadow rays and spawn
-//! their secondary gather's ray; lanes at mirrors and glass continue. After the bounce loop,
+//! their secondary gather's ray; gather and glossy lanes that landed on a narrow lobe spawn its
+//! ray; lanes at mirrors and glass continue. After the bounce loop,
 //! `resolve_wave` turns the tile's samples into pixels. Reads classified lanes and hits; writes
 //! the next queues, the shadow queue and the film.
 
@@ -11,6 +12,7 @@ use crate::film::Term;
 use crate::rng::{Domain, Sampler};
 use crate::transport::direct::{direct_light_rays, ShadowRay};
 use crate::transport::gather::{gather_rays, glossy_density, glossy_ray};
+use crate::transport::lobe::lobe_density;
 use crate::transport::mis::{receiver, Strategies};
 use crate::transport::photon::{scatter_photon, PathEnd, Scattered};
 use crate::transport::specular::continue_chain;
@@ -120,10 +122,11 @@ pub fn shade_direct(shared: Res<Shared>, maps: Res<Maps>, mut work: ResMut<Camer
         };
         let (beta, sample) = (paths.beta[i], paths.sample[i]);
         let delta_only = !bsdf.is_delta() && bsdf.photon_specular();
-        // Only a camera path's own non-specular hit sends the rays its light samples are
-        // weighed against (as in the reference).
+        // Only a camera path's own non-specular hit, and a glossy ray's landing on a narrow
+        // lobe, send the rays their light samples are weighed against (as in the reference).
         let mis = match paths.kind[i] {
             PathKind::Camera if !delta_only => Strategies::at_camera_hit(&ctx, bsdf),
+            PathKind::Glossy => Strategies::at_landing(&ctx, bsdf),
             _ => Strategies::LightOnly,
         };
         let wo = -paths.rays.direction(i);
@@ -226,7 +229,7 @@ pub fn spawn_glossy_rays(
     let t = StageClock::start();
     let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
     let scene = &*shared.scene;
-    let CameraWork { paths, classified, next, receivers, .. } = &mut *work;
+    let CameraWork { paths, classified, next, receivers, narrow_hits, .. } = &mut *work;
     let before = next.len();
     for &l in &classified.diffuse {
         let i = l as usize;
@@ -245,6 +248,7 @@ pub fn spawn_glossy_rays(
         let Some(ray) = glossy_ray(&sp, bsdf, wo, &gls) else { continue };
         let mis = Strategies::at_camera_hit(&ctx, bsdf);
         receivers[paths.sample[i] as usize] = receiver(&sp, bsdf, wo);
+        narrow_hits[paths.sample[i] as usize] = bsdf.narrow_lobe();
         next.push(Segment {
             origin: ray.origin,
             dir: ray.dir,
@@ -261,6 +265,62 @@ pub fn spawn_glossy_rays(
     }
     let count = next.len() - before;
     stats.record("spawn_glossy_rays", count, t);
+}
+
+/// Gather and glossy lanes that landed on a narrow lobe spawn that lobe's ray
+/// (`transport::lobe`): from a glossy lane's landing, whose light samples it is weighed
+/// against, with that point as the sample's lobe receiver; from a gather lane's, with nothing to
+/// weigh against (density ∞).
+pub fn spawn_lobe_rays(
+    shared: Res<Shared>,
+    maps: Res<Maps>,
+    mut work: ResMut<CameraWork>,
+    mut stats: ResMut<StageStats>,
+) {
+    let t = StageClock::start();
+    let ctx = Context::new(&shared.scene, &maps.0, &shared.job);
+    let scene = &*shared.scene;
+    let CameraWork { paths, classified, next, lobe_receivers, .. } = &mut *work;
+    let before = next.len();
+    for &l in &classified.diffuse {
+        let i = l as usize;
+        let kind = paths.kind[i];
+        if !matches!(kind, PathKind::Gather | PathKind::SecondaryGather | PathKind::Glossy) {
+            continue;
+        }
+        let Some(hit) = paths.hits.get(i) else { continue };
+        // Most landings are on materials without one: no surface point built for those.
+        if !scene.materials[scene.material[hit.tri as usize] as usize].may_have_narrow_lobe() {
+            continue;
+        }
+        let sp = scene.surface(&hit);
+        let bsdf = &scene.bsdf(&sp);
+        if !bsdf.narrow_lobe() {
+            continue;
+        }
+        let s = Sampler::from_key(paths.key[i]).fork(streams::LANDING_LOBE);
+        let wo = -paths.rays.direction(i);
+        let Some(ray) = glossy_ray(&sp, bsdf, wo, &s) else { continue };
+        let lit = (kind == PathKind::Glossy).then(|| Strategies::at_landing(&ctx, bsdf));
+        if lit.is_some() {
+            lobe_receivers[paths.sample[i] as usize] = receiver(&sp, bsdf, wo);
+        }
+        next.push(Segment {
+            origin: ray.origin,
+            dir: ray.dir,
+            sample: paths.sample[i],
+            kind: PathKind::Lobe,
+            key: s.key(),
+            base: streams::GLOSSY_CHAIN_BOUNCE as u8,
+            depth: 0,
+            beta: paths.beta[i] * ray.weight,
+            term: paths.term[i],
+            through_specular: paths.through_specular[i],
+            mis: lobe_density(&ray, lit.as_ref(), &sp, bsdf, wo),
+        });
+    }
+    let count = next.len() - before;
+    stats.record("spawn_lobe_rays", count, t);
 }
 
 /// Continues the lanes at mirrors (or, with `glass`, at glass) into the next queue by sampling
