@@ -215,6 +215,28 @@ fn presets_set_only_amounts_of_work() {
     }
 }
 
+/// Spreading a one-pass render over passes: 1 spp and photons / spp a pass (the caustic map's
+/// too), but at least one global photon per pixel (`GLOBAL_PHOTONS_PER_PIXEL`) — not when the
+/// photons are given per pass.
+#[test]
+fn passes_trace_at_least_a_global_photon_per_pixel() {
+    use photonwave::progressive::{per_pass, PerPass, GLOBAL_PHOTONS_PER_PIXEL};
+    assert_eq!(GLOBAL_PHOTONS_PER_PIXEL, 1);
+    let file = |w: u32| Settings {
+        width: w,
+        height: w,
+        spp: 16,
+        photons: 200_000,
+        caustic_photons: 100_000,
+        ..Default::default()
+    };
+    let amounts = |s: &Settings| (s.spp, s.photons, s.caustic_photons);
+    assert_eq!(amounts(&per_pass(&file(64), PerPass::default())), (1, 12_500, 6_250));
+    assert_eq!(amounts(&per_pass(&file(256), PerPass::default())), (1, 65_536, 6_250));
+    let given = PerPass { photons: true, ..PerPass::default() };
+    assert_eq!(amounts(&per_pass(&file(256), given)), (1, 200_000, 6_250));
+}
+
 /// `render --preset reference`: the preset's amounts are per pass, flags override them, and
 /// without a preset `--passes` spreads the default amounts over the passes.
 #[test]
