@@ -22,6 +22,7 @@ use crate::stats::RenderStats;
 use crate::transport::camera::probe_first_surfaces;
 use crate::transport::estimate::{caustic_estimate, global_estimate, indirect_estimate};
 use crate::transport::gather::trace_gather_rays;
+use crate::transport::specular::Chain;
 use crate::transport::{streams, Context};
 
 /// The diagnostic layers of `job`'s pass of `scene` seen through `rays` (see the module notes).
@@ -47,7 +48,8 @@ pub fn probe(scene: &Scene, rays: &CameraRays, job: &Job) -> EstimateLayers {
         } else if gather_on {
             let (mut sum, mut hits) = ([0.0f64; 2], 0u32);
             let gather = s.fork(streams::gather(0));
-            trace_gather_rays(&ctx, sp, -d, settings.gather_rays, &gather, counts, |end, _, _, _| {
+            trace_gather_rays(&ctx, sp, -d, settings.gather_rays, &gather, counts, |chain, _, _, _| {
+                let Chain::Hit(end) = chain else { return };
                 let bsdf = &scene.bsdf(&end.point);
                 let e = global_estimate(&ctx, &end.point, bsdf, -end.dir, 0, None, scratch).finish(&ctx);
                 sum[0] += f64::from(e.radius);

@@ -185,6 +185,20 @@ fn both_engines_see_the_sky_and_agree_per_pixel() {
     assert!(background > 300 && cube.len() > 200, "{background} background and {} cube pixels", cube.len());
     let (m, se) = mean_and_se(&cube);
     assert!((m - f64::from(KD)).abs() <= 4.0 * se, "cube {m} ± {se} against kd = {KD}");
+    // The path tracer weighs its sky samples against its next bounce (MIS): the cube's pixels
+    // return kd·L too, with and without MIS.
+    for mis in [true, false] {
+        let pt = render_path(&loaded, &Settings { mis, ..s.clone() });
+        let cube: Vec<f32> = pt
+            .pixels
+            .iter()
+            .zip(&a.pixels)
+            .filter(|(_, p)| p.emitted == Vec3::ZERO)
+            .map(|(t, _)| (t.beauty() - t.emitted).x / sky.x)
+            .collect();
+        let (m, se) = mean_and_se(&cube);
+        assert!((m - f64::from(KD)).abs() <= 4.0 * se, "path tracer (mis {mis}): cube {m} ± {se} against kd = {KD}");
+    }
 }
 
 #[test]

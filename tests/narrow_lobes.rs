@@ -6,7 +6,9 @@
 //! - A gather ray's landing (nothing sampled the lights there) reads the base and sends the
 //!   lobe's ray, which counts the emission it finds whole.
 //! - A glossy ray's landing samples the lights and sends the lobe's ray; the two are weighed by
-//!   MIS, so their sum is Le·R in expectation.
+//!   MIS, so their sum is Le·R in expectation — under the ceiling, and under a constant sky of
+//!   the same radiance, whose light samples are weighed against the lobe's ray as emitters'
+//!   are (light sampling alone reached 700·Le·R there).
 //!
 //! Tolerances: each mean within 4 standard errors of its 4 096 estimates plus 10⁻³ relative (the
 //! f32 sums and R's own sampling error, ~10⁻⁴); and every single estimate at most 3·Le·R. Light
@@ -23,7 +25,7 @@ use glam::Vec3;
 use photonwave::material::{Bsdf, Material};
 use photonwave::microfacet::Alpha;
 use photonwave::rng::{Domain, Sampler};
-use photonwave::scene::{MeshInput, Scene, SurfacePoint};
+use photonwave::scene::{Environment, MeshInput, Scene, SurfacePoint};
 use photonwave::settings::Settings;
 use photonwave::transport::direct::weighted_direct_light;
 use photonwave::transport::lobe::{gather_landing, lobe_ray};
@@ -81,6 +83,27 @@ fn assert_bounded_around(what: &str, values: &[f32], want: f64) {
     assert!(f64::from(max) <= 3.0 * want, "{what}: an estimate of {max} against Le·R {want}");
 }
 
+/// What a glossy ray's landing at `sp` (seen from `wo`) returns in 4 096 estimates of seed
+/// `seed`: its MIS-weighted light samples plus its lobe's ray.
+fn glossy_landing(scene: &Scene, sp: &SurfacePoint, wo: Vec3, seed: u64) -> Vec<f32> {
+    let bsdf = scene.bsdf(sp);
+    let maps = PhotonMaps::default();
+    let job = common::job(scene, &Settings::default());
+    let ctx = Context::new(scene, &maps, &job);
+    let lit = Strategies::at_landing(&ctx, &bsdf);
+    assert_eq!(lit, Strategies::Split { gather: 0, glossy: true });
+    (0..4096)
+        .map(|i| {
+            let s = Sampler::new(seed, Domain::Camera, i);
+            let (mut rays, mut scratch) = (Default::default(), Default::default());
+            let light = weighted_direct_light(&ctx, sp, &bsdf, wo, &s.fork(streams::GLOSSY_HIT_LIGHT), &lit, &mut rays);
+            let lobe =
+                lobe_ray(&ctx, sp, &bsdf, wo, &s.fork(streams::LANDING_LOBE), Some(&lit), &mut rays, &mut scratch);
+            light.x + lobe.radiance.x
+        })
+        .collect()
+}
+
 #[test]
 fn a_gather_rays_landing_on_a_near_mirror_reads_its_lobe_by_a_ray() {
     let scene = coat_under_ceiling();
@@ -106,25 +129,34 @@ fn a_gather_rays_landing_on_a_near_mirror_reads_its_lobe_by_a_ray() {
 fn a_glossy_rays_landing_weighs_its_light_samples_against_the_lobes_ray() {
     let scene = coat_under_ceiling();
     let (sp, wo) = landing(&scene);
-    let bsdf = scene.bsdf(&sp);
     let want = f64::from(LE) * albedo(&scene, &sp, wo);
-    let maps = PhotonMaps::default();
-    let job = common::job(&scene, &Settings::default());
-    let ctx = Context::new(&scene, &maps, &job);
-    let lit = Strategies::at_landing(&ctx, &bsdf);
-    assert_eq!(lit, Strategies::Split { gather: 0, glossy: true });
-    let values: Vec<f32> = (0..4096)
-        .map(|i| {
-            let s = Sampler::new(6, Domain::Camera, i);
-            let (mut rays, mut scratch) = (Default::default(), Default::default());
-            let light =
-                weighted_direct_light(&ctx, &sp, &bsdf, wo, &s.fork(streams::GLOSSY_HIT_LIGHT), &lit, &mut rays);
-            let lobe =
-                lobe_ray(&ctx, &sp, &bsdf, wo, &s.fork(streams::LANDING_LOBE), Some(&lit), &mut rays, &mut scratch);
-            light.x + lobe.radiance.x
-        })
-        .collect();
-    assert_bounded_around("glossy landing", &values, want);
+    assert_bounded_around("glossy landing", &glossy_landing(&scene, &sp, wo, 6), want);
+}
+
+#[test]
+fn a_glossy_rays_landing_under_the_sky_weighs_its_sky_samples_against_the_lobes_ray() {
+    // The coat alone under a constant sky of radiance 1: Le·R as under the ceiling, where the
+    // lobe's ray now leaves the scene and its light samples pick the environment.
+    let floor = coat_under_ceiling();
+    let (sp, wo) = landing(&floor);
+    let want = f64::from(LE) * albedo(&floor, &sp, wo);
+    let mesh = MeshInput {
+        source: "floor".into(),
+        positions: vec![
+            Vec3::new(-10.0, 0.0, -10.0),
+            Vec3::new(10.0, 0.0, -10.0),
+            Vec3::new(10.0, 0.0, 10.0),
+            Vec3::new(-10.0, 0.0, 10.0),
+        ],
+        triangles: vec![[0, 2, 1], [0, 3, 2]],
+        material: vec![0, 0],
+        ..Default::default()
+    };
+    let coat = Material::new("coat", Bsdf::rough_plastic(Vec3::ZERO, 1.5, Alpha::ggx(0.01)), Vec3::ZERO);
+    let sky = Some(Environment::constant(Vec3::splat(LE)));
+    let scene = Scene::build_lit(vec![mesh], vec![coat], vec![], sky, vec![]).unwrap();
+    let (sp, wo) = landing(&scene);
+    assert_bounded_around("glossy landing under the sky", &glossy_landing(&scene, &sp, wo, 7), want);
 }
 
 #[test]

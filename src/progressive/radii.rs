@@ -21,6 +21,7 @@ use crate::scene::Scene;
 use crate::settings::Settings;
 use crate::transport::camera::probe_first_surfaces;
 use crate::transport::gather::trace_gather_rays;
+use crate::transport::specular::Chain;
 use crate::transport::{streams, Context, PhotonMaps};
 use std::sync::Arc;
 
@@ -130,7 +131,8 @@ pub fn camera_knn_radii(scene: &Scene, rays: &CameraRays, job: &Job, maps: &Phot
             (true, false) => knn(&maps.global, settings.k, ctx.global_radius, at(sp.p, ng, flags::OWN_TERMS), scratch),
             (true, true) => {
                 let mut r = None;
-                trace_gather_rays(&ctx, sp, -d, 1, &s.fork(streams::gather(0)), counts, |end, _, _, _| {
+                trace_gather_rays(&ctx, sp, -d, 1, &s.fork(streams::gather(0)), counts, |chain, _, _, _| {
+                    let Chain::Hit(end) = chain else { return };
                     let (n, _) = end.point.frame.oriented(-end.dir);
                     r = knn(&maps.global, settings.k, ctx.global_radius, at(end.point.p, n, 0), scratch);
                 });

@@ -25,7 +25,7 @@ use crate::transport::direct::{delta_light, direct_light, weighted_direct_light}
 use crate::transport::estimate::{camera_indirect_estimate, caustic_estimate, indirect_estimate};
 use crate::transport::gather::{glossy_density, glossy_ray, lands_near, trace_gather_rays};
 use crate::transport::lobe::{gather_landing, lobe_escape, lobe_ray, Found};
-use crate::transport::mis::{emission_found, receiver, Strategies};
+use crate::transport::mis::{emission_found, environment_found, receiver, Strategies};
 use crate::transport::specular::{continue_chain, emission_toward, follow_chain, Chain, ChainEnd};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
@@ -169,14 +169,22 @@ pub fn final_gather(
     // the weight is kd for every ray, applied once at the end.
     let varies = bsdf.gather_varies();
     let r = receiver(sp, bsdf, wo);
-    trace_gather_rays(ctx, sp, wo, n, s, rays, |end, wi, chain, rays| {
-        let e = gather_hit(ctx, end, chain, rays, scratch);
-        let w = if varies { bsdf.gather_weight(&sp.frame, wo, wi) * end.beta } else { end.beta };
-        sum += w * e.radiance;
-        bias += w * e.bias;
-        if end.bounces == 0 {
-            emission += w * emission_found(ctx, &r, &end.hit, end.dir, mis.gather_density(sp, wo, wi));
+    trace_gather_rays(ctx, sp, wo, n, s, rays, |chain, wi, stream, rays| match chain {
+        Chain::Hit(end) => {
+            let e = gather_hit(ctx, end, stream, rays, scratch);
+            let w = if varies { bsdf.gather_weight(&sp.frame, wo, wi) * end.beta } else { end.beta };
+            sum += w * e.radiance;
+            bias += w * e.bias;
+            if end.bounces == 0 {
+                emission += w * emission_found(ctx, &r, &end.hit, end.dir, mis.gather_density(sp, wo, wi));
+            }
         }
+        // Leaving the scene straight away: the environment, weighed against its light samples.
+        Chain::Escaped { dir, bounces: 0, .. } => {
+            let w = if varies { bsdf.gather_weight(&sp.frame, wo, wi) } else { Vec3::ONE };
+            emission += w * environment_found(ctx, &r, *dir, mis.gather_density(sp, wo, wi));
+        }
+        _ => {}
     });
     let scale = if varies { Vec3::ONE } else { kd };
     Estimated { radiance: scale * sum / n as f32, bias: scale * bias / n as f32, emission: scale * emission / n as f32 }
@@ -205,8 +213,10 @@ fn gather_hit(
     // A black surface sends no gather ray (as in `final_gather` and the wavefront engine).
     if kd != Vec3::ZERO {
         trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, stream, rays| {
-            let e = gather_landing(ctx, z, stream, rays, scratch);
-            far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias, emission: Vec3::ZERO };
+            if let Chain::Hit(z) = z {
+                let e = gather_landing(ctx, z, stream, rays, scratch);
+                far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias, emission: Vec3::ZERO };
+            }
         });
     }
     Estimated {
@@ -241,9 +251,16 @@ pub fn glossy_reflection(
     let (y, d, beta, hit, bounces) = match follow_chain(ctx, ray.origin, ray.dir, s, streams::GLOSSY_CHAIN_BOUNCE, rays)
     {
         Chain::Hit(ChainEnd { point, dir, beta, hit, bounces }) => (point, dir, beta, hit, bounces),
-        Chain::Escaped { dir, beta, bounces } if narrow => {
-            let sky = ray.weight * beta * lobe_escape(ctx.scene, dir, bounces, density);
-            return Estimated { radiance: sky, ..Default::default() };
+        // Leaving the scene: the environment straight away, weighed against its light samples
+        // (the direct term's, as emitters are); from a narrow lobe, the sky through mirrors and
+        // glass too.
+        Chain::Escaped { dir, beta, bounces } if bounces == 0 || narrow => {
+            let sky = ray.weight * beta * lobe_escape(ctx, &receiver(sp, bsdf, wo), dir, bounces, density);
+            return if bounces == 0 {
+                Estimated { emission: sky, ..Default::default() }
+            } else {
+                Estimated { radiance: sky, ..Default::default() }
+            };
         }
         _ => return Estimated::default(),
     };

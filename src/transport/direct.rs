@@ -3,9 +3,10 @@
 //! power ([`crate::scene::Scene::choose_light`]) and each triangle's point by the solid angle it
 //! subtends or by area ([`crate::scene::light`]), each a shadow ray that
 //! carries its contribution if nothing blocks it. Where BSDF samples can find the same emitters
-//! ([`super::mis::Strategies`]), an emissive triangle's sample is weighted against them.
+//! ([`super::mis::Strategies`]), an emissive triangle's sample and the environment's are
+//! weighted against them.
 
-use super::mis::{light_density, receiver, weighed_light, Strategies};
+use super::mis::{environment_density, light_density, receiver, weighed_light, Strategies};
 use super::Context;
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::Bsdf;
@@ -53,16 +54,17 @@ pub fn direct_light_rays(
     let mut add = |light_index: u32, u: [f32; 2], weight: f32| {
         let light = &scene.lights[light_index as usize];
         let Some(inc) = scene.sample_incident(light, sp.p, ns, u) else { return };
-        let weighed = match (mis, light) {
+        // The density of the light sample where a BSDF ray can find the same light.
+        let density = match (mis, light) {
             (Strategies::LightOnly, _) => None,
-            (_, Light::Area { tri, .. }) => weighed_light(scene, *tri).map(|k| (k, *tri)),
+            (_, Light::Area { tri, .. }) => {
+                weighed_light(scene, *tri).map(|k| light_density(ctx, &r, k, *tri, inc.distance, inc.wi))
+            }
+            (_, Light::Environment) => Some(environment_density(ctx, &r, inc.wi)),
             _ => None,
         };
-        let f = match weighed {
-            Some((k, tri)) => {
-                let density = light_density(ctx, &r, k, tri, inc.distance, inc.wi);
-                mis.weighted_f(sp, bsdf, wo, inc.wi, density)
-            }
+        let f = match density {
+            Some(density) => mis.weighted_f(sp, bsdf, wo, inc.wi, density),
             None => bsdf.eval(&sp.frame, wo, inc.wi),
         };
         // A surface that only reflects takes no light from below its shading normal's

@@ -14,7 +14,7 @@
 //! read from the maps; LuxCore's PhotonGI does the same below its "usage threshold".
 
 use super::mis::Strategies;
-use super::specular::{first_non_specular, Bounce, ChainEnd};
+use super::specular::{follow_chain, Bounce, Chain};
 use super::{streams, Context};
 use crate::geometry::offset::offset_ray_origin;
 use crate::job::Job;
@@ -43,8 +43,8 @@ pub fn gather_rays(sp: &SurfacePoint, wo: Vec3, n: u32, s: &Sampler, mut emit: i
 }
 
 /// Traces the final-gather rays of [`gather_rays`] through mirrors and glass, each on its own
-/// stream (forked [`streams::gather_ray`]`(g)` from `s`), and calls `read(end, wi, stream, rays)`
-/// at each one's first non-specular hit (`wi` the ray's first direction), in ray order. Rays that escape or are absorbed read nothing.
+/// stream (forked [`streams::gather_ray`]`(g)` from `s`), and calls `read(chain, wi, stream,
+/// rays)` with how each one's chain ended (`wi` the ray's first direction), in ray order.
 pub fn trace_gather_rays(
     ctx: &Context,
     sp: &SurfacePoint,
@@ -52,13 +52,12 @@ pub fn trace_gather_rays(
     n: u32,
     s: &Sampler,
     rays: &mut RayCounts,
-    mut read: impl FnMut(&ChainEnd, Vec3, &Sampler, &mut RayCounts),
+    mut read: impl FnMut(&Chain, Vec3, &Sampler, &mut RayCounts),
 ) {
     gather_rays(sp, wo, n, s, |g, o, wi| {
-        let chain = s.fork(streams::gather_ray(g));
-        if let Some(end) = first_non_specular(ctx, o, wi, &chain, streams::GATHER_CHAIN_BOUNCE, rays) {
-            read(&end, wi, &chain, rays);
-        }
+        let stream = s.fork(streams::gather_ray(g));
+        let chain = follow_chain(ctx, o, wi, &stream, streams::GATHER_CHAIN_BOUNCE, rays);
+        read(&chain, wi, &stream, rays);
     });
 }
 

@@ -20,14 +20,14 @@
 
 use super::estimate::{base_radiance, map_radiance};
 use super::gather::{glossy_density, glossy_ray};
-use super::mis::{emission_found, receiver, Strategies};
+use super::mis::{emission_found, environment_found, receiver, Strategies};
 use super::specular::{emission_toward, follow_chain, Chain, ChainEnd};
 use super::{streams, Context};
 use crate::geometry::Hit;
 use crate::material::Bsdf;
 use crate::photon_map::Nearest;
 use crate::rng::Sampler;
-use crate::scene::{Receiver, Scene, SurfacePoint};
+use crate::scene::{Receiver, SurfacePoint};
 use crate::stats::RayCounts;
 use glam::Vec3;
 
@@ -75,13 +75,16 @@ pub fn lobe_emission(ctx: &Context, from: &Receiver, hit: &Hit, dir: Vec3, bounc
 /// The environment and the sun a ray from a narrow lobe, of density `density`, finds leaving
 /// the scene along `dir` after `bounces` mirrors and glass: all of it through mirrors and glass
 /// (the origin's caustic estimate reads its base alone) or where nothing sampled them at its
-/// origin (∞: a gather ray's landing, a smooth coat's mirror direction); none where light
-/// sampling found it (the environment is not weighed by MIS yet).
+/// origin (∞: a gather ray's landing, a smooth coat's mirror direction); where light sampling
+/// ran at its origin (receiver `from`), the environment weighed against it and not the sun.
 #[must_use]
 #[inline]
-pub fn lobe_escape(scene: &Scene, dir: Vec3, bounces: u32, density: f32) -> Vec3 {
-    if (bounces == 0 && density.is_finite()) || !scene.has_background() {
+pub fn lobe_escape(ctx: &Context, from: &Receiver, dir: Vec3, bounces: u32, density: f32) -> Vec3 {
+    let scene = ctx.scene;
+    if !scene.has_background() {
         Vec3::ZERO
+    } else if bounces == 0 && density.is_finite() {
+        environment_found(ctx, from, dir, density)
     } else {
         scene.background(dir)
     }
@@ -112,7 +115,8 @@ pub fn lobe_ray(
             Found { radiance: w * (e + m.radiance), bias: w * m.bias }
         }
         Chain::Escaped { dir, beta, bounces } => {
-            Found { radiance: ray.weight * beta * lobe_escape(ctx.scene, dir, bounces, density), bias: Vec3::ZERO }
+            let sky = lobe_escape(ctx, &receiver(y, bsdf, wo), dir, bounces, density);
+            Found { radiance: ray.weight * beta * sky, bias: Vec3::ZERO }
         }
         Chain::Lost => Found::default(),
     }

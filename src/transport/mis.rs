@@ -12,10 +12,12 @@
 //! The weights come from densities (samples × pdf per steradian): light sampling's is
 //! `light_samples × pmf(light | receiver) × pdf(direction)` ([`light_density`]: the light
 //! tree's or the power's pick, and 1/Ω or d²/(A·cos θ_light) for the point on it); a BSDF
-//! kind's is given by [`Strategies`]. Both depend on the receiver — the shading point and its
+//! kind's is given by [`Strategies`]; the environment's is the same pick probability times the
+//! density of its direction ([`environment_density`]). Both depend on the receiver — the shading point and its
 //! normal — so a BSDF sample's weight is computed for the receiver it left. Only emissive triangles whose surface ends a camera-side chain
 //! (neither mirror, glass nor what photons pass as specular) are weighed: those are the ones a
-//! BSDF ray can find. The environment and the sun stay with light sampling alone.
+//! BSDF ray can find; and the environment, which a BSDF ray finds where it leaves the scene
+//! straight away. The sun stays with light sampling alone.
 //!
 //! Reads the scene's lights and the BSDF's pdfs; writes weights and weighted emission. Every
 //! engine weighs through these functions, so their images agree.
@@ -177,6 +179,41 @@ pub fn light_density(ctx: &Context, r: &Receiver, light: usize, tri: u32, distan
         return 0.0;
     }
     ctx.settings.light_samples as f32 * pmf * area_light_pdf(&scene.triangle(tri), r.p, wi, distance)
+}
+
+/// Light sampling's density at receiver `r` toward the environment along unit `wi`:
+/// `light_samples` × the environment's pick probability there × the density of its direction
+/// (half cosine-weighted about the receiver's normal, half by the map:
+/// [`Scene::sample_incident`]). 0 without an environment.
+#[must_use]
+#[inline]
+pub fn environment_density(ctx: &Context, r: &Receiver, wi: Vec3) -> f32 {
+    let scene = ctx.scene;
+    let Some(env) = &scene.environment else { return 0.0 };
+    // The environment is the last light.
+    let pmf = scene.light_pmf(ctx.settings.light_sampler, r, scene.lights.len() as u32 - 1);
+    if !(pmf > 0.0) {
+        return 0.0;
+    }
+    let pdf = 0.5 * wi.dot(r.n).max(0.0) * FRAC_1_PI + 0.5 * env.pdf(wi);
+    ctx.settings.light_samples as f32 * pmf * pdf
+}
+
+/// The environment a BSDF-sampled ray from receiver `r` finds leaving the scene along unit `d`
+/// (no mirror or glass before), weighted against light sampling; `density` is the BSDF kind's
+/// density for `d`. Suns stay with light sampling alone: their disks are too small for a BSDF
+/// ray to find them often.
+#[must_use]
+pub fn environment_found(ctx: &Context, r: &Receiver, d: Vec3, density: f32) -> Vec3 {
+    let Some(env) = &ctx.scene.environment else { return Vec3::ZERO };
+    if !(density > 0.0) {
+        return Vec3::ZERO;
+    }
+    let l = env.radiance(d);
+    if l == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    l * power_heuristic(density, environment_density(ctx, r, d))
 }
 
 /// Emission a BSDF-sampled ray from receiver `r` finds at its first hit `hit` (no mirror or

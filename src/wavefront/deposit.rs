@@ -41,10 +41,10 @@ pub fn deposit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut st
 }
 
 /// Camera rays add the radiance of emitters whose front face they hit, and of the environment
-/// and the sun when they leave the scene; gather and glossy rays add the emission they hit
-/// straight away, weighted against light sampling ([`emission_found`]), to the direct term of
-/// the path they left; a narrow lobe's ray adds what it finds to its landing's term
-/// (`transport::lobe`).
+/// and the sun when they leave the scene; gather and glossy rays add the emission and the
+/// environment they find straight away, weighted against light sampling ([`emission_found`],
+/// [`lobe_escape`]), to the direct term of the path they left; a narrow lobe's ray adds what it
+/// finds to its landing's term (`transport::lobe`).
 pub fn deposit_emission(
     shared: Res<Shared>,
     maps: Res<super::Maps>,
@@ -58,49 +58,45 @@ pub fn deposit_emission(
     let mut n = 0;
     for i in 0..w.paths.len() {
         let (kind, sample, depth) = (w.paths.kind[i], w.paths.sample[i] as usize, w.paths.depth[i]);
-        let hit = w.paths.hits.get(i);
-        // Rays from a narrow lobe — a landing's lobe ray, or a camera hit's glossy ray on one —
-        // also count what they find through mirrors and glass and leaving the scene, in the term
-        // they carry (`transport::lobe`); a glossy ray's emitter hit straight away goes below.
-        let from_narrow = kind == PathKind::Lobe || (kind == PathKind::Glossy && w.narrow_hits[sample]);
-        if from_narrow && !(kind == PathKind::Glossy && depth == 0 && hit.is_some()) {
-            let (density, dir) = (w.paths.mis[i], w.paths.rays.direction(i));
-            let found = match hit {
-                Some(hit) => {
-                    let from = if kind == PathKind::Lobe { &w.lobe_receivers[sample] } else { &w.receivers[sample] };
-                    lobe_emission(&ctx, from, &hit, dir, depth, density)
-                }
-                None => lobe_escape(scene, dir, depth, density),
+        let (hit, dir) = (w.paths.hits.get(i), w.paths.rays.direction(i));
+        if kind == PathKind::Camera {
+            let emission = match hit {
+                Some(hit) => emission_toward(scene, &hit, -dir),
+                // Leaving the scene: the environment and the sun.
+                None if scene.has_background() => scene.background(dir),
+                None => continue,
             };
-            if found != Vec3::ZERO {
+            if emission != Vec3::ZERO {
                 n += 1;
-                w.terms[sample].add(w.paths.term[i], w.paths.beta[i] * found);
+                let term = Term::Emitted.seen(w.paths.through_specular[i]);
+                w.terms[sample].add(term, w.paths.beta[i] * emission);
             }
             continue;
         }
-        if kind != PathKind::Camera {
-            let density = w.paths.mis[i];
-            let Some(hit) = hit.filter(|_| density > 0.0 && depth == 0) else { continue };
-            let found = emission_found(&ctx, &w.receivers[sample], &hit, w.paths.rays.direction(i), density);
-            if found != Vec3::ZERO {
-                n += 1;
-                let term = Term::Direct.seen(w.paths.through_specular[i]);
-                w.terms[sample].add(term, w.paths.beta[i] * found);
-            }
-            continue;
-        }
-        let emission = match hit {
-            Some(hit) => emission_toward(scene, &hit, -w.paths.rays.direction(i)),
-            // Leaving the scene: the environment and the sun.
-            None if scene.has_background() => scene.background(w.paths.rays.direction(i)),
-            None => continue,
+        // Gather and glossy rays find emitters and the environment straight away, weighed
+        // against the light samples of the point they left; rays from a narrow lobe — a
+        // landing's lobe ray, a camera hit's glossy ray on one — also what they find through
+        // mirrors and glass (`transport::lobe`).
+        let density = w.paths.mis[i];
+        let narrow = kind == PathKind::Lobe || (kind == PathKind::Glossy && w.narrow_hits[sample]);
+        let from = if kind == PathKind::Lobe { &w.lobe_receivers[sample] } else { &w.receivers[sample] };
+        let found = match hit {
+            Some(hit) if narrow => lobe_emission(&ctx, from, &hit, dir, depth, density),
+            Some(hit) if depth == 0 && density > 0.0 => emission_found(&ctx, from, &hit, dir, density),
+            None if narrow || depth == 0 => lobe_escape(&ctx, from, dir, depth, density),
+            _ => Vec3::ZERO,
         };
-        if emission == Vec3::ZERO {
-            continue;
+        if found != Vec3::ZERO {
+            n += 1;
+            // Found straight away: the direct term of the path the ray left (a lobe ray's goes
+            // where its landing's light went, the term it carries).
+            let term = if kind != PathKind::Lobe && depth == 0 {
+                Term::Direct.seen(w.paths.through_specular[i])
+            } else {
+                w.paths.term[i]
+            };
+            w.terms[sample].add(term, w.paths.beta[i] * found);
         }
-        n += 1;
-        let term = Term::Emitted.seen(w.paths.through_specular[i]);
-        w.terms[sample].add(term, w.paths.beta[i] * emission);
     }
     stats.record("deposit_emission", n, t);
 }
