@@ -22,7 +22,7 @@ use crate::settings::Settings;
 use crate::stats::{MapStats, Numerics, PhaseTimes, RayCounts, RenderStats};
 use crate::transport::camera::render_pixels;
 use crate::transport::direct::weighted_direct_light;
-use crate::transport::mis::{emission_found, environment_found, receiver, Strategies};
+use crate::transport::mis::{emission_found, receiver, sky_found, Strategies};
 use crate::transport::specular::{continue_ray, emission_toward};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
@@ -106,7 +106,7 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
             if last_delta && scene.has_background() {
                 terms.add(path_term(Term::Emitted, depth, via_specular), beta * scene.background(d));
             } else if bsdf_density > 0.0 {
-                let found = environment_found(ctx, &from, d, bsdf_density);
+                let found = sky_found(ctx, &from, d, bsdf_density);
                 terms.add(path_term(Term::Direct, depth - 1, via_specular), beta * found);
             }
             break;

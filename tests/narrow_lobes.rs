@@ -8,7 +8,8 @@
 //! - A glossy ray's landing samples the lights and sends the lobe's ray; the two are weighed by
 //!   MIS, so their sum is Le·R in expectation — under the ceiling, and under a constant sky of
 //!   the same radiance, whose light samples are weighed against the lobe's ray as emitters'
-//!   are (light sampling alone reached 700·Le·R there).
+//!   are (light sampling alone reached 700·Le·R there), and under a sun in its mirror
+//!   direction, whose reference is the lobe's own samples' mean.
 //!
 //! Tolerances: each mean within 4 standard errors of its 4 096 estimates plus 10⁻³ relative (the
 //! f32 sums and R's own sampling error, ~10⁻⁴); and every single estimate at most 3·Le·R. Light
@@ -25,6 +26,7 @@ use glam::Vec3;
 use photonwave::material::{Bsdf, Material};
 use photonwave::microfacet::Alpha;
 use photonwave::rng::{Domain, Sampler};
+use photonwave::scene::light::Light;
 use photonwave::scene::{Environment, MeshInput, Scene, SurfacePoint};
 use photonwave::settings::Settings;
 use photonwave::transport::direct::weighted_direct_light;
@@ -52,6 +54,23 @@ fn coat_under_ceiling() -> Scene {
     let coat = Material::new("coat", Bsdf::rough_plastic(Vec3::ZERO, 1.5, Alpha::ggx(0.01)), Vec3::ZERO);
     let lamp = Material::new("lamp", Bsdf::Lambert { kd: Vec3::ZERO }, Vec3::splat(LE));
     Scene::build(vec![quad(0.0, 10.0, false, 0), quad(1.0, 20.0, true, 1)], vec![coat, lamp], vec![], vec![]).unwrap()
+}
+
+/// The near-mirror floor alone (20 × 20 at y = 0) and its coat, for other lights.
+fn coat_alone() -> (MeshInput, Material) {
+    let mesh = MeshInput {
+        source: "floor".into(),
+        positions: vec![
+            Vec3::new(-10.0, 0.0, -10.0),
+            Vec3::new(10.0, 0.0, -10.0),
+            Vec3::new(10.0, 0.0, 10.0),
+            Vec3::new(-10.0, 0.0, 10.0),
+        ],
+        triangles: vec![[0, 2, 1], [0, 3, 2]],
+        material: vec![0, 0],
+        ..Default::default()
+    };
+    (mesh, Material::new("coat", Bsdf::rough_plastic(Vec3::ZERO, 1.5, Alpha::ggx(0.01)), Vec3::ZERO))
 }
 
 /// The landing point at the floor's centre and the direction back along the arriving ray.
@@ -140,23 +159,39 @@ fn a_glossy_rays_landing_under_the_sky_weighs_its_sky_samples_against_the_lobes_
     let floor = coat_under_ceiling();
     let (sp, wo) = landing(&floor);
     let want = f64::from(LE) * albedo(&floor, &sp, wo);
-    let mesh = MeshInput {
-        source: "floor".into(),
-        positions: vec![
-            Vec3::new(-10.0, 0.0, -10.0),
-            Vec3::new(10.0, 0.0, -10.0),
-            Vec3::new(10.0, 0.0, 10.0),
-            Vec3::new(-10.0, 0.0, 10.0),
-        ],
-        triangles: vec![[0, 2, 1], [0, 3, 2]],
-        material: vec![0, 0],
-        ..Default::default()
-    };
-    let coat = Material::new("coat", Bsdf::rough_plastic(Vec3::ZERO, 1.5, Alpha::ggx(0.01)), Vec3::ZERO);
+    let (mesh, coat) = coat_alone();
     let sky = Some(Environment::constant(Vec3::splat(LE)));
     let scene = Scene::build_lit(vec![mesh], vec![coat], vec![], sky, vec![]).unwrap();
     let (sp, wo) = landing(&scene);
     assert_bounded_around("glossy landing under the sky", &glossy_landing(&scene, &sp, wo, 7), want);
+}
+
+#[test]
+fn a_glossy_rays_landing_under_a_sun_weighs_its_sun_samples_against_the_lobes_ray() {
+    // The coat alone under a sun of angular radius 5° in its mirror direction, E⊥ = 1: the lobe
+    // (about 1° wide) sees the disk's radiance, so the reference is the lobe's own estimate,
+    // its samples' weight times the sun's radiance where they point into the disk (65 536).
+    let (mesh, coat) = coat_alone();
+    let half = 5f32.to_radians();
+    let sun = Light::Sun {
+        direction: Vec3::new(1.0, -1.0, 0.0).normalize(),
+        irradiance: Vec3::ONE,
+        one_minus_cos: 1.0 - half.cos(),
+    };
+    let scene = Scene::build(vec![mesh], vec![coat], vec![sun], vec![]).unwrap();
+    let (sp, wo) = landing(&scene);
+    let bsdf = scene.bsdf(&sp);
+    let n = 65_536;
+    let want = (0..n)
+        .filter_map(|i| {
+            let s = Sampler::new(9, Domain::Camera, i);
+            bsdf.sample_glossy(&sp.frame, wo, [s.get(0, 0), s.get(0, 1), s.get(0, 2)])
+        })
+        .map(|b| f64::from(b.weight.x * sun.radiance_at_infinity(b.wi).x))
+        .sum::<f64>()
+        / n as f64;
+    assert!(want > 0.0);
+    assert_bounded_around("glossy landing under a sun", &glossy_landing(&scene, &sp, wo, 8), want);
 }
 
 #[test]

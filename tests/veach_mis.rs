@@ -128,7 +128,7 @@ fn scene(alpha: f32) -> Scene {
         let x = -3.75 + 2.5 * k as f32;
         meshes.push(icosphere(Vec3::new(x, 2.0, -5.0), *r, k as u32 + 1));
         let le = 0.01 / (r * r);
-        materials.push(Material::new(&format!("lamp{k}"), Bsdf::Lambert { kd: Vec3::ZERO }, Vec3::splat(le)));
+        materials.push(Material::new(format!("lamp{k}"), Bsdf::Lambert { kd: Vec3::ZERO }, Vec3::splat(le)));
     }
     Scene::build(meshes, materials, vec![], vec![]).unwrap()
 }

@@ -25,7 +25,7 @@ use crate::transport::direct::{delta_light, direct_light, weighted_direct_light}
 use crate::transport::estimate::{camera_indirect_estimate, caustic_estimate, indirect_estimate};
 use crate::transport::gather::{glossy_density, glossy_ray, lands_near, trace_gather_rays};
 use crate::transport::lobe::{gather_landing, lobe_escape, lobe_ray, Found};
-use crate::transport::mis::{emission_found, environment_found, receiver, Strategies};
+use crate::transport::mis::{emission_found, receiver, sky_found, Strategies};
 use crate::transport::specular::{continue_chain, emission_toward, follow_chain, Chain, ChainEnd};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
@@ -182,7 +182,7 @@ pub fn final_gather(
         // Leaving the scene straight away: the environment, weighed against its light samples.
         Chain::Escaped { dir, bounces: 0, .. } => {
             let w = if varies { bsdf.gather_weight(&sp.frame, wo, wi) } else { Vec3::ONE };
-            emission += w * environment_found(ctx, &r, *dir, mis.gather_density(sp, wo, wi));
+            emission += w * sky_found(ctx, &r, *dir, mis.gather_density(sp, wo, wi));
         }
         _ => {}
     });

@@ -533,6 +533,12 @@ impl Scene {
         self.suns.iter().map(|&i| self.lights[i as usize].radiance_at_infinity(d)).sum::<Vec3>() + env
     }
 
+    /// Indices in `lights` of the suns.
+    #[must_use]
+    pub fn suns(&self) -> &[u32] {
+        &self.suns
+    }
+
     /// Whether any ray leaving the scene sees light ([`Scene::background`]).
     #[must_use]
     pub fn has_background(&self) -> bool {

@@ -3,10 +3,10 @@
 //! power ([`crate::scene::Scene::choose_light`]) and each triangle's point by the solid angle it
 //! subtends or by area ([`crate::scene::light`]), each a shadow ray that
 //! carries its contribution if nothing blocks it. Where BSDF samples can find the same emitters
-//! ([`super::mis::Strategies`]), an emissive triangle's sample and the environment's are
-//! weighted against them.
+//! ([`super::mis::Strategies`]), an emissive triangle's, the environment's and a sun's samples
+//! are weighted against them.
 
-use super::mis::{environment_density, light_density, receiver, weighed_light, Strategies};
+use super::mis::{environment_density, light_density, receiver, sun_density, weighed_light, Strategies};
 use super::Context;
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::Bsdf;
@@ -61,6 +61,7 @@ pub fn direct_light_rays(
                 weighed_light(scene, *tri).map(|k| light_density(ctx, &r, k, *tri, inc.distance, inc.wi))
             }
             (_, Light::Environment) => Some(environment_density(ctx, &r, inc.wi)),
+            (_, Light::Sun { .. }) => Some(sun_density(ctx, &r, light_index)),
             _ => None,
         };
         let f = match density {

@@ -20,7 +20,7 @@
 
 use super::estimate::{base_radiance, map_radiance};
 use super::gather::{glossy_density, glossy_ray};
-use super::mis::{emission_found, environment_found, receiver, Strategies};
+use super::mis::{emission_found, receiver, sky_found, Strategies};
 use super::specular::{emission_toward, follow_chain, Chain, ChainEnd};
 use super::{streams, Context};
 use crate::geometry::Hit;
@@ -76,7 +76,7 @@ pub fn lobe_emission(ctx: &Context, from: &Receiver, hit: &Hit, dir: Vec3, bounc
 /// the scene along `dir` after `bounces` mirrors and glass: all of it through mirrors and glass
 /// (the origin's caustic estimate reads its base alone) or where nothing sampled them at its
 /// origin (∞: a gather ray's landing, a smooth coat's mirror direction); where light sampling
-/// ran at its origin (receiver `from`), the environment weighed against it and not the sun.
+/// ran at its origin (receiver `from`), weighed against it.
 #[must_use]
 #[inline]
 pub fn lobe_escape(ctx: &Context, from: &Receiver, dir: Vec3, bounces: u32, density: f32) -> Vec3 {
@@ -84,7 +84,7 @@ pub fn lobe_escape(ctx: &Context, from: &Receiver, dir: Vec3, bounces: u32, dens
     if !scene.has_background() {
         Vec3::ZERO
     } else if bounces == 0 && density.is_finite() {
-        environment_found(ctx, from, dir, density)
+        sky_found(ctx, from, dir, density)
     } else {
         scene.background(dir)
     }

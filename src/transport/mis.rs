@@ -12,12 +12,12 @@
 //! The weights come from densities (samples × pdf per steradian): light sampling's is
 //! `light_samples × pmf(light | receiver) × pdf(direction)` ([`light_density`]: the light
 //! tree's or the power's pick, and 1/Ω or d²/(A·cos θ_light) for the point on it); a BSDF
-//! kind's is given by [`Strategies`]; the environment's is the same pick probability times the
-//! density of its direction ([`environment_density`]). Both depend on the receiver — the shading point and its
+//! kind's is given by [`Strategies`]; the environment's and a sun's are the same pick probability
+//! times the density of their direction ([`environment_density`], [`sun_density`]). Both depend on the receiver — the shading point and its
 //! normal — so a BSDF sample's weight is computed for the receiver it left. Only emissive triangles whose surface ends a camera-side chain
 //! (neither mirror, glass nor what photons pass as specular) are weighed: those are the ones a
-//! BSDF ray can find; and the environment, which a BSDF ray finds where it leaves the scene
-//! straight away. The sun stays with light sampling alone.
+//! BSDF ray can find; and the environment and the suns, which a BSDF ray finds where it leaves
+//! the scene straight away.
 //!
 //! Reads the scene's lights and the BSDF's pdfs; writes weights and weighted emission. Every
 //! engine weighs through these functions, so their images agree.
@@ -25,7 +25,7 @@
 use super::Context;
 use crate::geometry::Hit;
 use crate::material::Bsdf;
-use crate::scene::light::area_light_pdf;
+use crate::scene::light::{area_light_pdf, Light};
 use crate::scene::{Receiver, Scene, SurfacePoint};
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
@@ -199,21 +199,41 @@ pub fn environment_density(ctx: &Context, r: &Receiver, wi: Vec3) -> f32 {
     ctx.settings.light_samples as f32 * pmf * pdf
 }
 
-/// The environment a BSDF-sampled ray from receiver `r` finds leaving the scene along unit `d`
-/// (no mirror or glass before), weighted against light sampling; `density` is the BSDF kind's
-/// density for `d`. Suns stay with light sampling alone: their disks are too small for a BSDF
-/// ray to find them often.
+/// Light sampling's density at receiver `r` toward sun `light` (index in the scene's lights),
+/// for a direction inside its disk: `light_samples` × its pick probability × 1/(2π(1 − cos θ))
+/// (uniform in its cone, [`crate::scene::light::Light::sample_incident`]).
 #[must_use]
-pub fn environment_found(ctx: &Context, r: &Receiver, d: Vec3, density: f32) -> Vec3 {
-    let Some(env) = &ctx.scene.environment else { return Vec3::ZERO };
+#[inline]
+pub fn sun_density(ctx: &Context, r: &Receiver, light: u32) -> f32 {
+    let scene = ctx.scene;
+    let Light::Sun { one_minus_cos, .. } = scene.lights[light as usize] else { return 0.0 };
+    let pmf = scene.light_pmf(ctx.settings.light_sampler, r, light);
+    ctx.settings.light_samples as f32 * pmf / (2.0 * std::f32::consts::PI * one_minus_cos)
+}
+
+/// The environment and the suns a BSDF-sampled ray from receiver `r` finds leaving the scene
+/// along unit `d` (no mirror or glass before), each weighted against its light samples;
+/// `density` is the BSDF kind's density for `d`.
+#[must_use]
+pub fn sky_found(ctx: &Context, r: &Receiver, d: Vec3, density: f32) -> Vec3 {
     if !(density > 0.0) {
         return Vec3::ZERO;
     }
-    let l = env.radiance(d);
-    if l == Vec3::ZERO {
-        return Vec3::ZERO;
+    let scene = ctx.scene;
+    let mut sum = Vec3::ZERO;
+    if let Some(env) = &scene.environment {
+        let l = env.radiance(d);
+        if l != Vec3::ZERO {
+            sum += l * power_heuristic(density, environment_density(ctx, r, d));
+        }
     }
-    l * power_heuristic(density, environment_density(ctx, r, d))
+    for &i in scene.suns() {
+        let l = scene.lights[i as usize].radiance_at_infinity(d);
+        if l != Vec3::ZERO {
+            sum += l * power_heuristic(density, sun_density(ctx, r, i));
+        }
+    }
+    sum
 }
 
 /// Emission a BSDF-sampled ray from receiver `r` finds at its first hit `hit` (no mirror or
