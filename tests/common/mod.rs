@@ -56,6 +56,10 @@ pub fn grey(film: &Film) -> Vec<f32> {
 /// A unique scratch directory for a test.
 pub fn scratch_dir(test: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("photonwave-{}-{test}", std::process::id()));
+    // Emptied first: an earlier run whose process had the same id leaves its files there (a
+    // link that test made again failed with "File exists" on a machine with 7 000 such
+    // folders).
+    let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
 }
