@@ -188,14 +188,21 @@ pub fn light_density(ctx: &Context, r: &Receiver, light: usize, tri: u32, distan
 #[must_use]
 #[inline]
 pub fn environment_density(ctx: &Context, r: &Receiver, wi: Vec3) -> f32 {
+    let Some(env) = &ctx.scene.environment else { return 0.0 };
+    density_with_map_pdf(ctx, r, wi, env.pdf(wi))
+}
+
+/// [`environment_density`] given the map's own density toward `wi` (read with its radiance
+/// in one texel lookup, [`crate::scene::Environment::radiance_pdf`]).
+#[inline]
+fn density_with_map_pdf(ctx: &Context, r: &Receiver, wi: Vec3, map_pdf: f32) -> f32 {
     let scene = ctx.scene;
-    let Some(env) = &scene.environment else { return 0.0 };
     // The environment is the last light.
     let pmf = scene.light_pmf(ctx.settings.light_sampler, r, scene.lights.len() as u32 - 1);
     if !(pmf > 0.0) {
         return 0.0;
     }
-    let pdf = 0.5 * wi.dot(r.n).max(0.0) * FRAC_1_PI + 0.5 * env.pdf(wi);
+    let pdf = 0.5 * wi.dot(r.n).max(0.0) * FRAC_1_PI + 0.5 * map_pdf;
     ctx.settings.light_samples as f32 * pmf * pdf
 }
 
@@ -222,9 +229,9 @@ pub fn sky_found(ctx: &Context, r: &Receiver, d: Vec3, density: f32) -> Vec3 {
     let scene = ctx.scene;
     let mut sum = Vec3::ZERO;
     if let Some(env) = &scene.environment {
-        let l = env.radiance(d);
+        let (l, map_pdf) = env.radiance_pdf(d);
         if l != Vec3::ZERO {
-            sum += l * power_heuristic(density, environment_density(ctx, r, d));
+            sum += l * power_heuristic(density, density_with_map_pdf(ctx, r, d, map_pdf));
         }
     }
     for &i in scene.suns() {
