@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes photonwave's bundled scenes (OBJ + MTL). Run from this folder: python3 generate.py
+"""Writes photonwave's bundled scenes (OBJ + MTL; the interior as a Mitsuba file). Run from this folder: python3 generate.py
 
 Geometry of the Cornell box is the measured data published by the Cornell Program of Computer
 Graphics (dimensions in mm: a 556 x 548.8 x 559.2 room, a 130 x 105 light, two blocks),
@@ -810,3 +810,112 @@ roughness = 0.3
 ''')
 
 real_scenes()
+
+# ---- a bundled interior (issue 56): one Mitsuba file that photonwave and Mitsuba 3 both render ---
+
+def interior():
+    """Two rooms joined by a doorway, written as interior.xml (Mitsuba 3's format) over OBJ meshes in
+    interior/, one per material: a near-mirror tiled floor (rough plastic, GGX alpha 0.01), thin
+    floating stair treads, five small ceiling lights (three in the near room, two warm ones beyond
+    the doorway), a terracotta far wall, a bench, and a standing glass pane whose glass absorbs (an
+    interior homogeneous medium of albedo 0). Metres; y up; the near room is x < 0."""
+    X, Z, H, T = 4.0, 2.5, 2.8, 0.05        # half length, half depth, height, half the partition
+    meshes = {}
+    def mesh(name):
+        if name not in meshes:
+            o = Obj("", convert=lambda p: p)
+            o.lines = [f"# photonwave's bundled interior ({name}), written by scenes/generate.py"]
+            meshes[name] = o
+        return meshes[name]
+    def block(name, material, lo, hi, skip=()):
+        """An axis-aligned box facing out, without the faces in `skip` (e.g. 'y-': resting on the floor)."""
+        o = mesh(material)
+        c = tuple((lo[i] + hi[i]) / 2 for i in range(3))
+        for axis in range(3):
+            for v, sign in ((lo[axis], "-"), (hi[axis], "+")):
+                if f"{'xyz'[axis]}{sign}" in skip:
+                    continue
+                u, w = (axis + 1) % 3, (axis + 2) % 3
+                pts = []
+                for a, b in [(lo[u], lo[w]), (hi[u], lo[w]), (hi[u], hi[w]), (lo[u], hi[w])]:
+                    p = [0.0, 0.0, 0.0]; p[axis], p[u], p[w] = v, a, b
+                    pts.append(tuple(p))
+                facing = [0.0, 0.0, 0.0]; facing[axis] = v - c[axis]
+                o.quad(f"{name}_{'xyz'[axis]}{sign}", material, pts, tuple(facing))
+    # The shell: floor (tiles at 0.5 m), ceiling, four walls facing in; the wall at x = +X terracotta.
+    textured_quad(mesh("floor"), "floor", "floor", [(-X, 0, -Z), (X, 0, -Z), (X, 0, Z), (-X, 0, Z)],
+                  [(0, 0), (X, 0), (X, Z), (0, Z)], (0, 1, 0))
+    mesh("walls").quad("ceiling", "walls", [(-X, H, -Z), (X, H, -Z), (X, H, Z), (-X, H, Z)], (0, -1, 0))
+    mesh("walls").quad("back", "walls", [(-X, 0, -Z), (X, 0, -Z), (X, H, -Z), (-X, H, -Z)], (0, 0, 1))
+    mesh("walls").quad("front", "walls", [(-X, 0, Z), (X, 0, Z), (X, H, Z), (-X, H, Z)], (0, 0, -1))
+    mesh("walls").quad("left", "walls", [(-X, 0, -Z), (-X, H, -Z), (-X, H, Z), (-X, 0, Z)], (1, 0, 0))
+    mesh("accent").quad("far", "accent", [(X, 0, -Z), (X, H, -Z), (X, H, Z), (X, 0, Z)], (-1, 0, 0))
+    # The partition at x = 0 with a doorway (z from -1.6 to -0.6, 2.1 m high).
+    d0, d1, dh = -1.6, -0.6, 2.1
+    block("partition_back", "walls", (-T, 0, -Z), (T, H, d0), skip=("y-", "y+", "z-"))
+    block("partition_front", "walls", (-T, 0, d1), (T, H, Z), skip=("y-", "y+", "z+"))
+    block("lintel", "walls", (-T, dh, d0), (T, H, d1), skip=("y+", "z-", "z+"))
+    # Ten floating treads, 4 cm thick, rising to the left along the back wall of the near room.
+    for i in range(10):
+        x1 = -1.0 - 0.28 * i
+        y = 0.19 * (i + 1)
+        block(f"tread{i}", "treads", (x1 - 0.28, y - 0.04, -Z), (x1, y, -Z + 0.9), skip=("z-",))
+    # A bench, and a glass pane (2 cm thick, 2 cm above the floor) in front of the stair.
+    block("bench", "bench", (-2.2, 0.0, 0.7), (-0.9, 0.45, 1.5), skip=("y-",))
+    block("pane", "glass", (-3.4, 0.02, -1.42), (-1.6, 1.02, -1.40))
+    # Small ceiling lights, facing down.
+    for i, (x, z, s) in enumerate([(-3.0, 0.9, 0.1), (-1.4, 1.6, 0.1), (-2.0, -0.6, 0.1)]):
+        mesh("lights_near").quad(f"light{i}", "lights_near", [(x - s, H - 0.001, z - s), (x + s, H - 0.001, z - s),
+                                  (x + s, H - 0.001, z + s), (x - s, H - 0.001, z + s)], (0, -1, 0))
+    for i, (x, z, s) in enumerate([(1.8, -1.2, 0.15), (2.8, 1.2, 0.15)]):
+        mesh("lights_far").quad(f"light{i}", "lights_far", [(x - s, H - 0.001, z - s), (x + s, H - 0.001, z - s),
+                                 (x + s, H - 0.001, z + s), (x - s, H - 0.001, z + s)], (0, -1, 0))
+    import os
+    os.makedirs("interior", exist_ok=True)
+    for name, o in meshes.items():
+        o.lines = [l for l in o.lines if not l.startswith("usemtl")]
+        o.write(f"interior/{name}.obj")
+    diffuse = lambda rgb: f'<bsdf type="diffuse"><rgb name="reflectance" value="{rgb}"/></bsdf>'
+    bsdfs = {
+        "floor": '<bsdf type="roughplastic"><string name="distribution" value="ggx"/><float name="alpha" value="0.01"/>'
+                 '<float name="int_ior" value="1.5"/><float name="ext_ior" value="1"/><boolean name="nonlinear" value="true"/>'
+                 '<texture type="bitmap" name="diffuse_reflectance"><string name="filename" value="tiles.png"/></texture></bsdf>',
+        "walls": diffuse("0.72, 0.71, 0.68"),
+        "accent": diffuse("0.62, 0.3, 0.2"),
+        "treads": diffuse("0.5, 0.36, 0.22"),
+        "bench": diffuse("0.2, 0.3, 0.5"),
+        "glass": '<bsdf type="dielectric"><float name="int_ior" value="1.5"/><float name="ext_ior" value="1"/></bsdf>',
+        "lights_near": diffuse("0, 0, 0"),
+        "lights_far": diffuse("0, 0, 0"),
+    }
+    extra = {
+        "glass": '<medium name="interior" type="homogeneous"><rgb name="sigma_t" value="1, 0.25, 0.6"/><float name="scale" value="30"/>'
+                 '<float name="albedo" value="0"/></medium>',
+        "lights_near": '<emitter type="area"><rgb name="radiance" value="250, 240, 225"/></emitter>',
+        "lights_far": '<emitter type="area"><rgb name="radiance" value="160, 120, 72"/></emitter>',
+    }
+    xml = ['<?xml version="1.0" encoding="utf-8"?>',
+           '<!-- photonwave\'s bundled interior, written by scenes/generate.py: two rooms joined by a doorway, a near-mirror',
+           '     tiled floor (GGX alpha 0.01), thin floating stair treads, five small ceiling lights, a glass pane that absorbs.',
+           '     photonwave renders this file as it is; so does Mitsuba 3 (volpath: the pane\'s medium absorbs). -->',
+           '<scene version="3.0.0">',
+           '\t<integrator type="volpath"/>',
+           '\t<sensor type="perspective">',
+           '\t\t<float name="fov" value="62"/>',
+           '\t\t<string name="fov_axis" value="y"/>',
+           '\t\t<transform name="to_world">',
+           '\t\t\t<lookat origin="-3.7, 1.55, 2.3" target="0.2, 0.75, -1.1" up="0, 1, 0"/>',
+           '\t\t</transform>',
+           '\t\t<film type="hdrfilm"><integer name="width" value="320"/><integer name="height" value="240"/><rfilter type="box"/></film>',
+           '\t</sensor>']
+    for name in meshes:
+        xml += ['\t<shape type="obj">', f'\t\t<string name="filename" value="interior/{name}.obj"/>',
+                '\t\t<boolean name="face_normals" value="true"/>', f'\t\t{bsdfs[name]}']
+        if name in extra:
+            xml.append(f'\t\t{extra[name]}')
+        xml.append('\t</shape>')
+    xml.append('</scene>')
+    with open("interior.xml", "w") as f:
+        f.write("\n".join(xml) + "\n")
+
+interior()

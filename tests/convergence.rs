@@ -7,7 +7,7 @@
 //! difference's spread, scaled by √(4 096/65 536)): on `cornell-box`, 0.21 % of a pixel's value
 //! (median; 0.8 % at the 90th percentile), 0.07 % of an 8×8 block's mean, 0.007 % of the image
 //! mean; on `cornell-spheres`, 0.8 % of a pixel (3 % at the 90th percentile, in the caustics)
-//! for one file, half that for the four the test averages.
+//! for one file, half that for the four the test averages; on `interior`, in `INTERIOR_NOISE`.
 
 mod common;
 
@@ -59,6 +59,16 @@ fn grey(v: Vec3) -> f64 {
     f64::from(v.element_sum()) / 3.0
 }
 
+/// The bundled scene file of `scene`: its TOML file, or its Mitsuba file where it has no TOML.
+fn file_of(scene: &str) -> String {
+    let toml = format!("{scene}.toml");
+    if common::bundled(&toml).exists() {
+        toml
+    } else {
+        format!("{scene}.xml")
+    }
+}
+
 /// `passes` progressive passes of the bundled `scene` at 32×32 with its own settings (per pass:
 /// 1 spp and its photons spread as `render --passes` spreads them), seed `seed`: the image, and
 /// each pass's 8×8-block means of reflected light ([`reflected`]).
@@ -68,7 +78,7 @@ fn passes(scene: &str, passes: u32, seed: u64) -> (Film, Vec<Vec<f64>>) {
 
 /// [`passes`] with the scene's settings changed by `change` first.
 fn passes_with(scene: &str, passes: u32, seed: u64, change: impl Fn(&mut Settings)) -> (Film, Vec<Vec<f64>>) {
-    let loaded = load(&format!("{scene}.toml"));
+    let loaded = load(&file_of(scene));
     let mut file = Settings { width: SIZE, height: SIZE, seed, threads: 2, ..loaded.settings.clone() };
     change(&mut file);
     let settings = photonwave::progressive::per_pass(&file, Default::default());
@@ -109,7 +119,7 @@ fn block_means(grey: &[f64]) -> Vec<f64> {
 /// outside (measured in BENCHMARKS.md).
 #[test]
 fn a_diffuse_box_converges_to_the_path_traced_image() {
-    assert_converges(passes("cornell-box", 64, 3));
+    assert_converges("cornell-box", BOX_NOISE, passes("cornell-box", 64, 3));
 }
 
 /// The secondary gather changes where the maps are read, not which paths are summed: with every
@@ -117,15 +127,86 @@ fn a_diffuse_box_converges_to_the_path_traced_image() {
 /// this box), the diffuse box still converges to the path-traced image, to the same tolerances.
 #[test]
 fn the_secondary_gather_sums_the_same_paths() {
-    assert_converges(passes_with("cornell-box", 64, 5, |s| s.secondary_gather = 100.0));
+    assert_converges("cornell-box", BOX_NOISE, passes_with("cornell-box", 64, 5, |s| s.secondary_gather = 100.0));
+}
+
+/// The noise of a committed reference, as fractions of an 8×8 block's mean and of the image mean.
+struct Noise {
+    block: f64,
+    mean: f64,
+}
+
+/// `cornell-box`'s reference (measured, above; rounded up).
+const BOX_NOISE: Noise = Noise { block: 7e-4, mean: 7e-5 };
+
+/// `interior`'s reference, the mean of its four files (measured from their spread: 0.074 % of
+/// a block for one file at the median, 0.27 % at the worst block, so 0.14 % for the mean of four;
+/// 0.009 % of the image mean; rounded up).
+const INTERIOR_NOISE: Noise = Noise { block: 1.5e-3, mean: 1e-4 };
+
+/// The bundled interior (`scenes/interior.xml`, issue 56: two rooms, thin treads, five small
+/// lights, a near-mirror floor, absorbing glass), 64 progressive passes: converges to its
+/// path-traced reference to the tolerances of [`a_diffuse_box_converges_to_the_path_traced_image`].
+#[test]
+fn the_interior_converges_to_the_path_traced_image() {
+    assert_converges("interior", INTERIOR_NOISE, passes("interior", 64, 3));
+}
+
+/// One-pass renders of the bundled interior at its default settings (16 spp, 200 000 global and
+/// 100 000 caustic photons), four seeds, against the path-traced reference. One pass is biased
+/// (its k-NN density estimates blur; on this scene they read ~1 % dark, measured at six seeds:
+/// 0.984–0.999 of the reference's mean, seed-averaged 8×8 blocks 0.98–1.01), so the check allows
+/// a stated bias plus 4 standard errors of the seeds' spread: 2 % for the mean (the allowance
+/// `tests/render.rs` gives the boxes) and 4 % for each block.
+#[test]
+fn one_pass_renders_of_the_interior_agree_with_the_path_tracer() {
+    let loaded = load("interior.xml");
+    let rays = loaded.camera.unwrap().prepare(SIZE, SIZE).unwrap();
+    let scene = Arc::new(loaded.scene);
+    let emitted = reference("interior", "emitted");
+    let reference: Vec<f64> = reference("interior", "").iter().zip(&emitted).map(|(b, e)| b - e).collect();
+    let renders: Vec<Vec<f64>> = (1..=4)
+        .map(|seed| {
+            let s = Settings { width: SIZE, height: SIZE, seed, threads: 2, ..loaded.settings.clone() };
+            let (film, _) = photonwave::wavefront::render(scene.clone(), &rays, &s, &NoProgress).unwrap();
+            block_means(&film.pixels.iter().map(reflected).collect::<Vec<_>>())
+        })
+        .collect();
+    let n = renders.len() as f64;
+    let mean_and_se = |values: Vec<f64>| {
+        let mean = values.iter().sum::<f64>() / n;
+        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        (mean, (var / n).sqrt())
+    };
+    let reference_blocks = block_means(&reference);
+    for b in 0..16 {
+        let (mean, se) = mean_and_se(renders.iter().map(|r| r[b]).collect());
+        let tol = 4.0 * se + 0.04 * reference_blocks[b];
+        println!(
+            "block {b:2}: {:+.2} % (tolerance {:.2} %)",
+            100.0 * (mean / reference_blocks[b] - 1.0),
+            100.0 * tol / reference_blocks[b]
+        );
+        assert!(
+            (mean - reference_blocks[b]).abs() <= tol,
+            "block {b}: {mean} against {} (tolerance {tol})",
+            reference_blocks[b]
+        );
+    }
+    let (mean, se) = mean_and_se(renders.iter().map(|r| r.iter().sum::<f64>() / 16.0).collect());
+    let reference_mean = reference_blocks.iter().sum::<f64>() / 16.0;
+    let tol = 4.0 * se + 0.02 * reference_mean;
+    println!("mean: {:+.2} % (tolerance {:.2} %)", 100.0 * (mean / reference_mean - 1.0), 100.0 * tol / reference_mean);
+    assert!((mean - reference_mean).abs() <= tol, "mean {mean} against {reference_mean} (tolerance {tol})");
 }
 
 /// The assertions of [`a_diffuse_box_converges_to_the_path_traced_image`] on `n` passes of the
-/// bundled diffuse box: the image and each pass's block means.
-fn assert_converges((image, per_pass): (Film, Vec<Vec<f64>>)) {
+/// bundled `scene` whose reference has the noise `noise`: the image and each pass's block means.
+fn assert_converges(scene: &str, noise: Noise, (image, per_pass): (Film, Vec<Vec<f64>>)) {
     let n = per_pass.len() as u32;
-    let emitted = reference("cornell-box", "emitted");
-    let reference: Vec<f64> = reference("cornell-box", "").iter().zip(&emitted).map(|(b, e)| b - e).collect();
+    assert_eq!(n, 64, "t below is Student's for 63 degrees of freedom");
+    let emitted = reference(scene, "emitted");
+    let reference: Vec<f64> = reference(scene, "").iter().zip(&emitted).map(|(b, e)| b - e).collect();
     let grey: Vec<f64> = image.pixels.iter().map(reflected).collect();
     let nf = f64::from(n);
     // t for 63 degrees of freedom at two-sided 0.1 %: 3.39 (tables); the normal's is 3.29.
@@ -138,7 +219,7 @@ fn assert_converges((image, per_pass): (Film, Vec<Vec<f64>>)) {
     let blocks = block_means(&grey);
     for b in 0..16 {
         let s = spread(&per_pass.iter().map(|p| p[b]).collect::<Vec<_>>());
-        let tol = t * (s * s / nf + (7e-4 * reference_blocks[b]).powi(2)).sqrt();
+        let tol = t * (s * s / nf + (noise.block * reference_blocks[b]).powi(2)).sqrt();
         let d = blocks[b] - reference_blocks[b];
         println!(
             "block {b:2}: {:+.4} % (tolerance {:.4} %)",
@@ -150,23 +231,23 @@ fn assert_converges((image, per_pass): (Film, Vec<Vec<f64>>)) {
     let means: Vec<f64> = per_pass.iter().map(|p| p.iter().sum::<f64>() / 16.0).collect();
     let (mean, reference_mean) =
         (grey.iter().sum::<f64>() / grey.len() as f64, reference.iter().sum::<f64>() / grey.len() as f64);
-    let tol = t * (spread(&means).powi(2) / nf + (7e-5 * reference_mean).powi(2)).sqrt();
+    let tol = t * (spread(&means).powi(2) / nf + (noise.mean * reference_mean).powi(2)).sqrt();
     println!("mean: {:+.4} % (tolerance {:.4} %)", 100.0 * (mean / reference_mean - 1.0), 100.0 * tol / reference_mean);
     assert!((mean - reference_mean).abs() <= tol, "mean {mean} against {reference_mean} (tolerance {tol})");
 }
 
-/// The error layer is calibrated: on the bundled diffuse box and glass-sphere box after 32
-/// passes, the share of pixels whose actual error (against the reference) lies within the
+/// The error layer is calibrated: on the bundled diffuse box, glass-sphere box and interior
+/// after 32 passes, the share of pixels whose actual error (against the reference) lies within the
 /// `error` bound is at least its stated 95 %, less a binomial tolerance: 3 standard deviations of
 /// a share over n pixels, 3·√(0.95·0.05/n) = 2.0 % for the 1 024 pixels. (Pixels are not quite
 /// independent — the passes' photons are shared by all of them — so this is the tolerance the
-/// issue asks for, not an exact one.) Measured: 96.1 % and 95.0 % (the noise alone 93.5 % and
-/// 91.4 %). The reference's own noise widens the actual error a little and is not allowed for;
+/// issue asks for, not an exact one.) Measured: 96.6 %, 94.9 % and 96.9 % (the noise alone 94.2 %,
+/// 92.3 % and 94.9 %; the boxes read 96.1 % and 95.0 % when this test was written). The reference's own noise widens the actual error a little and is not allowed for;
 /// with one 65 536-spp reference instead of four the glass-sphere box fell to 92.9 % here and
 /// 90.8 % after 128 passes (95.4 % with four).
 #[test]
 fn the_error_bound_holds_for_95_percent_of_pixels() {
-    for scene in ["cornell-box", "cornell-spheres"] {
+    for scene in ["cornell-box", "cornell-spheres", "interior"] {
         let reference = reference(scene, "");
         let (image, _) = passes(scene, 32, 5);
         let error = image.error().expect("progressive passes have an error layer");
