@@ -510,8 +510,8 @@ fn no_stored_photon_exceeds_the_power_bound() {
         .collect();
     names.sort();
     assert!(names.len() >= 20, "{names:?}");
-    // The bundled Cornell boxes too (the clamp must not fire there either).
-    names.extend(["../cornell-box.toml".to_string(), "../cornell-spheres.toml".to_string()]);
+    // The bundled Cornell boxes and the interior too (the clamp must not fire there either).
+    names.extend(["../cornell-box.toml", "../cornell-spheres.toml", "../interior.xml"].map(String::from));
     for name in names {
         use photonwave::material::Bsdf;
         let loaded = hard(&name);
