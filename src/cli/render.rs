@@ -311,7 +311,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         film.write_exr(&args.output)?;
         (film, stats, None)
     };
-    if let Some(w) = stats.progressive.as_ref().and_then(photonwave::progressive::budget_warning) {
+    if let Some(w) = photonwave::progressive::budget_warning(&stats) {
         say.warn(w);
     }
     if stats.progressive.is_none() {

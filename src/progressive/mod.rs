@@ -24,9 +24,11 @@
 //! The driver ([`render_passes`], [`drive`]) takes a closure that renders one pass of a [`Job`],
 //! so it knows nothing of the engines; it owns the time budget ([`Budget`]).
 
+mod budget;
 mod driver;
 mod radii;
 
+pub use budget::{budget_warning, costs, Cost};
 pub use driver::{default_set, drive, finish, render_passes, Drive, Ended};
 pub use radii::{initial_radii, median_knn_radius, pass_seed, pilot_seed, pixel_radii, RADIUS_SAMPLES};
 
@@ -276,16 +278,4 @@ pub fn describe(plan: &crate::effects::Effects, settings: &Settings, budget: Opt
         maps.join(" + "),
         settings.alpha
     )
-}
-
-/// A warning when one pass takes more than 5 % of the budget (the render cannot end within 5 %
-/// of it then).
-#[must_use]
-pub fn budget_warning(p: &ProgressiveStats) -> Option<String> {
-    let (b, first) = (p.budget_s?, *p.pass_seconds.first()?);
-    (first > 0.05 * b).then(|| {
-        format!(
-            "one pass takes {first:.2} s, more than 5 % of the {b:.2} s budget; lower --spp or --photons per pass to end closer to it"
-        )
-    })
 }
