@@ -279,9 +279,16 @@ pub enum Reflectance<'a> {
 impl PhotonMap {
     /// Builds the tree (takes ownership, reorders) and packs the photons.
     #[must_use]
-    pub fn build(mut photons: Vec<Photon>) -> Self {
+    pub fn build(photons: Vec<Photon>) -> Self {
+        Self::build_on(photons, 1)
+    }
+
+    /// [`Self::build`] on `threads` threads (the root's subtrees at once, for large maps): the
+    /// same map at any thread count.
+    #[must_use]
+    pub fn build_on(mut photons: Vec<Photon>, threads: usize) -> Self {
         let n = photons.len();
-        let nodes = build_tree(&mut photons);
+        let nodes = build_tree(&mut photons, threads);
         let inf = f32::INFINITY;
         let col = |f: &dyn Fn(&Photon) -> f32| {
             photons.iter().map(f).chain(std::iter::repeat_n(inf, PAD)).collect::<Vec<f32>>()

@@ -32,7 +32,7 @@ pub(super) const STACK: usize = 72;
 
 /// One node: its children's boxes in SoA form and what each child is. Empty slots have inverted
 /// boxes (low +∞, high −∞), which no sphere reaches.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub(super) struct Node {
     lo: [[f32; 8]; 3],
     hi: [[f32; 8]; 3],
@@ -190,13 +190,76 @@ impl PhotonMap {
 }
 
 /// Orders `photons` into the tree's blocks and returns its nodes (none for no photons; the root
-/// is node 0).
-pub(super) fn build_tree(photons: &mut [Photon]) -> Vec<Node> {
+/// is node 0), on `threads` threads ([`build_top`]); the tree is the same at any thread count.
+pub(super) fn build_tree(photons: &mut [Photon], threads: usize) -> Vec<Node> {
     let mut nodes = Vec::new();
-    if !photons.is_empty() {
+    if photons.len() >= PARALLEL_BUILD && threads > 1 {
+        nodes = build_top(photons, threads);
+    } else if !photons.is_empty() {
         nodes.push(Node::EMPTY);
-        build_node(photons, 0, photons.len(), 0, &mut nodes);
+        build_node(photons, 0, 0, photons.len(), 0, &mut nodes);
     }
+    nodes
+}
+
+/// Maps of at least this many photons build their root's subtrees in parallel (below it the
+/// fork costs more than it saves).
+const PARALLEL_BUILD: usize = 1 << 14;
+
+/// [`build_node`] at the root, then the root's subtrees at once, each into its own nodes, joined
+/// in the order the serial build numbers them: a subtree's nodes are contiguous there, its root
+/// first, so a subtree built alone (its root node 0) is the serial one with every node index
+/// shifted by where its root lands. Leaves name their block by its place in the whole map.
+fn build_top(photons: &mut [Photon], threads: usize) -> Vec<Node> {
+    let (parts, len) = split_parts(photons, 0, photons.len());
+    let parts = &parts[..len];
+    let mut root = boxes(photons, parts);
+    // The parts' photons as disjoint slices, each taken by the one chunk that builds its subtree.
+    let mut rest = &mut photons[..];
+    let mut slices = Vec::with_capacity(len);
+    for &(a, b) in parts {
+        let (part, tail) = std::mem::take(&mut rest).split_at_mut(b - a);
+        slices.push(std::sync::Mutex::new((a, part)));
+        rest = tail;
+    }
+    let subtrees = crate::parallel::map_chunks(
+        len,
+        1,
+        threads,
+        |range| {
+            let mut slot = slices[range.start].lock().unwrap_or_else(|e| e.into_inner());
+            let (base, part) = &mut *slot;
+            let base = *base;
+            if part.len() <= BLOCK {
+                return Vec::new();
+            }
+            let mut nodes = vec![Node::EMPTY];
+            build_node(part, base, 0, part.len(), 0, &mut nodes);
+            nodes
+        },
+        |_| {},
+    );
+    let mut nodes = vec![Node::EMPTY];
+    for (c, (&(a, b), subtree)) in parts.iter().zip(subtrees).enumerate() {
+        if blocks(a, b) == 1 {
+            root.leaves |= 1 << c;
+            root.child[c] = LEAF | (a / BLOCK) as u32;
+            continue;
+        }
+        let shift = nodes.len() as u32;
+        root.child[c] = shift;
+        nodes.extend(subtree.into_iter().map(|mut node| {
+            // Inner children: neither a leaf nor an empty slot (child 0, which no inner child
+            // of a subtree is: node 0 is its root).
+            for (slot, child) in node.child.iter_mut().enumerate() {
+                if node.leaves & (1 << slot) == 0 && *child != 0 {
+                    *child += shift;
+                }
+            }
+            node
+        }));
+    }
+    nodes[0] = root;
     nodes
 }
 
@@ -205,12 +268,32 @@ fn blocks(lo: usize, hi: usize) -> usize {
     (hi - lo).div_ceil(BLOCK)
 }
 
-/// Fills node `index` with the parts of the photon range `lo..hi`, and builds the nodes below it.
-/// Each part holds at most `cap` blocks, the smallest power of 8 that leaves at most 8 parts, and
-/// all but the last are full: subtrees are complete, so nodes have 8 children wherever the
-/// photons allow (halving at the median instead left nodes of two leaves: 5.3 bytes of nodes per
-/// photon, against 4.1).
-fn build_node(photons: &mut [Photon], lo: usize, hi: usize, index: usize, nodes: &mut Vec<Node>) {
+/// Fills node `index` with the parts of the photon range `lo..hi` ([`split_parts`]), and builds
+/// the nodes below it. `photons` starts at photon `base` of the map (where a leaf's block index
+/// counts from).
+fn build_node(photons: &mut [Photon], base: usize, lo: usize, hi: usize, index: usize, nodes: &mut Vec<Node>) {
+    let (parts, len) = split_parts(photons, lo, hi);
+    let mut node = boxes(photons, &parts[..len]);
+    for (c, &(a, b)) in parts[..len].iter().enumerate() {
+        node.child[c] = if blocks(a, b) == 1 {
+            node.leaves |= 1 << c;
+            LEAF | ((base + a) / BLOCK) as u32
+        } else {
+            let child = nodes.len();
+            nodes.push(Node::EMPTY);
+            build_node(photons, base, a, b, child, nodes);
+            child as u32
+        };
+    }
+    nodes[index] = node;
+}
+
+/// Splits the photon range `lo..hi` into up to 8 parts (reordering the photons), each of at
+/// most `cap` blocks, the smallest power of 8 that leaves at most 8 parts, and all but the last
+/// full: subtrees are complete, so nodes have 8 children wherever the photons allow (halving at
+/// the median instead left nodes of two leaves: 5.3 bytes of nodes per photon, against 4.1). The
+/// parts depend on the count alone; which photons go where, on their positions.
+fn split_parts(photons: &mut [Photon], lo: usize, hi: usize) -> ([(usize, usize); 8], usize) {
     let mut cap = 1;
     while cap * 8 < blocks(lo, hi) {
         cap *= 8;
@@ -243,24 +326,20 @@ fn build_node(photons: &mut [Photon], lo: usize, hi: usize, index: usize, nodes:
         parts[j + 1] = (mid, b);
         len += 1;
     }
+    (parts, len)
+}
+
+/// A node whose children's boxes are those of `parts` (children not yet set).
+fn boxes(photons: &[Photon], parts: &[(usize, usize)]) -> Node {
     let mut node = Node::EMPTY;
-    for (c, &(a, b)) in parts[..len].iter().enumerate() {
+    for (c, &(a, b)) in parts.iter().enumerate() {
         let (mn, mx) = bounds(&photons[a..b]);
         for axis in 0..3 {
             node.lo[axis][c] = mn[axis];
             node.hi[axis][c] = mx[axis];
         }
-        node.child[c] = if blocks(a, b) == 1 {
-            node.leaves |= 1 << c;
-            LEAF | (a / BLOCK) as u32
-        } else {
-            let child = nodes.len();
-            nodes.push(Node::EMPTY);
-            build_node(photons, a, b, child, nodes);
-            child as u32
-        };
     }
-    nodes[index] = node;
+    node
 }
 
 /// The box of `photons`' positions, ignoring NaN coordinates (such a photon is never within any
@@ -320,7 +399,7 @@ mod tests {
                     flags: 0,
                 })
                 .collect();
-            let nodes = build_tree(&mut photons);
+            let nodes = build_tree(&mut photons, 1);
             let mut seen = vec![0u32; n.div_ceil(BLOCK)];
             for node in &nodes {
                 for c in 0..8 {
@@ -339,6 +418,31 @@ mod tests {
                 }
             }
             assert!(seen.iter().all(|&k| k == 1), "n {n}: {seen:?}");
+        }
+    }
+    /// A map built on 2 or 3 threads has the serial build's tree and photon order, bit for bit:
+    /// above [`PARALLEL_BUILD`] photons, where the root's subtrees are built apart and joined.
+    #[test]
+    fn a_parallel_build_is_the_serial_build() {
+        let mut rnd = super::super::test_uniforms(11);
+        for n in [PARALLEL_BUILD, PARALLEL_BUILD + 1, 3 * PARALLEL_BUILD + 77, 70_001] {
+            let photons: Vec<Photon> = (0..n)
+                .map(|_| Photon {
+                    position: Vec3::new(rnd(), rnd() * 0.3, rnd() * 2.0),
+                    power: Vec3::ONE,
+                    wi: Vec3::Y,
+                    normal: Vec3::Y,
+                    flags: 0,
+                })
+                .collect();
+            let mut serial = photons.clone();
+            let serial_nodes = build_tree(&mut serial, 1);
+            for threads in [2, 3] {
+                let mut parallel = photons.clone();
+                let nodes = build_tree(&mut parallel, threads);
+                assert!(nodes == serial_nodes, "n {n}, {threads} threads: the nodes differ");
+                assert!(parallel == serial, "n {n}, {threads} threads: the photon order differs");
+            }
         }
     }
 }

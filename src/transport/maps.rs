@@ -30,16 +30,9 @@ impl PhotonMaps {
     /// (and is not a progressive pass), the irradiance map.
     #[must_use]
     pub fn build(scene: &Scene, job: &Job, global: Vec<Photon>, caustic: Vec<Photon>) -> Self {
-        // The two trees are independent: built side by side when there is a second thread.
-        let (global, caustic) = if job.threads > 1 {
-            std::thread::scope(|s| {
-                let c = s.spawn(|| PhotonMap::build(caustic));
-                let g = PhotonMap::build(global);
-                (g, c.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            })
-        } else {
-            (PhotonMap::build(global), PhotonMap::build(caustic))
-        };
+        // One after the other, each on every thread (its root's subtrees at once): two trees
+        // side by side kept at most two threads busy, and only while the smaller lasted.
+        let (global, caustic) = (PhotonMap::build_on(global, job.threads), PhotonMap::build_on(caustic, job.threads));
         let mut maps = PhotonMaps { global, caustic, irradiance: PhotonMap::default() };
         // Not under a progressive pass's fixed radii: reading the nearest precomputed point is
         // biased low there (see `precompute_irradiance`).
@@ -105,5 +98,5 @@ fn precompute_irradiance(global: &PhotonMap, scene: &Scene, settings: &Settings,
         },
         |_| {},
     );
-    PhotonMap::build(chunks.into_iter().flatten().collect())
+    PhotonMap::build_on(chunks.into_iter().flatten().collect(), threads)
 }
