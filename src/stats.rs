@@ -133,11 +133,33 @@ impl std::ops::AddAssign for Numerics {
     }
 }
 
+/// The stages of a load for the summary (` (parse 0.91 s, textures …)`), or nothing where they
+/// were not measured.
+fn load_stages(l: &crate::scene::LoadTimes) -> String {
+    let parts = [
+        ("parse", l.parse_s),
+        ("textures", l.textures_s),
+        ("triangles", l.triangles_s),
+        ("BVH", l.bvh_s),
+        ("lights", l.lights_s),
+        ("edges", l.topology_s),
+    ];
+    if parts.iter().all(|p| p.1 == 0.0) {
+        return String::new();
+    }
+    let parts: Vec<String> = parts.iter().map(|(name, s)| format!("{name} {s:.2} s")).collect();
+    format!(" ({})", parts.join(", "))
+}
+
 /// Wall time per phase, seconds.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct PhaseTimes {
     /// Loading and BVH build.
     pub load_s: f64,
+    /// Loading by stage (a render from a scene file; zero otherwise, and in summaries written
+    /// before it).
+    #[serde(default)]
+    pub load: crate::scene::LoadTimes,
     /// Global photon pass.
     pub global_photons_s: f64,
     /// Caustic photon pass.
@@ -289,7 +311,7 @@ impl RenderStats {
         };
         format!(
             "summary ({} engine, {} code path, {} threads)\n{}{}  rays: {} total ({} camera, {} shadow, {} gather, {} photon)\n  \
-             time: load {:.2} s, global photons {:.2} s, caustic photons {:.2} s, maps {:.2} s, camera {:.2} s{}, total {:.2} s\n  \
+             time: load {:.2} s{}, global photons {:.2} s, caustic photons {:.2} s, maps {:.2} s, camera {:.2} s{}, total {:.2} s\n  \
              non-finite values dropped: {} photon emissions, {} photon bounces ({} more with a zero pdf), \
              {} camera samples; \
              {} pixel sums overflowed; {} vertex normals replaced at load; {} photon rays escaped a \
@@ -306,6 +328,7 @@ impl RenderStats {
             self.rays.gather,
             self.rays.photon,
             t.load_s,
+            load_stages(&t.load),
             t.global_photons_s,
             t.caustic_photons_s,
             t.map_build_s,

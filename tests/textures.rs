@@ -328,3 +328,21 @@ fn engines_agree_on_a_metallic_and_roughness_mapped_floor() {
     // plastic ones have a diffuse base too: both are lit.
     assert!(a.pixels.iter().any(|p| p.specular != Vec3::ZERO) && a.pixels.iter().any(|p| p.direct != Vec3::ZERO));
 }
+
+/// Loading counts its stages (issue 57, `--stats` `times.load`): the textured table spends time
+/// decoding `wood.png`, the untextured box none; both spend some on their BVH and lights; the
+/// stages never add up to more than the load took.
+#[test]
+fn a_load_says_where_its_time_went() {
+    for (scene, textured) in [("table.toml", true), ("cornell-box.toml", false)] {
+        let clock = std::time::Instant::now();
+        let loaded = load_scene(&bundled(scene)).unwrap();
+        let whole = clock.elapsed().as_secs_f64();
+        let t = loaded.scene.load_times;
+        println!("{scene}: {t:?} of {whole:.4} s");
+        assert_eq!(t.textures_s > 0.0, textured, "{scene}: {t:?}");
+        assert!(t.bvh_s > 0.0 && t.lights_s > 0.0 && t.triangles_s > 0.0 && t.parse_s > 0.0, "{scene}: {t:?}");
+        let sum = t.parse_s + t.textures_s + t.triangles_s + t.bvh_s + t.lights_s + t.topology_s;
+        assert!(sum <= whole, "{scene}: stages {sum} s of a {whole} s load");
+    }
+}

@@ -325,6 +325,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     stats.scene = args.scene.display().to_string();
     stats.times.load_s = load_s;
+    stats.times.load = scene.load_times;
     stats.times.total_s += load_s;
 
     if signal.is_none() {

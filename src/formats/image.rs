@@ -39,8 +39,28 @@ fn sniff(head: &[u8]) -> Option<Format> {
     }
 }
 
+thread_local! {
+    /// Seconds this thread has spent in [`load_texture`].
+    static TEXTURE_SECONDS: std::cell::Cell<f64> = const { std::cell::Cell::new(0.0) };
+}
+
+/// Seconds this thread has spent reading and decoding textures so far: a loader takes the
+/// difference across its reading ([`crate::scene::LoadTimes::textures_s`]).
+#[must_use]
+pub fn texture_seconds() -> f64 {
+    TEXTURE_SECONDS.with(std::cell::Cell::get)
+}
+
 /// Reads the image at `path` (`what` names its use in messages: "`map_Kd` texture").
 pub fn load_texture(path: &Path, encoding: Encoding, what: &str) -> Result<Texture> {
+    let clock = std::time::Instant::now();
+    let texture = read_texture(path, encoding, what);
+    TEXTURE_SECONDS.with(|t| t.set(t.get() + clock.elapsed().as_secs_f64()));
+    texture
+}
+
+/// [`load_texture`], untimed.
+fn read_texture(path: &Path, encoding: Encoding, what: &str) -> Result<Texture> {
     let len = read_input_len(path, what)?;
     if len > MAX_IMAGE_FILE {
         return Err(Error::io(

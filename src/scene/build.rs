@@ -27,6 +27,7 @@ impl Scene {
         environment: Option<Environment>,
         mut warnings: Vec<String>,
     ) -> Result<Scene> {
+        let clock = std::time::Instant::now();
         for m in &meshes {
             // The readers name the line or the `[[mesh]]` entry; this catches meshes made in code.
             if let Some((k, p)) = super::first_out_of_range(&m.positions) {
@@ -77,7 +78,11 @@ impl Scene {
         if let Some(w) = checks::coincident_dielectrics(&t.p0, &t.p1, &t.p2, &t.mat, &materials, size) {
             warnings.push(w);
         }
+        let mut load_times = LoadTimes { triangles_s: clock.elapsed().as_secs_f64(), ..LoadTimes::default() };
+        let clock = std::time::Instant::now();
         let (bvh, order) = Bvh::build(&t.p0, &t.p1, &t.p2);
+        load_times.bvh_s = clock.elapsed().as_secs_f64();
+        let clock = std::time::Instant::now();
         let pick = |v: &Vec<Vec3>| order.iter().map(|&i| v[i as usize]).collect::<Vec<_>>();
         let (p0, p1, p2) = (pick(&t.p0), pick(&t.p1), pick(&t.p2));
         let vn: Vec<[Vec3; 3]> = order.iter().map(|&i| t.vn[i as usize]).collect();
@@ -129,14 +134,21 @@ impl Scene {
             kinds: (false, false, false, false, false, false),
             open_edges: open_edges::OpenEdges::default(),
             caustic_targets: Vec::new(),
+            load_times,
         };
         scene.find_kinds();
+        // Placing the triangles in BVH order (and listing the emitting ones) counts with them.
+        scene.load_times.triangles_s += clock.elapsed().as_secs_f64();
+        let clock = std::time::Instant::now();
         scene.distribute_lights()?;
+        scene.load_times.lights_s = clock.elapsed().as_secs_f64();
+        let clock = std::time::Instant::now();
         let edges = scene.edge_uses();
         // Light may leave through a cut-out's holes: a photon that escapes has not leaked.
         scene.encloses_lights = !scene.kinds.5 && scene.find_enclosure(&edges);
         scene.open_edges = scene.find_open_edges(scene.diagonal().max(f32::MIN_POSITIVE), &edges);
         scene.caustic_targets = scene.find_caustic_targets(&edges);
+        scene.load_times.topology_s = clock.elapsed().as_secs_f64();
         Ok(scene)
     }
 

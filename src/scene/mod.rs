@@ -85,6 +85,25 @@ pub fn out_of_range_message(p: Vec3) -> String {
     )
 }
 
+/// Where loading a scene spent its time (seconds, wall clock), by stage. The readers fill
+/// `parse_s` and `textures_s`; [`Scene::build`] the rest.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct LoadTimes {
+    /// Reading the scene and mesh files and their materials (textures not included).
+    pub parse_s: f64,
+    /// Reading and decoding texture images ([`crate::formats::image::load_texture`]).
+    pub textures_s: f64,
+    /// Gathering, checking and placing the triangles.
+    pub triangles_s: f64,
+    /// Building the BVH.
+    pub bvh_s: f64,
+    /// The lights' power distributions and the light tree.
+    pub lights_s: f64,
+    /// The meshes' edges: whether the lights are enclosed, open edges, caustic targets.
+    pub topology_s: f64,
+}
+
 /// An assembled, validated scene.
 pub struct Scene {
     /// First vertices (BVH order).
@@ -148,6 +167,8 @@ pub struct Scene {
     /// Bounding spheres of the objects photons pass on as specular: where caustic photons are
     /// aimed.
     pub caustic_targets: Vec<targets::Target>,
+    /// Where loading it spent its time.
+    pub load_times: LoadTimes,
     bvh: Bvh,
     /// (any delta, any glass, any non-delta, any absorbing interior, any normal map) material on
     /// a triangle, computed once.
