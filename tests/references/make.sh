@@ -4,7 +4,7 @@
 # estimation, within 0.2 % of the converged reference issue 15 measured against on
 # CornellBox-Original), 32×32, from the bundled scenes' cameras, 65 536 samples per pixel (the
 # most one render takes) per file; the test averages a scene's files. Run from the repository's
-# root after `cargo build --release`; about 12 minutes on two cores, and 16 more for the interior.
+# root after `cargo build --release`; about 12 minutes on two cores, and about 10 more for the interior.
 set -e
 pw=target/release/photonwave
 $pw render scenes/cornell-box.toml --engine path --width 32 --height 32 --spp 65536 --seed 7 \
