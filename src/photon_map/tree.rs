@@ -420,6 +420,7 @@ mod tests {
             assert!(seen.iter().all(|&k| k == 1), "n {n}: {seen:?}");
         }
     }
+
     /// A map built on 2 or 3 threads has the serial build's tree and photon order, bit for bit:
     /// above [`PARALLEL_BUILD`] photons, where the root's subtrees are built apart and joined.
     #[test]

@@ -56,10 +56,8 @@ pub fn costs(stats: &RenderStats) -> Vec<(Cost, f64)> {
     let mut out = vec![(Cost::Photons, t.global_photons_s + t.caustic_photons_s), (Cost::MapBuilds, t.map_build_s)];
     let camera = stats.stages.as_ref().map(|s| {
         let camera_systems = s.0.iter().filter(|(name, _)| !name.ends_with("_photons"));
-        let (lookups, all) = camera_systems.fold((0.0, 0.0), |(l, a), (name, st)| {
-            (l + if LOOKUP_SYSTEMS.contains(&name.as_str()) { st.seconds } else { 0.0 }, a + st.seconds)
-        });
-        (lookups, all)
+        let lookups = camera_systems.clone().filter(|(name, _)| LOOKUP_SYSTEMS.contains(&name.as_str()));
+        (lookups.map(|(_, st)| st.seconds).sum::<f64>(), camera_systems.map(|(_, st)| st.seconds).sum::<f64>())
     });
     match camera {
         Some((lookups, all)) if all > 0.0 => {
@@ -108,6 +106,11 @@ mod tests {
     use super::*;
     use crate::stats::{PhaseTimes, ProgressiveStats, StageStat, StageStats};
 
+    /// Phase times: global and caustic photons, map builds, camera pass.
+    fn phases(global_photons_s: f64, caustic_photons_s: f64, map_build_s: f64, camera_s: f64) -> PhaseTimes {
+        PhaseTimes { global_photons_s, caustic_photons_s, map_build_s, camera_s, ..Default::default() }
+    }
+
     fn stats(first_pass: f64, times: PhaseTimes, stages: &[(&str, f64)]) -> RenderStats {
         let stages = (!stages.is_empty()).then(|| {
             StageStats(
@@ -133,13 +136,7 @@ mod tests {
     /// lookups and the settings that make fewer or cheaper ones, not photons alone.
     #[test]
     fn a_pass_spent_in_lookups_is_named_so() {
-        let times = PhaseTimes {
-            global_photons_s: 0.2,
-            caustic_photons_s: 0.1,
-            map_build_s: 0.1,
-            camera_s: 9.6,
-            ..Default::default()
-        };
+        let times = phases(0.2, 0.1, 0.1, 9.6);
         let s = stats(
             1.0,
             times,
@@ -158,13 +155,7 @@ mod tests {
     /// budget is not warned of.
     #[test]
     fn a_pass_spent_in_photons_names_the_photon_counts() {
-        let times = PhaseTimes {
-            global_photons_s: 6.0,
-            caustic_photons_s: 2.0,
-            map_build_s: 0.5,
-            camera_s: 1.5,
-            ..Default::default()
-        };
+        let times = phases(6.0, 2.0, 0.5, 1.5);
         let s = stats(0.8, times.clone(), &[("gather_global", 1.0), ("intersect_paths", 2.0)]);
         let w = budget_warning(&s).unwrap();
         assert!(w.contains("80 % of the passes' time went to tracing photons"), "{w}");

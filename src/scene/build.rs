@@ -8,6 +8,14 @@
 use super::light_tree::{LightTree, TreeLight};
 use super::*;
 
+/// Seconds since `clock`, which then restarts: one stage of [`LoadTimes`].
+fn lap(clock: &mut std::time::Instant) -> f64 {
+    let now = std::time::Instant::now();
+    let seconds = now.duration_since(*clock).as_secs_f64();
+    *clock = now;
+    seconds
+}
+
 impl Scene {
     /// Assembles meshes, materials and extra lights; validates and builds the BVH.
     pub fn build(
@@ -27,7 +35,7 @@ impl Scene {
         environment: Option<Environment>,
         mut warnings: Vec<String>,
     ) -> Result<Scene> {
-        let clock = std::time::Instant::now();
+        let mut clock = std::time::Instant::now();
         for m in &meshes {
             // The readers name the line or the `[[mesh]]` entry; this catches meshes made in code.
             if let Some((k, p)) = super::first_out_of_range(&m.positions) {
@@ -78,11 +86,9 @@ impl Scene {
         if let Some(w) = checks::coincident_dielectrics(&t.p0, &t.p1, &t.p2, &t.mat, &materials, size) {
             warnings.push(w);
         }
-        let mut load_times = LoadTimes { triangles_s: clock.elapsed().as_secs_f64(), ..LoadTimes::default() };
-        let clock = std::time::Instant::now();
+        let mut load_times = LoadTimes { triangles_s: lap(&mut clock), ..LoadTimes::default() };
         let (bvh, order) = Bvh::build(&t.p0, &t.p1, &t.p2);
-        load_times.bvh_s = clock.elapsed().as_secs_f64();
-        let clock = std::time::Instant::now();
+        load_times.bvh_s = lap(&mut clock);
         let pick = |v: &Vec<Vec3>| order.iter().map(|&i| v[i as usize]).collect::<Vec<_>>();
         let (p0, p1, p2) = (pick(&t.p0), pick(&t.p1), pick(&t.p2));
         let vn: Vec<[Vec3; 3]> = order.iter().map(|&i| t.vn[i as usize]).collect();
@@ -138,17 +144,15 @@ impl Scene {
         };
         scene.find_kinds();
         // Placing the triangles in BVH order (and listing the emitting ones) counts with them.
-        scene.load_times.triangles_s += clock.elapsed().as_secs_f64();
-        let clock = std::time::Instant::now();
+        scene.load_times.triangles_s += lap(&mut clock);
         scene.distribute_lights()?;
-        scene.load_times.lights_s = clock.elapsed().as_secs_f64();
-        let clock = std::time::Instant::now();
+        scene.load_times.lights_s = lap(&mut clock);
         let edges = scene.edge_uses();
         // Light may leave through a cut-out's holes: a photon that escapes has not leaked.
         scene.encloses_lights = !scene.kinds.5 && scene.find_enclosure(&edges);
         scene.open_edges = scene.find_open_edges(scene.diagonal().max(f32::MIN_POSITIVE), &edges);
         scene.caustic_targets = scene.find_caustic_targets(&edges);
-        scene.load_times.topology_s = clock.elapsed().as_secs_f64();
+        scene.load_times.topology_s = lap(&mut clock);
         Ok(scene)
     }
 
