@@ -103,7 +103,9 @@ pub struct Numerics {
     /// (a leak; counted only in such scenes, where missing everything is impossible).
     pub photon_escaped: u64,
     /// Density estimates: photons within the search radius that the normal filter turned away
-    /// (another surface's photons, around a corner or across a thin wall), at shading points.
+    /// (another surface's photons, around a corner or across a thin wall), at shading points;
+    /// only those the lookups tested (they skip subtrees whose photons all face away,
+    /// `photon_map::orientation`).
     pub photons_filtered: u64,
     /// Photon scattering: bounces whose power would have exceeded the stated bound
     /// ([`POWER_GROWTH_MAX`](crate::transport::photon::POWER_GROWTH_MAX) times the path's

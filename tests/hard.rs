@@ -284,7 +284,10 @@ fn total_internal_reflection_lets_nothing_out() {
 
 /// `--stats` counts the photons the normal filter turns away in density estimates at shading
 /// points (here the global map read at the first hit; precomputed irradiance reads make none): on
-/// the corner, many, and the same number on both engines (they make the same estimates).
+/// the corner, some, and the same number on both engines (they make the same estimates). Only
+/// photons a lookup tests count, and it skips the subtrees that face away
+/// (`photon_map::orientation`): 30 here, those sharing a block with the lookup's own surface
+/// at the corner.
 fn photons_turned_away_are_counted_alike() {
     let loaded = hard("corner.toml");
     let rays = loaded.camera.unwrap().prepare(16, 16).unwrap();
@@ -295,7 +298,7 @@ fn photons_turned_away_are_counted_alike() {
         .map(|&e| render(&scene, &rays, &s, e, None, &NoProgress).unwrap().1.numerics.photons_filtered)
         .collect();
     println!("photons turned away: {counts:?}");
-    assert!(counts[0] > 100 && counts[0] == counts[1], "{counts:?}");
+    assert!(counts[0] >= 10 && counts[0] == counts[1], "{counts:?}");
 }
 
 /// Case 4: a lit floor meets a wall that the light (straight down) never reaches directly. The 64
@@ -344,8 +347,12 @@ fn no_photon_crosses_a_corner() {
                 let e_own = own.estimate_radius(set, &fixed, Reflectance::Constant(Vec3::ONE));
                 println!("{name}, {side}, {set:?}: {} photons nearby on the other surface; irradiance {} from {} photons, own map {} from {}", others, e.radiance, e.count, e_own.radiance, e_own.count);
                 assert_eq!(e.count, e_own.count, "{name}, {side}, {set:?}");
-                // Every one of the other surface's photons in the disk was counted as turned away.
-                assert_eq!(e.rejected as usize, others, "{name}, {side}, {set:?}");
+                // Every one of the other surface's photons in the disk is turned away: a
+                // boundary-corrected estimate, which tests them all, counts each; the plain one
+                // skips most of them unread (they face away, `photon_map::orientation`).
+                let corrected = map.estimate_radius_on_surface(set, &fixed, Reflectance::Constant(Vec3::ONE), &[]);
+                assert_eq!(corrected.rejected as usize, others, "{name}, {side}, {set:?}");
+                assert!((e.rejected as usize) < others / 10, "{name}, {side}, {set:?}: {} tested", e.rejected);
                 // The k-nearest search counts those it met while its radius shrank, alike in both
                 // kernel sets.
                 let knn =

@@ -8,6 +8,7 @@
 //! the baseline pays for the same estimate. (Its k nearest are taken before the normal test,
 //! ours after it: at corners the two sum slightly different photons.)
 
+use super::orientation::reachable;
 use super::{Estimate, Lookup, PhotonMap, Reflectance, Test};
 use crate::code_path::CodePath;
 
@@ -52,7 +53,7 @@ impl PhotonMap {
         let mut tested = 0u64;
         if q.k == 0 {
             let r2 = q.r_max * q.r_max;
-            let mut walk = super::tree::Walk::<false>::new(self, CodePath::Scalar, q.p);
+            let mut walk = super::tree::Walk::<false>::new(self, CodePath::Scalar, q.p, reachable(q.filter.n));
             while let Some((lo, hi)) = walk.next(self, r2) {
                 tested += (hi - lo) as u64;
             }

@@ -15,21 +15,24 @@
 //!   direction (octahedral, 8 + 8 bits);
 //! - `power`: RGBE (Ward's shared exponent, as Jensen stored it).
 //!
-//! The tree's nodes add [`PhotonMap::tree_bytes_per_photon`] (4.1 B measured: a 228-byte node
-//! per 7 blocks or so).
+//! The tree's nodes add [`PhotonMap::tree_bytes_per_photon`] (4.2 B: a 236-byte node per 7
+//! blocks or so; 4.1 B measured before the nodes kept their children's direction classes).
 //!
 //! Error bounds of the packing: power per channel within 2⁻⁷ of the largest channel (dithered,
 //! so unbiased even when all photons carry one power); incoming direction within 1° (octahedral
 //! step 2/254; 0.95° measured over 4·10⁵ random directions); normal within 4° (step 2/62; 3.9°
 //! measured), against a filter threshold of 45°. A lookup tests every block whose box its sphere
-//! reaches — 8 photons at a time by the SIMD kernels, one at a time by their scalar twins, with
-//! the same arithmetic in the same order, so both find the same photons.
+//! reaches and that holds photons facing its way ([`orientation`]) — 8 photons at a time by the
+//! SIMD kernels, one at a time by their scalar twins, with the same arithmetic in the same order,
+//! so both find the same photons.
 //!
 //! Files: [`kernel`] (the density kernels), `packing` (key and RGBE codecs), `tree` (build and
 //! walk), `filter` (which photons a lookup may use), [`nearest`] (the k-nearest search, by
 //! counting), [`knn`] (k-nearest lookups and estimates),
 //! [`radius`] (fixed-radius estimates), [`query_packet`] (up to 8 fixed-radius estimates sharing
-//! one walk), `sum` (the kernel sums); each SIMD kernel beside its scalar twin.
+//! one walk), `sum` (the kernel sums), [`orientation`] (which way each subtree's photons face,
+//! so that lookups skip those their normal test would turn away); each SIMD kernel beside its
+//! scalar twin.
 
 pub mod boundary;
 mod candidates;
@@ -37,6 +40,7 @@ mod filter;
 pub mod kernel;
 pub mod knn;
 pub mod nearest;
+pub mod orientation;
 mod packing;
 pub mod query_packet;
 pub mod radius;
@@ -113,7 +117,9 @@ pub struct Estimate {
     pub count: u32,
     /// Photons within the search radius (a k-nearest lookup's: strictly nearer than the k-th)
     /// that the surface tests of the [`Filter`] turned away: another surface's photons, around
-    /// a corner, through a thin wall or off a parallel surface.
+    /// a corner, through a thin wall or off a parallel surface. Only photons the walk tested
+    /// count: it skips the subtrees whose photons all face away from the query ([`orientation`]),
+    /// unless the estimate is boundary-corrected.
     pub rejected: u32,
     /// Photons within the search radius set aside off a flat query's plane ([`Filter::plane`]):
     /// not in this estimate, which the caller completes with those of them that are visible.
@@ -293,7 +299,7 @@ impl PhotonMap {
         let col = |f: &dyn Fn(&Photon) -> f32| {
             photons.iter().map(f).chain(std::iter::repeat_n(inf, PAD)).collect::<Vec<f32>>()
         };
-        PhotonMap {
+        let mut map = PhotonMap {
             x: col(&|p| p.position.x),
             y: col(&|p| p.position.y),
             z: col(&|p| p.position.z),
@@ -306,7 +312,9 @@ impl PhotonMap {
                 .collect(),
             len: n,
             nodes,
-        }
+        };
+        map.fill_classes();
+        map
     }
 
     /// Number of stored photons.

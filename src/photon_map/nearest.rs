@@ -18,6 +18,7 @@
 //! them in; the SIMD kernel and its scalar twin fill, count and order the same lanes, so both
 //! find the same photons and the same radius.
 
+use super::orientation::{reachable, ALL};
 use super::tree::Walk;
 use super::{Lookup, PhotonMap, Test};
 use crate::code_path::CodePath;
@@ -279,7 +280,10 @@ impl PhotonMap {
         }
         // The farthest candidate so far (its SIMD form lane by lane).
         let (mut far, mut far8) = (0.0f32, f32x8::ZERO);
-        let mut walk = Walk::<true>::new(self, set, q.p);
+        // The nearest alone (a precomputed irradiance point) is found in a short walk, which the
+        // class test slows more than it shortens (cornell-spheres' final gather 4 % slower).
+        let reach = if k == 1 { ALL } else { reachable(q.filter.n) };
+        let mut walk = Walk::<true>::new(self, set, q.p, reach);
         while let Some((lo, hi)) = walk.next(self, r2) {
             if COUNT {
                 *tested += (hi - lo) as u64;

@@ -18,6 +18,7 @@
 
 use super::boundary::{Cut, Neighbours};
 use super::filter::Normals8;
+use super::orientation::{reachable, ALL};
 use super::sum::{reduce3, Decoded8};
 use super::tree::{Node, LEAF, STACK};
 use super::{Estimate, Kernel, Lookup, PhotonMap, Reflectance};
@@ -99,6 +100,11 @@ impl PhotonMap {
             let ok = self.fixed_radius2(&q.lookup).is_some() && q.lookup.p.is_finite();
             m | u8::from(ok) << j
         });
+        // The classes each query reaches: all of them for a corrected one, which reads the
+        // photons the normal test turns away (as `estimate_radius_with` walks).
+        let classes: [u8; PACKET] = std::array::from_fn(|j| {
+            queries.get(j).map_or(0, |q| if q.edges.is_some() { ALL } else { reachable(q.lookup.filter.n) })
+        });
         let mut sums = [Sums::default(); PACKET];
         let mut stack = [(0u32, 0u8); STACK];
         let mut top = usize::from(live != 0);
@@ -107,7 +113,7 @@ impl PhotonMap {
             top -= 1;
             let (index, qmask) = stack[top];
             let node = &self.nodes[index as usize];
-            let (reach, reached) = Self::node_reach(node, queries, &r2, qmask);
+            let (reach, reached) = Self::node_reach(node, queries, &r2, &classes, qmask);
             // Leaves first, in slot order; inner children pushed last slot first, so that they are
             // popped in slot order: the order of a single fixed-radius walk. (The set bits of the
             // reached children, not a test of every slot: `gather_global` on cornell-spheres
@@ -133,16 +139,24 @@ impl PhotonMap {
         }
     }
 
-    /// For each of `node`'s 8 children, the queries of `qmask` whose sphere reaches its box, as
-    /// bits (child `c`'s in byte `c`), and the children some query reaches, as bits.
+    /// For each of `node`'s 8 children, the queries of `qmask` whose sphere reaches its box and
+    /// whose `classes` it holds photons of, as bits (child `c`'s in byte `c`), and the children
+    /// some query reaches, as bits.
     #[inline]
-    fn node_reach(node: &Node, queries: &[RadiusQuery<'_>], r2: &[f32; PACKET], qmask: u8) -> ([u8; 8], u8) {
+    fn node_reach(
+        node: &Node,
+        queries: &[RadiusQuery<'_>],
+        r2: &[f32; PACKET],
+        classes: &[u8; PACKET],
+        qmask: u8,
+    ) -> ([u8; 8], u8) {
         let (mut reach, mut reached) = (0u64, 0u32);
         let mut left = qmask;
         while left != 0 {
             let j = left.trailing_zeros() as usize;
             left &= left - 1;
             let (_, hits) = node.distances8(queries[j].lookup.p, r2[j]);
+            let hits = if classes[j] == ALL { hits } else { hits & node.facing8(classes[j]) };
             reach |= SPREAD[hits as usize] << j;
             reached |= hits;
         }

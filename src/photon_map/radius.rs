@@ -3,6 +3,7 @@
 //! with the estimate's bias from the same photons ([`Kernel::bias_normalisation`]).
 
 use super::boundary::{Coverage, Cut, Neighbours};
+use super::orientation::{reachable, ALL};
 use super::sum::reduce3;
 use super::tree::Walk;
 use super::{Estimate, Kernel, Lookup, PhotonMap, Reflectance, Test};
@@ -58,7 +59,9 @@ impl PhotonMap {
         let mut neighbours = Neighbours::default();
         let (mut sum, mut bias) = (Vec3::ZERO, Vec3::ZERO);
         let (mut sum8, mut bias8) = ([f32x8::ZERO; 3], [f32x8::ZERO; 3]);
-        let mut walk = Walk::<false>::new(self, set, q.p);
+        // A corrected estimate reads the other surfaces' photons for its cuts: it walks them all.
+        let reach = if on_surface.is_some() { ALL } else { reachable(q.filter.n) };
+        let mut walk = Walk::<false>::new(self, set, q.p, reach);
         while let Some((lo, hi)) = walk.next(self, r2) {
             if set == CodePath::Simd {
                 let v = self.accepts8(lo, q.p, r2, &q.filter);
@@ -173,7 +176,7 @@ impl PhotonMap {
     pub fn off_plane_photons(&self, q: &Lookup) -> Vec<(f32, u32)> {
         let mut out = Vec::new();
         let Some(r2) = self.fixed_radius2(q) else { return out };
-        let mut walk = Walk::<false>::new(self, CodePath::Scalar, q.p);
+        let mut walk = Walk::<false>::new(self, CodePath::Scalar, q.p, reachable(q.filter.n));
         while let Some((lo, hi)) = walk.next(self, r2) {
             for i in lo..hi {
                 let d2 = self.d2(i, q.p);

@@ -13,6 +13,7 @@
 //! distance's operations on coordinates no farther, and rounding is monotone, so a photon within
 //! the radius never lies in a pruned box.
 
+use super::orientation::ALL;
 use super::{Photon, PhotonMap};
 use crate::code_path::CodePath;
 use glam::Vec3;
@@ -37,12 +38,21 @@ pub(super) struct Node {
     lo: [[f32; 8]; 3],
     hi: [[f32; 8]; 3],
     pub(super) child: [u32; 8],
+    /// Per child (byte `c` for child `c`), the direction classes of the photons below it, as
+    /// bits ([`super::orientation`]); 0 in an empty slot.
+    pub(super) classes: [u8; 8],
     /// The slots holding leaves, as bits.
     pub(super) leaves: u8,
 }
 
 impl Node {
-    const EMPTY: Node = Node { lo: [[f32::INFINITY; 8]; 3], hi: [[f32::NEG_INFINITY; 8]; 3], child: [0; 8], leaves: 0 };
+    const EMPTY: Node = Node {
+        lo: [[f32::INFINITY; 8]; 3],
+        hi: [[f32::NEG_INFINITY; 8]; 3],
+        child: [0; 8],
+        classes: [0; 8],
+        leaves: 0,
+    };
 
     /// Squared distances from `p` to the 8 child boxes (0 inside), and the mask of those below `r2`.
     #[inline]
@@ -71,16 +81,36 @@ impl Node {
         }
         (out, mask)
     }
+
+    /// The children holding a photon of the classes `reach`, as bits: the 8 bytes of
+    /// `classes` tested at once in a 64-bit word (each byte's high bit set where the byte
+    /// is nonzero, then the 8 high bits gathered by one multiply).
+    #[inline]
+    pub(super) fn facing8(&self, reach: u8) -> u32 {
+        let x = u64::from_le_bytes(self.classes) & (u64::from(reach) * 0x0101_0101_0101_0101);
+        let low = 0x7f7f_7f7f_7f7f_7f7f;
+        let high = (((x & low) + low) | x) & !low;
+        ((high >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u32
+    }
+
+    /// Scalar twin of [`Node::facing8`]: one byte at a time.
+    #[inline]
+    pub(super) fn facing(&self, reach: u8) -> u32 {
+        (0..8).fold(0, |bits, c| bits | u32::from(self.classes[c] & reach != 0) << c)
+    }
 }
 
 /// A walk through the tree toward a query point: [`Walk::next`] returns every block whose box lies
-/// within the radius² it is given, which may shrink between calls. `NEAREST_FIRST`: a node's
+/// within the radius² it is given, which may shrink between calls, and that holds photons of the
+/// direction classes the walk reaches ([`super::orientation`]). `NEAREST_FIRST`: a node's
 /// children in order of their boxes' distance, so a shrinking radius shrinks early (k-nearest
 /// lookups); otherwise in slot order. The caller's loop holds the per-block work, so its sums stay
 /// in registers.
 pub(super) struct Walk<const NEAREST_FIRST: bool> {
     set: CodePath,
     p: Vec3,
+    /// The direction classes it reaches ([`super::orientation::reachable`]).
+    reach: u8,
     /// Children still to visit, each with its box's squared distance (popped from the end).
     stack: [(u32, f32); STACK],
     top: usize,
@@ -90,12 +120,13 @@ pub(super) struct Walk<const NEAREST_FIRST: bool> {
 }
 
 impl<const NEAREST_FIRST: bool> Walk<NEAREST_FIRST> {
-    /// A walk of `map` toward `p` by code path `set` (the node test or its scalar twin). A
-    /// non-finite query lies at a non-finite distance from every photon: its walk is empty.
+    /// A walk of `map` toward `p` by code path `set` (the node tests or their scalar twins)
+    /// through the children holding photons of the classes `reach`. A non-finite query lies at a
+    /// non-finite distance from every photon: its walk is empty.
     #[inline]
-    pub(super) fn new(map: &PhotonMap, set: CodePath, p: Vec3) -> Self {
+    pub(super) fn new(map: &PhotonMap, set: CodePath, p: Vec3, reach: u8) -> Self {
         let top = usize::from(!map.nodes.is_empty() && p.is_finite());
-        Walk { set, p, stack: [(0, 0.0); STACK], top, pending: 0, node: 0 }
+        Walk { set, p, reach, stack: [(0, 0.0); STACK], top, pending: 0, node: 0 }
     }
 
     /// The next block (photons `lo..hi`, at most [`BLOCK`], `lo` a multiple of it) whose box lies
@@ -121,8 +152,14 @@ impl<const NEAREST_FIRST: bool> Walk<NEAREST_FIRST> {
             }
             let node = &map.nodes[child as usize];
             let (d2s, mut hits) = match self.set {
-                CodePath::Simd => node.distances8(self.p, r2),
-                CodePath::Scalar => node.distances(self.p, r2),
+                CodePath::Simd => {
+                    let (d2s, hits) = node.distances8(self.p, r2);
+                    (d2s, if self.reach == ALL { hits } else { hits & node.facing8(self.reach) })
+                }
+                CodePath::Scalar => {
+                    let (d2s, hits) = node.distances(self.p, r2);
+                    (d2s, if self.reach == ALL { hits } else { hits & node.facing(self.reach) })
+                }
             };
             if NEAREST_FIRST {
                 // Pushed farthest first, so that the nearest is popped first (of equals, the
@@ -382,6 +419,19 @@ mod tests {
                 assert_eq!(ma, mb, "{p} {r2}");
                 assert_eq!(ma & 0x80, 0, "the empty slot is never reached");
             }
+        }
+    }
+
+    /// The class test (8 bytes in a 64-bit word) and its scalar twin agree on random byte
+    /// patterns, empty children included.
+    #[test]
+    fn class_test_matches_its_scalar_twin() {
+        let mut rnd = super::super::test_uniforms(8);
+        let mut node = Node::EMPTY;
+        for _ in 0..2000 {
+            node.classes = std::array::from_fn(|_| if rnd() < 0.3 { 0 } else { (rnd() * 256.0) as u8 });
+            let reach = (rnd() * 256.0) as u8;
+            assert_eq!(node.facing8(reach), node.facing(reach), "{:?} {reach:b}", node.classes);
         }
     }
 
