@@ -318,7 +318,7 @@ impl RenderStats {
              {} camera samples; \
              {} pixel sums overflowed; {} vertex normals replaced at load; {} photon rays escaped a \
              closed scene; \
-             {} photons turned away by the normal filter\n",
+             {} photons tested and turned away by the normal filter\n",
             self.engine,
             self.code_path,
             self.threads,

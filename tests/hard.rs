@@ -286,8 +286,8 @@ fn total_internal_reflection_lets_nothing_out() {
 /// points (here the global map read at the first hit; precomputed irradiance reads make none): on
 /// the corner, some, and the same number on both engines (they make the same estimates). Only
 /// photons a lookup tests count, and it skips the subtrees that face away
-/// (`photon_map::orientation`): 30 here, those sharing a block with the lookup's own surface
-/// at the corner.
+/// (`photon_map::orientation`): those sharing a block with the lookup's own surface at the
+/// corner (30 when this was written).
 fn photons_turned_away_are_counted_alike() {
     let loaded = hard("corner.toml");
     let rays = loaded.camera.unwrap().prepare(16, 16).unwrap();

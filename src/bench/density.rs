@@ -35,7 +35,8 @@ pub struct DensityRow {
     /// SIMD time per photon tested, nanoseconds.
     pub ns_per_photon_tested: f64,
     /// Photons each estimate sums (within the radius, passing the filter), per query: with
-    /// `photons_tested_per_query`, how tightly the tree's boxes fit the query's sphere.
+    /// `photons_tested_per_query`, how tightly the tree's boxes fit the query's sphere (past the
+    /// subtrees facing away, which the walk skips since 9498c5f).
     pub photons_summed_per_query: f64,
     /// Bytes of the map per photon: its 20-byte records and its tree's nodes.
     pub map_bytes_per_photon: f64,

@@ -41,8 +41,9 @@ impl PhotonMap {
         Estimate { radius: q.r_max, ..self.sum_estimate(CodePath::Scalar, q, r2, f, found) }
     }
 
-    /// Photons the tree walk tests for a fixed-radius lookup (`q.k == 0`) or a k-nearest one:
-    /// the photons of every block it reaches (the scalar and SIMD lookups walk alike). A
+    /// Photons the tree walk tests for a fixed-radius lookup (`q.k == 0`, not boundary-corrected)
+    /// or a k-nearest one: the photons of every block it reaches, past the subtrees facing away
+    /// (the scalar and SIMD lookups walk alike). A
     /// k-nearest search reads and leaves `scratch`'s hint as a lookup does (pass the same
     /// scratch through the lookups in their order to count what they test).
     #[must_use]

@@ -119,7 +119,7 @@ pub struct Estimate {
     /// that the surface tests of the [`Filter`] turned away: another surface's photons, around
     /// a corner, through a thin wall or off a parallel surface. Only photons the walk tested
     /// count: it skips the subtrees whose photons all face away from the query ([`orientation`]),
-    /// unless the estimate is boundary-corrected.
+    /// unless the estimate is boundary-corrected or looks for the nearest photon alone (k = 1).
     pub rejected: u32,
     /// Photons within the search radius set aside off a flat query's plane ([`Filter::plane`]):
     /// not in this estimate, which the caller completes with those of them that are visible.

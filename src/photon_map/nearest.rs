@@ -38,7 +38,7 @@ pub struct Nearest {
     /// The photons [`PhotonMap::nearest`] lists.
     pub(super) found: Vec<(f32, u32)>,
     /// Squared distances of the photons within the radius (at their block's turn) that the
-    /// surface tests turned away.
+    /// surface tests turned away, in the blocks the walk tested.
     turned: Vec<f32>,
     /// Squared distances of the photons within the radius set aside off a flat query's plane.
     off: Vec<f32>,
@@ -56,8 +56,8 @@ pub(super) struct Walked {
     /// Candidates within `r2`.
     pub live: usize,
     /// Photons within the search radius (the k-th nearest's distance, or the maximum radius when
-    /// fewer than k are found) that the normal test turned away (see
-    /// [`super::Estimate::rejected`]).
+    /// fewer than k are found) that the normal test turned away, in the blocks the walk tested
+    /// (see [`super::Estimate::rejected`]).
     pub rejected: u32,
     /// Photons within that radius set aside off a flat query's plane
     /// ([`super::Estimate::off_plane`]).

@@ -1,6 +1,7 @@
 //! Which way the photons under each child of the tree face, so that a lookup skips the subtrees
-//! whose photons its normal test would turn away to the last one: a floor's lookup then never
-//! reads the wall beside it, the far face of a thin wall, or the underside of the tread above.
+//! whose photons its normal test would turn away to the last one: a floor's lookup then skips
+//! the subtrees holding only the photons of the wall beside it, of the far face of a thin wall, or
+//! of the underside of the tread above (a block that mixes them with its own is still read).
 //! Reads the packed keys; writes each node's `classes` and a lookup's reachable classes.
 //!
 //! A stored normal is one of 64 × 64 octahedral codes. Each code belongs to one of 7 classes: the
@@ -10,8 +11,8 @@
 //! acos(0.7) + θ + a margin (θ the widest angle of the cone's codes from its axis): beyond it,
 //! every normal in the cone is more than acos(0.7) from n, and the normal test
 //! (n·m > 0.7·|m|, in `filter.rs`) turns it away. It always reaches the rest. A lookup whose
-//! normal lies within 8° of an axis reaches its own cone and the rest: a floor skips the walls',
-//! the ceiling's and the undersides' photons.
+//! normal lies within 8° of an axis reaches its own cone and the rest: a floor skips the
+//! subtrees of the walls', the ceiling's and the undersides' photons.
 //!
 //! Skipping is exact: the photons of a skipped child are all turned away, so every estimate keeps
 //! the same photons, sums them in the same order and is the same to the bit; only the count of

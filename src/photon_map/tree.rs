@@ -1,7 +1,7 @@
 //! The photon tree: photons in blocks of 8 (one `f32x8` per column), the blocks under a
 //! bounding-volume hierarchy of 8-wide nodes, and the walk that finds every block within a
-//! (possibly shrinking) radius of a query point. Reads photon positions at build; writes their
-//! order and the nodes. The node test (a sphere against 8 child boxes) has its scalar twin beside
+//! (possibly shrinking) radius of a query point that holds photons facing its way
+//! ([`super::orientation`]). Reads photon positions at build; writes their order and the nodes. The node test (a sphere against 8 child boxes) has its scalar twin beside
 //! it, with the same operations, so both code paths reach the same blocks in the same order.
 //!
 //! Each node splits its photons into up to 8 parts by repeated median splits along the longest
@@ -130,7 +130,7 @@ impl<const NEAREST_FIRST: bool> Walk<NEAREST_FIRST> {
     }
 
     /// The next block (photons `lo..hi`, at most [`BLOCK`], `lo` a multiple of it) whose box lies
-    /// within `r2` of the query. (Forcing it inline into the caller's loop measured 5–8 % slower.)
+    /// within `r2` of the query and that holds photons of the classes the walk reaches. (Forcing it inline into the caller's loop measured 5–8 % slower.)
     #[inline]
     pub(super) fn next(&mut self, map: &PhotonMap, r2: f32) -> Option<(usize, usize)> {
         loop {

@@ -58,7 +58,7 @@ pub struct Context<'a> {
     /// Gather rays landing closer than this take the secondary gather
     /// ([`gather::secondary_gather_distance`]).
     pub secondary_gather: f32,
-    /// Photons the normal filter turned away in this context's estimates
+    /// Photons the normal filter tested and turned away in this context's estimates
     /// ([`Numerics::photons_filtered`](crate::stats::Numerics::photons_filtered)).
     pub filtered: AtomicU64,
     /// Chains through mirrors and glass cut at `max_depth` in this context
@@ -96,7 +96,7 @@ impl<'a> Context<'a> {
         self.depth_cut.load(Ordering::Relaxed)
     }
 
-    /// Photons the normal filter has turned away in this context's estimates so far.
+    /// Photons the normal filter has tested and turned away in this context's estimates so far.
     #[must_use]
     pub fn filtered(&self) -> u64 {
         self.filtered.load(Ordering::Relaxed)
