@@ -16,8 +16,10 @@ use std::sync::Arc;
 mod bsdf;
 mod opacity;
 mod plastic;
+mod prepared;
 pub use opacity::{AlphaMode, Opacity};
 pub use plastic::{fresnel_diffuse_reflectance, PlasticSample, SmoothPlastic};
+pub use prepared::Prepared;
 
 /// What flows along the path: radiance (camera paths) or power (photons). Refraction scales
 /// radiance by (η_wo / η_wi)², never power.

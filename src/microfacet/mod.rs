@@ -242,8 +242,17 @@ pub fn plastic_coat_eval(wo: Vec3, wi: Vec3, eta: f32, alpha: Alpha) -> f32 {
     if wo.z <= 0.0 || wi.z <= 0.0 {
         return 0.0;
     }
+    plastic_coat_above(wo, wi, eta, alpha, alpha.g1(wo))
+}
+
+/// [`plastic_coat_eval`] for `wo` and `wi` both above the surface, given G1(wo) (the same value
+/// to the bit: G2 = G1(wo)·G1(wi)); for many `wi` toward one `wo`.
+#[inline]
+#[must_use]
+pub fn plastic_coat_above(wo: Vec3, wi: Vec3, eta: f32, alpha: Alpha, g1_wo: f32) -> f32 {
     let m = (wo + wi).normalize();
-    fresnel_dielectric(wo.dot(m), eta) * alpha.d(m) * g2(wo, wi, alpha) / (4.0 * wo.z * wi.z)
+    let g2 = g1_wo * alpha.g1(wi);
+    fresnel_dielectric(wo.dot(m), eta) * alpha.d(m) * g2 / (4.0 * wo.z * wi.z)
 }
 
 /// The pdf of [`plastic_coat_sample`]: D_wo(m)/(4·wo·m), as the conductor's.

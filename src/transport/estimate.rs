@@ -148,7 +148,8 @@ fn plan_map<'m>(
             0.0
         }),
     };
-    let eval = |wi| if base { bsdf.eval_base(&sp.frame, wo, wi) } else { bsdf.eval(&sp.frame, wo, wi) };
+    let prepared = bsdf.prepare(&sp.frame, wo);
+    let eval = |wi| if base { prepared.eval_base(wi) } else { prepared.eval(wi) };
     let f = match *bsdf {
         // Lambertian (or a glossy material's base): f = kd/π above the surface, 0 below — no
         // per-photon call.
