@@ -24,7 +24,7 @@
 //! nodes — turned away as few photons on the Modern Hall, and cost cornell-spheres' default
 //! render 2.8 % of its time, where a byte in the node costs nothing measurable.)
 
-use super::packing::{dequantise, oct_decode, NORMAL_STEPS};
+use super::packing::key_normal;
 use super::PhotonMap;
 use glam::Vec3;
 use std::sync::OnceLock;
@@ -59,7 +59,7 @@ fn classes() -> &'static Classes {
         let mut of_code = [REST; 4096];
         let mut half_angle = [0.0f64; 6];
         for (code, class) in of_code.iter_mut().enumerate() {
-            let m = key_normal_of_code(code as u32).as_dvec3().normalize();
+            let m = key_normal(code as u32).as_dvec3().normalize();
             let a = m.abs();
             let axis = if a.x >= a.y && a.x >= a.z {
                 0
@@ -77,11 +77,6 @@ fn classes() -> &'static Classes {
         let threshold = half_angle.map(|h| (0.7f64.acos() + h + MARGIN).cos() as f32);
         Classes { of_code, threshold }
     })
-}
-
-/// The stored normal of a 12-bit code (as [`super::packing::key_normal`] decodes it).
-fn key_normal_of_code(code: u32) -> Vec3 {
-    oct_decode(dequantise(code & 63, NORMAL_STEPS), dequantise(code >> 6 & 63, NORMAL_STEPS))
 }
 
 /// The class bit of a photon's key.
@@ -106,6 +101,18 @@ pub fn reachable(n: Vec3) -> u8 {
         bits |= u8::from(n[axis] > t[2 * axis]) << (2 * axis) | u8::from(-n[axis] > t[2 * axis + 1]) << (2 * axis + 1);
     }
     bits
+}
+
+/// The classes a walk for a lookup with normal `n` visits: [`reachable`], or [`ALL`] for a
+/// boundary-corrected estimate (`corrected`), which reads the photons the normal test turns away
+/// for its cuts.
+#[must_use]
+pub fn walked(n: Vec3, corrected: bool) -> u8 {
+    if corrected {
+        ALL
+    } else {
+        reachable(n)
+    }
 }
 
 impl PhotonMap {
@@ -142,7 +149,6 @@ impl PhotonMap {
 
 #[cfg(test)]
 mod tests {
-    use super::super::packing::key_normal;
     use super::*;
 
     /// Random unit normals (and a few off unit length by up to 4·10⁻⁴), and the axes, their

@@ -18,7 +18,7 @@
 
 use super::boundary::{Cut, Neighbours};
 use super::filter::Normals8;
-use super::orientation::{reachable, ALL};
+use super::orientation::walked;
 use super::sum::{reduce3, Decoded8};
 use super::tree::{Node, LEAF, STACK};
 use super::{Estimate, Kernel, Lookup, PhotonMap, Reflectance};
@@ -100,11 +100,9 @@ impl PhotonMap {
             let ok = self.fixed_radius2(&q.lookup).is_some() && q.lookup.p.is_finite();
             m | u8::from(ok) << j
         });
-        // The classes each query reaches: all of them for a corrected one, which reads the
-        // photons the normal test turns away (as `estimate_radius_with` walks).
-        let classes: [u8; PACKET] = std::array::from_fn(|j| {
-            queries.get(j).map_or(0, |q| if q.edges.is_some() { ALL } else { reachable(q.lookup.filter.n) })
-        });
+        // The classes each query's walk visits, as `estimate_radius_with` walks.
+        let classes: [u8; PACKET] =
+            std::array::from_fn(|j| queries.get(j).map_or(0, |q| walked(q.lookup.filter.n, q.edges.is_some())));
         let mut sums = [Sums::default(); PACKET];
         let mut stack = [(0u32, 0u8); STACK];
         let mut top = usize::from(live != 0);
@@ -156,7 +154,7 @@ impl PhotonMap {
             let j = left.trailing_zeros() as usize;
             left &= left - 1;
             let (_, hits) = node.distances8(queries[j].lookup.p, r2[j]);
-            let hits = if classes[j] == ALL { hits } else { hits & node.facing8(classes[j]) };
+            let hits = hits & node.facing8(classes[j]);
             reach |= SPREAD[hits as usize] << j;
             reached |= hits;
         }

@@ -3,7 +3,7 @@
 //! with the estimate's bias from the same photons ([`Kernel::bias_normalisation`]).
 
 use super::boundary::{Coverage, Cut, Neighbours};
-use super::orientation::{reachable, ALL};
+use super::orientation::{reachable, walked};
 use super::sum::reduce3;
 use super::tree::Walk;
 use super::{Estimate, Kernel, Lookup, PhotonMap, Reflectance, Test};
@@ -59,9 +59,7 @@ impl PhotonMap {
         let mut neighbours = Neighbours::default();
         let (mut sum, mut bias) = (Vec3::ZERO, Vec3::ZERO);
         let (mut sum8, mut bias8) = ([f32x8::ZERO; 3], [f32x8::ZERO; 3]);
-        // A corrected estimate reads the other surfaces' photons for its cuts: it walks them all.
-        let reach = if on_surface.is_some() { ALL } else { reachable(q.filter.n) };
-        let mut walk = Walk::<false>::new(self, set, q.p, reach);
+        let mut walk = Walk::<false>::new(self, set, q.p, walked(q.filter.n, on_surface.is_some()));
         while let Some((lo, hi)) = walk.next(self, r2) {
             if set == CodePath::Simd {
                 let v = self.accepts8(lo, q.p, r2, &q.filter);

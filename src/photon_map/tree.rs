@@ -84,9 +84,13 @@ impl Node {
 
     /// The children holding a photon of the classes `reach`, as bits: the 8 bytes of
     /// `classes` tested at once in a 64-bit word (each byte's high bit set where the byte
-    /// is nonzero, then the 8 high bits gathered by one multiply).
+    /// is nonzero, then the 8 high bits gathered by one multiply). Every child for [`ALL`] (a
+    /// walk that skips nothing: no test; an empty slot no sphere reaches anyway).
     #[inline]
     pub(super) fn facing8(&self, reach: u8) -> u32 {
+        if reach == ALL {
+            return 0xff;
+        }
         let x = u64::from_le_bytes(self.classes) & (u64::from(reach) * 0x0101_0101_0101_0101);
         let low = 0x7f7f_7f7f_7f7f_7f7f;
         let high = (((x & low) + low) | x) & !low;
@@ -96,6 +100,9 @@ impl Node {
     /// Scalar twin of [`Node::facing8`]: one byte at a time.
     #[inline]
     pub(super) fn facing(&self, reach: u8) -> u32 {
+        if reach == ALL {
+            return 0xff;
+        }
         (0..8).fold(0, |bits, c| bits | u32::from(self.classes[c] & reach != 0) << c)
     }
 }
@@ -154,11 +161,11 @@ impl<const NEAREST_FIRST: bool> Walk<NEAREST_FIRST> {
             let (d2s, mut hits) = match self.set {
                 CodePath::Simd => {
                     let (d2s, hits) = node.distances8(self.p, r2);
-                    (d2s, if self.reach == ALL { hits } else { hits & node.facing8(self.reach) })
+                    (d2s, hits & node.facing8(self.reach))
                 }
                 CodePath::Scalar => {
                     let (d2s, hits) = node.distances(self.p, r2);
-                    (d2s, if self.reach == ALL { hits } else { hits & node.facing(self.reach) })
+                    (d2s, hits & node.facing(self.reach))
                 }
             };
             if NEAREST_FIRST {
