@@ -94,6 +94,34 @@ impl Effects {
                 ),
             ),
         };
-        Effects { caustic_map, global_map, final_gather, refraction, shadow_rays, absorption, cut_outs }
+        let thin_glass = thin_glass_part(scene);
+        Effects { caustic_map, global_map, final_gather, refraction, shadow_rays, absorption, cut_outs, thin_glass }
+    }
+}
+
+/// The plan's line on thin glass: the sheets every ray passes with their transmittance, and
+/// those that stay surfaces (a coloured transmission tint).
+fn thin_glass_part(scene: &Scene) -> Part {
+    let (passed, tinted) = scene.thin_sheets();
+    let plural = |n: usize| if n == 1 { "" } else { "s" };
+    let stay = if tinted > 0 {
+        format!(
+            "; {tinted} with a coloured transmission stay{} surfaces that rays sample, the light through them a caustic",
+            if tinted == 1 { "s" } else { "" }
+        )
+    } else {
+        String::new()
+    };
+    match passed {
+        0 if tinted == 0 => Part::new(false, "no thin glass (window panes, thindielectric)"),
+        0 => Part::new(false, format!("no clear thin glass{stay}")),
+        n => Part::new(
+            true,
+            format!(
+                "{n} thin glass material{} (window panes) let shadow rays, photons and every other ray straight \
+                 through with their transmittance: light through them is direct light, not a caustic{stay}",
+                plural(n)
+            ),
+        ),
     }
 }

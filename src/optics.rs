@@ -29,6 +29,15 @@ pub fn thin_slab_reflectance(cos_i: f32, eta: f32) -> f32 {
     2.0 * r / (1.0 + r)
 }
 
+/// The chance that a ray at cos θ = `cos` to a thin sheet's normal passes it when the sheet
+/// (index `ior`, grey transmission scale `t`) is passed in traversal
+/// ([`crate::material::Bsdf::thin_pass`]): its transmittance t·(1 − R′), R′ the slab's
+/// reflectance ([`thin_slab_reflectance`]).
+#[must_use]
+pub fn thin_pass_probability(cos: f32, ior: f32, t: f32) -> f32 {
+    t * (1.0 - thin_slab_reflectance(cos, ior))
+}
+
 /// Mirror reflection of `wo` about `n`.
 #[inline]
 #[must_use]

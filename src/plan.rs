@@ -47,6 +47,11 @@ pub struct Effects {
     /// (absent from plans written before it existed: read as off).
     #[serde(default = "Part::not_recorded")]
     pub cut_outs: Part,
+    /// Thin glass sheets (window panes) passed in traversal with their transmittance: shadow
+    /// rays and photons go straight through (absent from plans written before it existed: read
+    /// as off).
+    #[serde(default = "Part::not_recorded")]
+    pub thin_glass: Part,
 }
 
 impl Effects {
@@ -80,6 +85,7 @@ impl Effects {
             line("shadow rays", &self.shadow_rays),
             line("absorption", &self.absorption),
             line("cut-outs", &self.cut_outs),
+            line("thin glass", &self.thin_glass),
         ]
         .concat()
     }

@@ -14,6 +14,13 @@ pub const PART_NAMES: [&str; 5] = ["caustic_map", "global_map", "final_gather", 
 /// reach a surface the map stores on).
 pub const MAX_PATHS_PER_PHOTON: u64 = 256;
 
+/// A map that has stored nothing after this many paths per photon asked stops emitting: its
+/// light paths are rarer than one in 16 per photon asked (1.6 million paths for 10⁵ photons),
+/// so the rest of [`MAX_PATHS_PER_PHOTON`]'s allowance would store a handful at most, at 15
+/// times the cost. A caustic map whose only specular surfaces are window panes that reflect
+/// the sun out of the scene spent 5.3 s of a 23.5 s render storing nothing before this.
+pub const EMPTY_PATHS_PER_PHOTON: u64 = 16;
+
 /// Passes a `target_error` render runs before it trusts the spread between passes.
 pub const MIN_PASSES_FOR_TARGET: u32 = 4;
 

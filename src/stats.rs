@@ -63,17 +63,24 @@ impl std::ops::AddAssign<&MapStats> for MapStats {
 impl MapStats {
     /// A warning when the map holds fewer photons than `asked` because its photon pass hit the
     /// cap of [`MAX_PATHS_PER_PHOTON`](crate::settings::MAX_PATHS_PER_PHOTON) paths per
-    /// photon asked: few light paths reach the surfaces it stores on, and its estimates are
-    /// sparse (or, when it is empty, zero).
+    /// photon asked, or stayed empty for
+    /// [`EMPTY_PATHS_PER_PHOTON`](crate::settings::EMPTY_PATHS_PER_PHOTON): few light paths
+    /// reach the surfaces it stores on, and its estimates are sparse (or, when it is empty,
+    /// zero).
     #[must_use]
     pub fn shortfall(&self, name: &str, asked: u64) -> Option<String> {
         (self.built && self.stored < asked).then(|| {
+            let cap = if self.stored == 0 {
+                crate::settings::EMPTY_PATHS_PER_PHOTON
+            } else {
+                crate::settings::MAX_PATHS_PER_PHOTON
+            };
             format!(
-                "{name} map: {} of {asked} photons stored from {} paths, the cap of {} per photon asked — \
+                "{name} map: {} of {asked} photons stored from {} paths, the cap of {cap} per photon asked{} — \
                  few light paths reach the surfaces it stores on{}",
                 self.stored,
                 self.emitted,
-                crate::settings::MAX_PATHS_PER_PHOTON,
+                if self.stored == 0 { " for a map that stays empty" } else { "" },
                 if self.stored == 0 { "; it is empty and adds nothing" } else { "" }
             )
         })

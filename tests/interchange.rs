@@ -182,7 +182,8 @@ fn gltf_materials_map_onto_the_bsdfs_they_name() {
         (
             json!({"pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
                 "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_ior": {"ior": 1.33}}}),
-            Bsdf::ThinGlass { ior: 1.33, tint: photonwave::material::Tint::CLEAR },
+            // Clear: the scene lets rays pass it in traversal (`Bsdf::thin_pass`).
+            Bsdf::ThinGlass { ior: 1.33, tint: photonwave::material::Tint::CLEAR, passed: true },
         ),
     ];
     for (material, want) in cases {

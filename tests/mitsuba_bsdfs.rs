@@ -128,7 +128,7 @@ fn ours(bsdf: &str, params: &str) -> Bsdf {
         "roughplastic" => Bsdf::rough_plastic(v3(param(params, "kd")), param(params, "ior")[0], alpha(params))
             .with_nonlinear(param(params, "nonlinear")[0] == 1.0)
             .with_coat_scale(v3(param(params, "ks"))),
-        "thindielectric" => Bsdf::ThinGlass { ior: param(params, "ior")[0], tint },
+        "thindielectric" => Bsdf::ThinGlass { ior: param(params, "ior")[0], tint, passed: false },
         "dielectric" => Bsdf::Glass { ior: param(params, "ior")[0], tint },
         "plastic" | "plastic-coat" => Bsdf::Plastic {
             kd: v3(param(params, "kd")),

@@ -37,7 +37,11 @@ fn with_twin(name: &str) -> (LoadedScene, LoadedScene) {
         &format!("file = \"{}\"", name.replace(".toml", ".obj")),
         &format!("file = {:?}", obj.to_str().unwrap()),
     );
-    let twin = common::scratch_dir("rooms").join(name.replace(".toml", "-dark.toml"));
+    // A folder per call: tests running at once write the same twin, and each scratch folder is
+    // emptied when made (a shared one lost a twin to another test's call).
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let twin = common::scratch_dir(&format!("rooms-{call}")).join(name.replace(".toml", "-dark.toml"));
     std::fs::write(&twin, dark).unwrap();
     let load = |p: &std::path::Path| load_scene(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
     (load(&path), load(&twin))

@@ -10,7 +10,9 @@ use super::{
     PHOTON_SPECULAR_ALPHA,
 };
 use crate::microfacet;
-use crate::optics::{conductor_reflectance, fresnel_dielectric, reflect, refract, thin_slab_reflectance};
+use crate::optics::{
+    conductor_reflectance, fresnel_dielectric, reflect, refract, thin_pass_probability, thin_slab_reflectance,
+};
 use crate::sampling::{cosine_hemisphere, Frame};
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -20,6 +22,33 @@ impl Bsdf {
     #[must_use]
     pub fn is_delta(&self) -> bool {
         matches!(self, Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::ThinGlass { .. })
+    }
+
+    /// For a thin sheet whose rays pass it in traversal (`ThinGlass` with `passed`): its index
+    /// and the grey scale on what it transmits — the chance a ray along a direction at cos θ
+    /// = `cos` to its normal passes is [`crate::optics::thin_pass_probability`] of them.
+    #[must_use]
+    pub fn thin_pass(&self) -> Option<(f32, f32)> {
+        match *self {
+            Bsdf::ThinGlass { ior, tint, passed: true } => Some((ior, tint.transmit.x)),
+            _ => None,
+        }
+    }
+
+    /// This material with rays passing it in traversal when it is a thin sheet that can be:
+    /// one whose transmission tint is grey and at most 1, so that passing needs no weight (a
+    /// coloured tint would: such a sheet stays a surface rays sample, and the light through it
+    /// a caustic). Other materials unchanged.
+    #[must_use]
+    pub fn passing_thin_sheets(self) -> Bsdf {
+        match self {
+            Bsdf::ThinGlass { ior, tint, .. } => {
+                let t = tint.transmit;
+                let grey = t.x == t.y && t.y == t.z && (0.0..=1.0).contains(&t.x);
+                Bsdf::ThinGlass { ior, tint, passed: grey }
+            }
+            other => other,
+        }
     }
 
     /// True for materials that let light through (glass, rough glass).
@@ -303,9 +332,10 @@ impl Bsdf {
                 let wi = f.to_world(s.sample.wi);
                 (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: s.sample.weight, delta: s.coat })
             }
-            Bsdf::ThinGlass { ior, tint } => {
+            Bsdf::ThinGlass { ior, tint, passed: false } => {
                 sample_thin_glass(frame, wo, ior, u[0]).map(|s| tinted(s, &tint, frame, wo))
             }
+            Bsdf::ThinGlass { ior, tint, passed: true } => reflect_thin_glass(frame, wo, ior, tint),
             Bsdf::RoughConductor { .. } | Bsdf::RoughDielectric { .. } | Bsdf::RoughPlastic { .. } => {
                 self.sample_rough(frame, wo, u, transport == Transport::Radiance)
             }
@@ -548,6 +578,22 @@ fn sample_thin_glass(frame: &SurfaceFrame, wo: Vec3, ior: f32, u: f32) -> Option
         return (wi.dot(ng) > 0.0).then_some(BsdfSample { wi, weight: Vec3::ONE, delta: true });
     }
     Some(BsdfSample { wi: -wo, weight: Vec3::ONE, delta: true })
+}
+
+/// A thin sheet passed in traversal, met by a ray that did not pass it (probability
+/// 1 − t·(1 − R′) at cos θ = |wo·ng|, the traversal's own): reflection about the shading
+/// normal with weight `tint.reflect`·R′ / (1 − t·(1 − R′)), so reflection's expected share is
+/// R′·`tint.reflect` as when sampled; at most `tint.reflect` (R′ ≤ 1 − t·(1 − R′) for t ≤ 1).
+fn reflect_thin_glass(frame: &SurfaceFrame, wo: Vec3, ior: f32, tint: Tint) -> Option<BsdfSample> {
+    let (ng, ns) = frame.oriented(wo);
+    let cos = wo.dot(ng).abs();
+    let r = thin_slab_reflectance(cos, ior);
+    let stopped = 1.0 - thin_pass_probability(cos, ior, tint.transmit.x);
+    let wi = reflect(wo, ns);
+    if !(stopped > 0.0) || wi.dot(ng) <= 0.0 {
+        return None;
+    }
+    Some(BsdfSample { wi, weight: tint.reflect * (r / stopped).min(1.0), delta: true })
 }
 
 /// Chooses reflection with probability F, refraction otherwise; the weight is 1 (power) or

@@ -51,7 +51,10 @@ pub enum Bsdf {
     /// A thin dielectric sheet of index `ior` (Mitsuba's `thindielectric`, a window pane): light
     /// passes straight through, unbent, or is reflected, with the slab's reflectance
     /// ([`crate::optics::thin_slab_reflectance`]: the two faces and every bounce between them).
-    ThinGlass { ior: f32, tint: Tint },
+    /// `passed`: rays pass the sheet in traversal with its transmittance, as through a cut-out
+    /// ([`Bsdf::thin_pass`]), so a hit is a reflection (set by the scene for a sheet whose
+    /// transmission tint is grey; `false` as read).
+    ThinGlass { ior: f32, tint: Tint, passed: bool },
     /// Rough conductor ([`crate::microfacet`]): microfacets `alpha` (GGX or Beckmann), Schlick's
     /// Fresnel from the normal-incidence reflectance `ks`, or with the complex index `eta_k` its
     /// exact Fresnel times `ks` ([`crate::optics::conductor_reflectance`]).

@@ -137,7 +137,7 @@ impl Scene {
             encloses_lights: false,
             warnings,
             bvh,
-            kinds: (false, false, false, false, false, false),
+            kinds: (false, false, false, false, false, false, false),
             open_edges: open_edges::OpenEdges::default(),
             caustic_targets: Vec::new(),
             load_times,
@@ -148,8 +148,9 @@ impl Scene {
         scene.distribute_lights()?;
         scene.load_times.lights_s = lap(&mut clock);
         let edges = scene.edge_uses();
-        // Light may leave through a cut-out's holes: a photon that escapes has not leaked.
-        scene.encloses_lights = !scene.kinds.5 && scene.find_enclosure(&edges);
+        // Light may leave through a cut-out's holes and a window pane: a photon that escapes has
+        // not leaked.
+        scene.encloses_lights = !scene.kinds.5 && !scene.kinds.6 && scene.find_enclosure(&edges);
         scene.open_edges = scene.find_open_edges(scene.diagonal().max(f32::MIN_POSITIVE), &edges);
         scene.caustic_targets = scene.find_caustic_targets(&edges);
         scene.load_times.topology_s = lap(&mut clock);
@@ -157,10 +158,16 @@ impl Scene {
     }
 
     /// Which kinds of material the scene's triangles use: (any passed as specular by photons,
-    /// any glass, any non-delta, any absorbing interior, any normal map, any cut-out).
+    /// any glass, any non-delta, any absorbing interior, any normal map, any cut-out, any thin
+    /// sheet passed in traversal). Thin sheets that can be passed are marked so first
+    /// ([`Bsdf::passing_thin_sheets`]).
     fn find_kinds(&mut self) {
+        for m in &mut self.materials {
+            m.bsdf = m.bsdf.passing_thin_sheets();
+        }
         let used = self.used_materials();
         for (m, _) in self.materials.iter().zip(&used).filter(|(_, u)| **u) {
+            self.kinds.6 |= m.bsdf.thin_pass().is_some();
             self.kinds.0 |= m.bsdf.photon_specular();
             self.kinds.1 |= matches!(m.bsdf, Bsdf::Glass { .. } | Bsdf::ThinGlass { .. });
             self.kinds.2 |= !m.bsdf.is_delta();

@@ -20,6 +20,7 @@ use crate::geometry::offset::barycentric_error;
 use crate::geometry::triangle::is_degenerate;
 use crate::geometry::{in_range, normal_and_area, Bvh, Hit, MAX_COORDINATE};
 use crate::material::{Bsdf, Material, NormalMap, Relief, SurfaceFrame};
+use crate::optics::thin_pass_probability;
 use crate::sampling::Distribution1D;
 use crate::texture::luminance;
 pub use camera::Camera;
@@ -170,9 +171,10 @@ pub struct Scene {
     /// Where loading it spent its time.
     pub load_times: LoadTimes,
     bvh: Bvh,
-    /// (any delta, any glass, any non-delta, any absorbing interior, any normal map) material on
-    /// a triangle, computed once.
-    kinds: (bool, bool, bool, bool, bool, bool),
+    /// (any passed on as specular by photons, any glass, any non-delta, any absorbing interior,
+    /// any normal map, any cut-out, any thin sheet passed in traversal) material on a triangle,
+    /// computed once.
+    kinds: (bool, bool, bool, bool, bool, bool, bool),
 }
 
 impl Scene {
@@ -209,7 +211,7 @@ impl Scene {
     /// Vertex columns for intersection.
     #[must_use]
     pub fn columns(&self) -> TriangleColumns<'_> {
-        let cut: Option<&dyn CutOut> = if self.kinds.5 { Some(self) } else { None };
+        let cut: Option<&dyn CutOut> = if self.kinds.5 || self.kinds.6 { Some(self) } else { None };
         TriangleColumns { cut, ..TriangleColumns::new(&self.p0, &self.p1, &self.p2) }
     }
 
@@ -236,6 +238,23 @@ impl Scene {
     #[must_use]
     pub fn has_cut_outs(&self) -> bool {
         self.kinds.5
+    }
+
+    /// How many materials the triangles use are thin glass sheets: (passed in traversal with
+    /// their transmittance, [`Bsdf::thin_pass`]: window panes through which shadow rays and
+    /// photons go straight, so light through them is direct light, not a caustic; sampled as
+    /// surfaces, for a coloured transmission).
+    #[must_use]
+    pub fn thin_sheets(&self) -> (usize, usize) {
+        if !self.kinds.1 {
+            return (0, 0);
+        }
+        let used = self.materials.iter().zip(self.used_materials()).filter(|(_, u)| *u).map(|(m, _)| m.bsdf);
+        used.fold((0, 0), |(p, s), b| match b {
+            Bsdf::ThinGlass { passed: true, .. } => (p + 1, s),
+            Bsdf::ThinGlass { passed: false, .. } => (p, s + 1),
+            _ => (p, s),
+        })
     }
 
     /// How many materials the triangles use have an alpha cut-out ([`crate::material::Opacity`]).
@@ -616,15 +635,31 @@ impl Scene {
     }
 }
 
-/// The scene's alpha cut-outs, for every traversal ([`Scene::columns`] hands them over when some
-/// material has one): a hit passes where its material's [`crate::material::Opacity`] lets the
-/// ray through at the hit's texture coordinates.
+/// The scene's alpha cut-outs and passed thin sheets, for every traversal ([`Scene::columns`]
+/// hands them over when some material has one): a hit passes where its material's
+/// [`crate::material::Opacity`] lets the ray through at the hit's texture coordinates, and,
+/// where it is present, a thin sheet passed in traversal ([`Bsdf::thin_pass`]) lets it through
+/// with its transmittance at the ray's angle to the triangle, drawn from the ray's hash with
+/// the triangle's number salted (independent of the mask's draw).
 impl CutOut for Scene {
     fn passes(&self, tri: u32, b: [f32; 3], o: Vec3, d: Vec3) -> bool {
         let i = tri as usize;
-        match &self.materials[self.material[i] as usize].opacity {
+        let m = &self.materials[self.material[i] as usize];
+        if let Some(opacity) = &m.opacity {
+            if opacity.passes(self.uv_at(i, b), || coverage_sample(tri, o, d)) {
+                return true;
+            }
+        }
+        match m.bsdf.thin_pass() {
             None => false,
-            Some(opacity) => opacity.passes(self.uv_at(i, b), || coverage_sample(tri, o, d)),
+            Some((ior, t)) => {
+                let cos = d.dot(self.ng[i]).abs() / d.length();
+                coverage_sample(tri ^ SHEET_SALT, o, d) < thin_pass_probability(cos, ior, t)
+            }
         }
     }
 }
+
+/// Flips a triangle's number for a thin sheet's draw, so that a sheet with a mask draws its
+/// two decisions from unrelated hashes.
+const SHEET_SALT: u32 = 0x8000_0000;

@@ -28,7 +28,7 @@ use crate::material::{Bsdf, SurfaceFrame, Transport};
 use crate::photon_map::{flags, Photon};
 use crate::rng::{Domain, Sampler};
 use crate::scene::{Scene, SurfacePoint};
-use crate::settings::MAX_PATHS_PER_PHOTON;
+use crate::settings::{EMPTY_PATHS_PER_PHOTON, MAX_PATHS_PER_PHOTON};
 use crate::stats::Numerics;
 use glam::Vec3;
 
@@ -102,10 +102,12 @@ impl Tally {
         }
     }
 
-    /// Whether another batch should be emitted.
+    /// Whether another batch should be emitted: the map is short of its target, below the path
+    /// cap, and not still empty after [`EMPTY_PATHS_PER_PHOTON`] paths per photon asked.
     #[must_use]
     pub fn wants_more(&self) -> bool {
-        (self.photons.len() as u64) < self.target && self.emitted < self.cap
+        let empty = self.photons.is_empty() && self.emitted >= self.target * EMPTY_PATHS_PER_PHOTON;
+        (self.photons.len() as u64) < self.target && self.emitted < self.cap && !empty
     }
 
     /// Index of the next batch's first path (the paths emitted so far).

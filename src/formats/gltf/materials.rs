@@ -159,7 +159,7 @@ pub(super) fn convert(
         }
         match (roughness < SMOOTH, solid) {
             (true, true) => Bsdf::Glass { ior, tint },
-            (true, false) => Bsdf::ThinGlass { ior, tint },
+            (true, false) => Bsdf::ThinGlass { ior, tint, passed: false },
             (false, solid) => {
                 if !solid {
                     warn("rough thin-walled transmission is rendered as a solid rough dielectric".into());

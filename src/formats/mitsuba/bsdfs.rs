@@ -363,7 +363,7 @@ impl Ctx<'_> {
                 };
                 let bsdf = match kind {
                     "roughdielectric" => Bsdf::RoughDielectric { ior, alpha: self.alpha(node, kind)?, tint },
-                    "thindielectric" => Bsdf::ThinGlass { ior, tint },
+                    "thindielectric" => Bsdf::ThinGlass { ior, tint, passed: false },
                     _ => Bsdf::Glass { ior, tint },
                 };
                 (bsdf, Maps::default(), None)

@@ -91,6 +91,18 @@ pub(super) enum MaterialEntry {
         #[serde(default)]
         emission: Option<[f32; 3]>,
     },
+    /// A thin sheet (a window pane, Mitsuba's `thindielectric`): straight through or reflected.
+    #[serde(rename = "thin_glass")]
+    ThinGlass {
+        #[serde(default = "ior_default")]
+        ior: f32,
+        /// Scale on what it transmits (Mitsuba's `specular_transmittance`); a grey one lets
+        /// every ray pass in traversal.
+        #[serde(default = "ones")]
+        transmittance: [f32; 3],
+        #[serde(default)]
+        emission: Option<[f32; 3]>,
+    },
 }
 
 fn ones() -> [f32; 3] {
@@ -218,6 +230,13 @@ impl MaterialEntry {
                     return Err(Error::setting(f("outside_ior"), "must be a positive number"));
                 }
                 (Bsdf::Glass { ior: finite_ratio(&f("ior"), ior / outside_ior)?, tint: Tint::CLEAR }, emission)
+            }
+            MaterialEntry::ThinGlass { ior, transmittance, emission } => {
+                if !(ior > 0.0 && ior.is_finite()) {
+                    return Err(Error::setting(f("ior"), "must be a positive number"));
+                }
+                let tint = Tint { reflect: Vec3::ONE, transmit: albedo(&f("transmittance"), transmittance)? };
+                (Bsdf::ThinGlass { ior, tint, passed: false }, emission)
             }
         };
         let emission = match emission {
