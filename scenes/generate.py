@@ -791,6 +791,10 @@ irradiance = [5.0, 4.8, 4.4]
 
 [environment]
 radiance = [0.8, 1.0, 1.4]
+
+# The window marked as a portal: half the sky's light samples go through it.
+[[portal]]
+corners = [[-0.7, 0.9, -2.0], [0.7, 0.9, -2.0], [0.7, 2.0, -2.0], [-0.7, 2.0, -2.0]]
 ''')
 
     with open("cornell-rough.toml", "w") as f:

@@ -48,6 +48,7 @@ impl Scene {
             }
         }
         let origin = move_to_frame(&mut meshes, &mut extra_lights);
+        let environment = environment.map(|e| e.moved(origin));
         if environment.is_some() {
             extra_lights.push(Light::Environment);
         }

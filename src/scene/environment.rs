@@ -10,6 +10,7 @@
 //! inside it, and p(ω) = P(k)·w·h / (2π² sin θ) — mixed with a uniform share
 //! ([`UNIFORM_SHARE`]) so that no direction the map lights is left to chance.
 
+use super::portal::Portals;
 use crate::sampling::{uniform_sphere, Distribution1D};
 use crate::texture::Texture;
 use glam::Vec3;
@@ -28,6 +29,9 @@ pub struct Environment {
     rotation: f32,
     /// ∫ L(ω) dω over the sphere.
     integral: Vec3,
+    /// Where its light enters an interior: direct light draws half its samples through them
+    /// instead of by the map ([`Environment::sampling_pdf`]).
+    portals: Portals,
 }
 
 /// Rec. 709 luminance of linear RGB.
@@ -40,7 +44,14 @@ impl Environment {
     /// The same radiance `l` from every direction.
     #[must_use]
     pub fn constant(l: Vec3) -> Environment {
-        Environment { constant: l, map: None, scale: 1.0, rotation: 0.0, integral: l * 4.0 * PI }
+        Environment {
+            constant: l,
+            map: None,
+            scale: 1.0,
+            rotation: 0.0,
+            integral: l * 4.0 * PI,
+            portals: Portals::default(),
+        }
     }
 
     /// A lat-long map scaled by `scale` and turned by `rotation` radians about +y. `Err` says
@@ -68,7 +79,56 @@ impl Environment {
         }
         let distribution = Distribution1D::try_new(&weights).unwrap_or_default();
         let integral = integral.as_vec3() * scale;
-        Ok(Environment { constant: Vec3::ZERO, map: Some((map, distribution)), scale, rotation, integral })
+        Ok(Environment {
+            constant: Vec3::ZERO,
+            map: Some((map, distribution)),
+            scale,
+            rotation,
+            integral,
+            portals: Portals::default(),
+        })
+    }
+
+    /// This environment with its light entering through `portals` (in the scene files'
+    /// coordinates until the scene moves them, [`Environment::moved`]).
+    #[must_use]
+    pub fn with_portals(self, portals: Portals) -> Environment {
+        Environment { portals, ..self }
+    }
+
+    /// The same environment, its portals relative to `origin` (the scene's frame).
+    #[must_use]
+    pub fn moved(self, origin: Vec3) -> Environment {
+        let portals = self.portals.moved(origin);
+        Environment { portals, ..self }
+    }
+
+    /// Its portals (empty without).
+    #[must_use]
+    pub fn portals(&self) -> &Portals {
+        &self.portals
+    }
+
+    /// A direction from `x` for direct light's second half of samples: through a portal when
+    /// there are portals, else by the map ([`Environment::sample_direction`]).
+    #[must_use]
+    pub fn sample_from(&self, x: Vec3, u: [f32; 2]) -> Option<Vec3> {
+        if self.portals.is_empty() {
+            self.sample_direction(u)
+        } else {
+            self.portals.sample(x, u)
+        }
+    }
+
+    /// The density of [`Environment::sample_from`] at `x` toward `wi`, given the map's density
+    /// `map_pdf` there (read with its radiance): the portals' when there are portals.
+    #[must_use]
+    pub fn sampling_pdf(&self, x: Vec3, wi: Vec3, map_pdf: f32) -> f32 {
+        if self.portals.is_empty() {
+            map_pdf
+        } else {
+            self.portals.pdf(x, wi)
+        }
     }
 
     /// ∫ L(ω) dω over the sphere.

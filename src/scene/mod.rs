@@ -11,6 +11,7 @@ pub mod light;
 mod light_choice;
 pub mod light_tree;
 pub mod open_edges;
+pub mod portal;
 pub mod targets;
 
 use crate::error::{Error, Result};
@@ -478,9 +479,10 @@ impl Scene {
                     let local = crate::sampling::cosine_hemisphere([(2.0 * u[0]).min(1.0), u[1]]);
                     crate::sampling::Frame::new(n).to_world(local)
                 } else {
-                    env.sample_direction([(2.0 * u[0] - 1.0).min(crate::sampling::ONE_BELOW), u[1]])?
+                    env.sample_from(p, [(2.0 * u[0] - 1.0).min(crate::sampling::ONE_BELOW), u[1]])?
                 };
-                let (radiance, env_pdf) = env.radiance_pdf(wi);
+                let (radiance, map_pdf) = env.radiance_pdf(wi);
+                let env_pdf = env.sampling_pdf(p, wi, map_pdf);
                 let pdf = 0.5 * wi.dot(n).max(0.0) * std::f32::consts::FRAC_1_PI + 0.5 * env_pdf;
                 (pdf > 0.0 && wi.is_finite()).then(|| light::Incident {
                     wi,

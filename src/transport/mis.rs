@@ -183,17 +183,18 @@ pub fn light_density(ctx: &Context, r: &Receiver, light: usize, tri: u32, distan
 
 /// Light sampling's density at receiver `r` toward the environment along unit `wi`:
 /// `light_samples` × the environment's pick probability there × the density of its direction
-/// (half cosine-weighted about the receiver's normal, half by the map:
-/// [`Scene::sample_incident`]). 0 without an environment.
+/// (half cosine-weighted about the receiver's normal, half by the map or, where the scene has
+/// portals, through them: [`Scene::sample_incident`]). 0 without an environment.
 #[must_use]
 #[inline]
 pub fn environment_density(ctx: &Context, r: &Receiver, wi: Vec3) -> f32 {
     let Some(env) = &ctx.scene.environment else { return 0.0 };
-    density_with_map_pdf(ctx, r, wi, env.pdf(wi))
+    density_with_map_pdf(ctx, r, wi, env.sampling_pdf(r.p, wi, env.pdf(wi)))
 }
 
-/// [`environment_density`] given the map's own density toward `wi` (read with its radiance
-/// in one texel lookup, [`crate::scene::Environment::radiance_pdf`]).
+/// [`environment_density`] given the density of its second half toward `wi` (the map's, read
+/// with its radiance in one texel lookup, [`crate::scene::Environment::radiance_pdf`], or the
+/// portals': [`crate::scene::Environment::sampling_pdf`]).
 #[inline]
 fn density_with_map_pdf(ctx: &Context, r: &Receiver, wi: Vec3, map_pdf: f32) -> f32 {
     let scene = ctx.scene;
@@ -231,7 +232,8 @@ pub fn sky_found(ctx: &Context, r: &Receiver, d: Vec3, density: f32) -> Vec3 {
     if let Some(env) = &scene.environment {
         let (l, map_pdf) = env.radiance_pdf(d);
         if l != Vec3::ZERO {
-            sum += l * power_heuristic(density, density_with_map_pdf(ctx, r, d, map_pdf));
+            let second = env.sampling_pdf(r.p, d, map_pdf);
+            sum += l * power_heuristic(density, density_with_map_pdf(ctx, r, d, second));
         }
     }
     for &i in scene.suns() {

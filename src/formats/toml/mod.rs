@@ -29,6 +29,9 @@
 //! scale = 1.0
 //! rotation = 0                  # degrees about +y
 //!
+//! [[portal]]                    # where the environment's light enters (a window); optional
+//! corners = [[-1, 1, -2], [1, 1, -2], [1, 2, -2], [-1, 2, -2]]   # in order around it
+//!
 //! [materials.sphere]            # replaces the MTL material `sphere`
 //! type = "glass"                # lambert | glossy | mirror | glass | rough_conductor | rough_dielectric | rough_plastic
 //! ior = 1.5
@@ -49,6 +52,7 @@ use crate::files::{read_text, MAX_SCENE_FILE};
 use crate::scene::camera::{Camera, DEFAULT_FOV};
 use crate::scene::environment::Environment;
 use crate::scene::light::Light;
+use crate::scene::portal::{Portal, Portals};
 use crate::scene::{bounds_of, MeshInput, Scene};
 use crate::settings::Settings;
 use crate::texture::Encoding;
@@ -71,7 +75,17 @@ struct SceneFile {
     materials: BTreeMap<String, MaterialEntry>,
     environment: Option<EnvironmentEntry>,
     #[serde(default)]
+    portal: Vec<PortalEntry>,
+    #[serde(default)]
     render: Option<Settings>,
+}
+
+/// `[[portal]]`: a parallelogram (a window, a door) where the environment's light enters, its
+/// four `corners` in order around it.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct PortalEntry {
+    corners: [[f32; 3]; 4],
 }
 
 /// `[environment]`: a constant `radiance`, or a lat-long `map` (linear HDR, EXR or any image
@@ -294,7 +308,25 @@ pub fn load(path: &Path, added: AddedLights) -> Result<LoadedScene> {
     }
     let settings = file.render.unwrap_or_default();
     settings.validate()?;
-    let environment = file.environment.as_ref().map(|e| e.to_environment(dir, &mut inputs)).transpose()?;
+    let mut environment = file.environment.as_ref().map(|e| e.to_environment(dir, &mut inputs)).transpose()?;
+    if !file.portal.is_empty() {
+        let Some(env) = environment.take() else {
+            return Err(Error::setting(
+                "portal[0]",
+                "a portal marks where the [environment]'s light enters, but the scene has no [environment]",
+            ));
+        };
+        let portals = file
+            .portal
+            .iter()
+            .enumerate()
+            .map(|(k, p)| {
+                Portal::new(p.corners.map(Vec3::from_array))
+                    .map_err(|e| Error::setting(format!("portal[{k}].corners"), e))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        environment = Some(env.with_portals(Portals::new(portals)));
+    }
     let scene = Scene::build_lit(meshes, table.materials, lights, environment, warnings)?;
     Ok(LoadedScene::framed(scene, camera, brought.cameras, settings, inputs))
 }
