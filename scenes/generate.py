@@ -930,3 +930,103 @@ def interior():
         f.write("\n".join(xml) + "\n")
 
 interior()
+
+def leaf(x, y):
+    """A 64 x 64 leaf mask (white where the leaf is, read as opacity by map_d): a pointed
+    ellipse along u with a notch-free edge."""
+    u, v = (x - 31.5) / 31.0, (y - 31.5) / 31.0
+    half_width = 0.42 * (1.0 - u * u) * (1.0 - 0.35 * u)
+    return (255, 255, 255) if abs(v) < half_width else (0, 0, 0)
+
+def daylight_sky(x, y):
+    """A 256 x 128 lat-long sky (row 0 the zenith), read as linear: blue overhead, pale toward
+    the horizon, a grey-green ground below it."""
+    theta = math.pi * (y + 0.5) / 128
+    if theta > math.pi / 2:
+        return (60, 62, 52)
+    t = theta / (math.pi / 2)
+    return (int(90 + 140 * t ** 2), int(130 + 110 * t ** 2), int(235 + 15 * t))
+
+def daylight():
+    """A room lit by daylight: zero-thickness walls, a glass window (thin glass) and an open one,
+    a sun and a sky map, a glossy wooden floor, a plant with alpha-masked leaves, both windows
+    marked as portals."""
+    raw = lambda p: p
+    o = Obj("daylight.mtl", convert=raw)
+    W, H, D = 2.0, 2.6, 2.5
+    textured_quad(o, "floor", "floor", [(-W, 0, -D), (W, 0, -D), (W, 0, D), (-W, 0, D)],
+                  [(0, 0), (2, 0), (2, 2.5), (0, 2.5)], (0, 1, 0))
+    o.quad("ceiling", "wall", [(-W, H, -D), (W, H, -D), (W, H, D), (-W, H, D)], (0, -1, 0))
+    o.quad("right", "wall", [(W, 0, -D), (W, H, -D), (W, H, D), (W, 0, D)], (-1, 0, 0))
+    o.quad("front", "wall", [(-W, 0, D), (W, 0, D), (W, H, D), (-W, H, D)], (0, 0, -1))
+    # Back wall (z = -D): a glazed window x in [-1.5, -0.1], y in [0.8, 2.0].
+    bx0, bx1, by0, by1 = -1.5, -0.1, 0.8, 2.0
+    for name, pts in [("back_low", [(-W, 0), (W, 0), (W, by0), (-W, by0)]), ("back_high", [(-W, by1), (W, by1), (W, H), (-W, H)]),
+                      ("back_left", [(-W, by0), (bx0, by0), (bx0, by1), (-W, by1)]), ("back_right", [(bx1, by0), (W, by0), (W, by1), (bx1, by1)])]:
+        o.quad(name, "wall", [(x, y, -D) for x, y in pts], (0, 0, 1))
+    o.quad("pane", "pane", [(bx0, by0, -D), (bx1, by0, -D), (bx1, by1, -D), (bx0, by1, -D)], (0, 0, 1))
+    # Left wall (x = -W): an open window z in [-0.9, 0.7], y in [0.7, 2.1].
+    lz0, lz1, ly0, ly1 = -0.9, 0.7, 0.7, 2.1
+    for name, pts in [("left_low", [(-D, 0), (D, 0), (D, ly0), (-D, ly0)]), ("left_high", [(-D, ly1), (D, ly1), (D, H), (-D, H)]),
+                      ("left_back", [(-D, ly0), (lz0, ly0), (lz0, ly1), (-D, ly1)]), ("left_front", [(lz1, ly0), (D, ly0), (D, ly1), (lz1, ly1)])]:
+        o.quad(name, "wall", [(-W, y, z) for z, y in pts], (1, 0, 0))
+    # The ground outside, a little below the floor (zero-thickness walls stand on it).
+    o.quad("ground", "ground", [(-6, -0.02, -6), (6, -0.02, -6), (6, -0.02, 6), (-6, -0.02, 6)], (0, 1, 0))
+    # A bench and a potted plant: a stem and ten leaves on alpha-masked quads.
+    box_faces(o, "bench", "bench", (0.6, 0.0, 1.2), (1.9, 0.45, 1.9))
+    box_faces(o, "pot", "pot", (0.95, 0.0, -1.75), (1.35, 0.38, -1.35))
+    box_faces(o, "stem", "stem", (1.13, 0.38, -1.57), (1.17, 1.15, -1.53))
+    for k in range(10):
+        a = 2 * math.pi * k / 10 + 0.3 * (k % 3)
+        y = 0.55 + 0.06 * k
+        length, width = 0.42 - 0.015 * k, 0.2
+        base = (1.15, y, -1.55)
+        tip = (1.15 + length * math.cos(a), y + 0.12 + 0.03 * (k % 2), -1.55 + length * math.sin(a))
+        side = (-math.sin(a) * width / 2, 0.0, math.cos(a) * width / 2)
+        pts = [(base[0] - side[0], base[1], base[2] - side[2]), (tip[0] - side[0], tip[1], tip[2] - side[2]),
+               (tip[0] + side[0], tip[1], tip[2] + side[2]), (base[0] + side[0], base[1], base[2] + side[2])]
+        textured_quad(o, f"leaf{k}", "leaf", pts, [(0, 0), (1, 0), (1, 1), (0, 1)], (0, 1, 0))
+    o.write("daylight.obj")
+    write_png("leaf.png", 64, 64, leaf)
+    write_png("daylight-sky.png", 256, 128, daylight_sky)
+    mtl("daylight.mtl", [("wall", "illum 1\nKd 0.78 0.76 0.72"),
+                         ("floor", "illum 2\nKd 1 1 1\nmap_Kd wood.png\nPr 0.3\nNi 1.5"),
+                         ("pane", "illum 7\nNi 1.5"), ("ground", "illum 1\nKd 0.32 0.33 0.28"),
+                         ("bench", "illum 1\nKd 0.55 0.58 0.66"), ("pot", "illum 1\nKd 0.62 0.32 0.2"),
+                         ("stem", "illum 1\nKd 0.3 0.25 0.12"), ("leaf", "illum 1\nKd 0.12 0.42 0.1\nmap_d leaf.png")])
+    with open("daylight.toml", "w") as f:
+        f.write('''# A room lit by daylight, written by scenes/generate.py: zero-thickness walls, a glazed window
+# (a thin glass pane) and an open one, a sun and a sky map (daylight-sky.png), a glossy wooden
+# floor (rough plastic over map_Kd wood.png), a potted plant whose leaves are alpha-masked quads
+# (map_d leaf.png), the ground outside; both windows are portals.
+[[mesh]]
+file = "daylight.obj"
+
+[materials.pane]
+type = "thin_glass"
+ior = 1.5
+
+[camera]
+eye = [1.7, 1.45, 2.3]
+target = [-0.7, 0.85, -1.3]
+fov = 66
+
+[[light]]
+type = "sun"
+direction = [0.62, -0.5, 0.6]
+irradiance = [7.0, 6.6, 6.0]
+
+[environment]
+map = "daylight-sky.png"
+scale = 1.6
+
+# The glazed window and the open one.
+[[portal]]
+corners = [[-1.5, 0.8, -2.5], [-0.1, 0.8, -2.5], [-0.1, 2.0, -2.5], [-1.5, 2.0, -2.5]]
+
+[[portal]]
+corners = [[-2.0, 0.7, -0.9], [-2.0, 0.7, 0.7], [-2.0, 2.1, 0.7], [-2.0, 2.1, -0.9]]
+''')
+
+daylight()
+

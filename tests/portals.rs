@@ -1,7 +1,8 @@
 //! Light portals (`[[portal]]` in a TOML scene): direct light from the environment draws half its
-//! samples through the portals instead of over the whole sky. A room whose only opening is a
-//! portal renders the same direct light with and without it, with several times less variance
-//! at equal samples; a portal's corners are checked.
+//! samples through the portals instead of over the whole sky, and half its photons travel lines
+//! through them. A room whose only opening is a portal renders the same direct light with and
+//! without it, with several times less variance at equal samples, and its photons bring the
+//! same light in, many more of them; a portal's corners are checked.
 
 mod common;
 
@@ -103,6 +104,48 @@ fn a_portal_keeps_the_mean_and_cuts_the_variance() {
 }
 
 #[test]
+fn photons_through_a_portal_bring_the_same_light_in() {
+    // The room's global photons, 20 000 a seed at 8 seeds, with and without the portal. A
+    // photon's first hit (direct) inside the room (a hair along its stored normal from it lies
+    // in the box) is sky light that came through the window, whose flux is π·A·L = 0.36π W (the
+    // whole sky outside it is open): the seeds' mean power must be that within 4 of its
+    // standard errors, with the portal and without (the mixture's density keeps every line's
+    // expectation), and the portal must bring at least 4 times as many photons in (13.5×
+    // measured).
+    use photonwave::photon_map::flags;
+    use photonwave::reference::photons::trace_photons;
+    use photonwave::rng::Domain;
+    let d = scratch_dir("portal-photons");
+    let inside = |p: glam::Vec3| p.x.abs() < 1.0 && p.z.abs() < 1.0 && p.y > 0.0 && p.y < 2.0;
+    let run = |path: &Path| {
+        let scene = load_scene(path).unwrap().scene;
+        let per_seed: Vec<(f64, usize)> = (1..=8u64)
+            .map(|seed| {
+                let s = Settings { threads: 2, seed, ..Settings::default() };
+                let pass = trace_photons(&scene, &common::job(&scene, &s), Domain::GlobalPhoton, 20_000, &NoProgress);
+                let came_in: Vec<_> = pass
+                    .photons
+                    .iter()
+                    .filter(|p| p.flags & flags::DIRECT != 0 && inside(p.position + p.normal * 1e-3))
+                    .collect();
+                (came_in.iter().map(|p| f64::from(p.power.x)).sum(), came_in.len())
+            })
+            .collect();
+        let n = per_seed.len() as f64;
+        let mean = per_seed.iter().map(|p| p.0).sum::<f64>() / n;
+        let se = (per_seed.iter().map(|p| (p.0 - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+        let count = per_seed.iter().map(|p| p.1).sum::<usize>();
+        (mean, se, count)
+    };
+    let ((m0, s0, c0), (m1, s1, c1)) = (run(&room(&d, false)), run(&room(&d, true)));
+    println!("open: {m0:.4} ± {s0:.4} W from {c0} photons; portal: {m1:.4} ± {s1:.4} W from {c1} photons");
+    let flux = 0.36 * std::f64::consts::PI;
+    assert!((m0 - flux).abs() < 4.0 * s0, "power in without the portal: {m0} ± {s0}, want {flux}");
+    assert!((m1 - flux).abs() < 4.0 * s1, "power in with the portal: {m1} ± {s1}, want {flux}");
+    assert!(c1 >= 4 * c0, "photons in: {c0} without the portal, {c1} with");
+}
+
+#[test]
 fn portals_are_checked() {
     let d = scratch_dir("portals-bad");
     let path = room(&d, true);
@@ -129,4 +172,14 @@ fn portals_are_checked() {
         ),
     );
     assert!(dark.contains("portal[0]") && dark.contains("no [environment]"), "{dark}");
+}
+
+#[test]
+fn engines_agree_in_the_daylight_room_at_any_thread_count() {
+    // The bundled daylight room: a sky map and a sun through a glazed and an open window, both
+    // portals (light samples and half the sky's photons through them), alpha-masked leaves and
+    // a thin pane: the wavefront kernels and the reference engine agree per pixel.
+    let loaded = common::load("daylight.toml");
+    assert_eq!(loaded.scene.environment.as_ref().map(|e| e.portals().len()), Some(2));
+    common::assert_engines_agree(loaded);
 }

@@ -508,11 +508,13 @@ impl Scene {
 
     /// Samples a photon leaving light `l` with four uniform numbers ([`Light::sample_emission`];
     /// the environment's from a disk of the scene's radius across a direction picked by the
-    /// map's importance: power L·π r²/pdf).
+    /// map's importance: power L·π r²/pdf; with portals, through them for
+    /// [`PORTAL_PHOTON_SHARE`] of its photons, along lines [`portal::Portals::sample_line`] draws).
     #[must_use]
     pub fn sample_emission(&self, l: &Light, u: [f32; 4]) -> light::Emission {
         let (centre, radius) = (self.centre(), self.radius());
         match (l, &self.environment) {
+            (Light::Environment, Some(env)) if !env.portals().is_empty() => self.portal_photon(env, u),
             (Light::Environment, Some(env)) => {
                 let Some((wi, pdf, radiance)) = env.sample([u[0], u[1]]) else {
                     return light::Emission { origin: centre, direction: Vec3::Y, power: Vec3::ZERO, normal: None };
@@ -531,6 +533,39 @@ impl Scene {
             }
             _ => l.sample_emission(self.light_triangle(l).as_ref(), (centre, radius), u),
         }
+    }
+
+    /// An environment photon in a scene with portals: with probability [`PORTAL_PHOTON_SHARE`]
+    /// (from `u[2]`, remapped) its line is drawn through a portal
+    /// ([`portal::Portals::sample_line`]),
+    /// otherwise across the scene's disk as without portals; either way it starts outside the
+    /// scene, on the disk's plane, and carries L(−ω) over the mixture's density at its line per
+    /// steradian and unit area across it: share·(portal lines' density) + (1 − share)·(map pdf
+    /// of −ω)/(π r²) (the disk's, for a line within r of the centre). Unbiased for every line,
+    /// through a portal or not.
+    fn portal_photon(&self, env: &Environment, u: [f32; 4]) -> light::Emission {
+        use std::f32::consts::PI;
+        let (centre, radius) = (self.centre(), self.radius());
+        let dark = light::Emission { origin: centre, direction: Vec3::Y, power: Vec3::ZERO, normal: None };
+        let share = PORTAL_PHOTON_SHARE;
+        let (origin, dir) = if u[2] < share {
+            let Some((y, w)) = env.portals().sample_line([u[0], u[1], u[2] / share, u[3]]) else { return dark };
+            (y - w * ((y - centre).dot(w) + 2.0 * radius), w)
+        } else {
+            let u2 = ((u[2] - share) / (1.0 - share)).min(crate::sampling::ONE_BELOW);
+            let Some(wi) = env.sample_direction([u[0], u[1]]) else { return dark };
+            let (dx, dy) = crate::sampling::concentric_disk([u2, u[3]]);
+            let f = crate::sampling::Frame::new(wi);
+            (centre + (f.s * dx + f.t * dy) * radius + wi * (2.0 * radius), -wi)
+        };
+        let (radiance, map_pdf) = env.radiance_pdf(-dir);
+        let across = (centre - origin).reject_from_normalized(dir).length();
+        let disk = if across <= radius * (1.0 + 1e-5) { map_pdf / (PI * radius * radius) } else { 0.0 };
+        let density = share * env.portals().line_density(origin, dir) + (1.0 - share) * disk;
+        if !(density > 0.0) || !dir.is_finite() {
+            return dark;
+        }
+        light::Emission { origin, direction: dir, power: radiance / density, normal: None }
     }
 
     /// Radiance emitted from the front of triangle `tri` at barycentrics `b` (the emission
@@ -661,6 +696,11 @@ impl CutOut for Scene {
         }
     }
 }
+
+/// The share of an environment's photons whose lines are drawn through its portals
+/// ([`Scene::sample_emission`]); the rest cross the whole scene, for the light that reaches
+/// what lies outside the portals (the ground outside a window, which a gather ray can see).
+pub const PORTAL_PHOTON_SHARE: f32 = 0.5;
 
 /// Flips a triangle's number for a thin sheet's draw, so that a sheet with a mask draws its
 /// two decisions from unrelated hashes.

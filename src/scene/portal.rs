@@ -10,6 +10,12 @@
 //! crosses (at tₖ > 0, θₖ its angle to portal k's normal), A the portals' total area. A
 //! direction that crosses no portal has density 0 here; the cosine-weighted half and the BSDF
 //! rays still find it, so a portal that misses a window costs noise, not bias.
+//!
+//! Photons: a share of the environment's photons travel lines drawn through the portals
+//! ([`Portals::sample_line`]), the rest the disk across the whole scene, and each carries the
+//! radiance over the two strategies' mixed density at its line ([`Portals::line_density`] and
+//! the disk's), so lines through no portal keep their light and the maps' expectation is the
+//! disk's alone ([`super::Scene::sample_emission`]).
 
 use glam::Vec3;
 
@@ -147,6 +153,42 @@ impl Portals {
         let d = p.corner + p.e1 * a + p.e2 * u[1] - x;
         let len = d.length();
         (len > 0.0 && len.is_finite()).then(|| d / len)
+    }
+
+    /// A line of light through a portal, for a photon: a portal picked by area, a point
+    /// uniform on it, and a unit direction of travel cosine-weighted about its normal, to
+    /// either side with equal chance (which side is inside is not known), from four uniform
+    /// numbers: (the point, the direction). `None` without portals.
+    #[must_use]
+    pub fn sample_line(&self, u: [f32; 4]) -> Option<(Vec3, Vec3)> {
+        let total = self.area();
+        if !(total > 0.0) {
+            return None;
+        }
+        let target = u[2] * total;
+        let k = self.running.partition_point(|&s| s <= target).min(self.list.len() - 1);
+        let p = &self.list[k];
+        let below = if k == 0 { 0.0 } else { self.running[k - 1] };
+        let a = ((target - below) / p.area).clamp(0.0, 1.0);
+        let y = p.corner + p.e1 * a + p.e2 * u[3];
+        let (side, u0) = if u[0] < 0.5 { (p.normal, 2.0 * u[0]) } else { (-p.normal, 2.0 * u[0] - 1.0) };
+        let local = crate::sampling::cosine_hemisphere([u0.min(crate::sampling::ONE_BELOW), u[1]]);
+        Some((y, crate::sampling::Frame::new(side).to_world(local)))
+    }
+
+    /// The density of [`Portals::sample_line`]'s lines at the line `o + t·w` (unit `w`), per
+    /// steradian and unit area across the line: for each portal it crosses, (Aₖ/A)·(1/Aₖ)·
+    /// (|cos θₖ|/2π) per unit of the portal's area, which is |cos θₖ| of the area across, so
+    /// (portals crossed)/(2π·A). `o` must lie before every portal on the line (outside the
+    /// scene).
+    #[must_use]
+    pub fn line_density(&self, o: Vec3, w: Vec3) -> f32 {
+        let crossed = self.list.iter().filter(|p| p.crossing(o, w).is_some()).count();
+        if crossed == 0 {
+            0.0
+        } else {
+            crossed as f32 / (2.0 * std::f32::consts::PI * self.area())
+        }
     }
 
     /// The density of [`Portals::sample`] toward unit `w` from `x`, per steradian: Σₖ tₖ² /
