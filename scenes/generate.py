@@ -643,6 +643,16 @@ def box_faces(o, name, material, lo, hi, inward=False):
             facing = [0.0, 0.0, 0.0]; facing[axis] = (v - c[axis]) * (-1 if inward else 1)
             o.quad(f"{name}_{'xyz'[axis]}{'-' if v == lo[axis] else '+'}", material, pts, tuple(facing))
 
+def wall_with_opening(o, name, span, rise, opening, place, facing, sides=("left", "right")):
+    """A zero-thickness wall of material `wall` over `span` x `rise` (its own coordinates (a, b),
+    put in space by `place(a, b)`) around a rectangular opening (a0, a1, b0, b1): four quads,
+    `NAME_low`, `NAME_high` and one each side (named by `sides`)."""
+    (s0, s1), (r0, r1) = span, rise
+    a0, a1, b0, b1 = opening
+    for part, pts in [("low", [(s0, r0), (s1, r0), (s1, b0), (s0, b0)]), ("high", [(s0, b1), (s1, b1), (s1, r1), (s0, r1)]),
+                      (sides[0], [(s0, b0), (a0, b0), (a0, b1), (s0, b1)]), (sides[1], [(a1, b0), (s1, b0), (s1, b1), (a1, b1)])]:
+        o.quad(f"{name}_{part}", "wall", [place(a, b) for a, b in pts], facing)
+
 def textured_quad(o, name, material, pts, uvs, facing):
     """A quad with texture coordinates (one `vt` per corner)."""
     n = cross(sub(pts[1], pts[0]), sub(pts[2], pts[0]))
@@ -758,9 +768,7 @@ outside_ior = 1.33
     o.quad("right", "wall", [(W, 0, -D), (W, H, -D), (W, H, D), (W, 0, D)], (-1, 0, 0))
     o.quad("front", "wall", [(-W, 0, D), (W, 0, D), (W, H, D), (-W, H, D)], (0, 0, -1))
     x0, x1, y0, y1 = -0.7, 0.7, 0.9, 2.0
-    for name, pts in [("back_low", [(-W, 0), (W, 0), (W, y0), (-W, y0)]), ("back_high", [(-W, y1), (W, y1), (W, H), (-W, H)]),
-                      ("back_left", [(-W, y0), (x0, y0), (x0, y1), (-W, y1)]), ("back_right", [(x1, y0), (W, y0), (W, y1), (x1, y1)])]:
-        o.quad(name, "wall", [(x, y, -D) for x, y in pts], (0, 0, 1))
+    wall_with_opening(o, "back", (-W, W), (0, H), (x0, x1, y0, y1), lambda x, y: (x, y, -D), (0, 0, 1))
     # The pane: one sheet of thin glass in the wall's plane (TOML `thin_glass`: a window pane that
     # shadow rays and photons pass with its transmittance).
     o.quad("pane", "glass", [(x0, y0, -D), (x1, y0, -D), (x1, y1, -D), (x0, y1, -D)], (0, 0, 1))
@@ -792,7 +800,7 @@ irradiance = [5.0, 4.8, 4.4]
 [environment]
 radiance = [0.8, 1.0, 1.4]
 
-# The window marked as a portal: half the sky's light samples go through it.
+# The window marked as a portal: half the sky's light samples and photons go through it.
 [[portal]]
 corners = [[-0.7, 0.9, -2.0], [0.7, 0.9, -2.0], [0.7, 2.0, -2.0], [-0.7, 2.0, -2.0]]
 ''')
@@ -961,15 +969,12 @@ def daylight():
     o.quad("front", "wall", [(-W, 0, D), (W, 0, D), (W, H, D), (-W, H, D)], (0, 0, -1))
     # Back wall (z = -D): a glazed window x in [-1.5, -0.1], y in [0.8, 2.0].
     bx0, bx1, by0, by1 = -1.5, -0.1, 0.8, 2.0
-    for name, pts in [("back_low", [(-W, 0), (W, 0), (W, by0), (-W, by0)]), ("back_high", [(-W, by1), (W, by1), (W, H), (-W, H)]),
-                      ("back_left", [(-W, by0), (bx0, by0), (bx0, by1), (-W, by1)]), ("back_right", [(bx1, by0), (W, by0), (W, by1), (bx1, by1)])]:
-        o.quad(name, "wall", [(x, y, -D) for x, y in pts], (0, 0, 1))
+    wall_with_opening(o, "back", (-W, W), (0, H), (bx0, bx1, by0, by1), lambda x, y: (x, y, -D), (0, 0, 1))
     o.quad("pane", "pane", [(bx0, by0, -D), (bx1, by0, -D), (bx1, by1, -D), (bx0, by1, -D)], (0, 0, 1))
     # Left wall (x = -W): an open window z in [-0.9, 0.7], y in [0.7, 2.1].
     lz0, lz1, ly0, ly1 = -0.9, 0.7, 0.7, 2.1
-    for name, pts in [("left_low", [(-D, 0), (D, 0), (D, ly0), (-D, ly0)]), ("left_high", [(-D, ly1), (D, ly1), (D, H), (-D, H)]),
-                      ("left_back", [(-D, ly0), (lz0, ly0), (lz0, ly1), (-D, ly1)]), ("left_front", [(lz1, ly0), (D, ly0), (D, ly1), (lz1, ly1)])]:
-        o.quad(name, "wall", [(-W, y, z) for z, y in pts], (1, 0, 0))
+    wall_with_opening(o, "left", (-D, D), (0, H), (lz0, lz1, ly0, ly1), lambda z, y: (-W, y, z), (1, 0, 0),
+                      sides=("back", "front"))
     # The ground outside, a little below the floor (zero-thickness walls stand on it).
     o.quad("ground", "ground", [(-6, -0.02, -6), (6, -0.02, -6), (6, -0.02, 6), (-6, -0.02, 6)], (0, 1, 0))
     # A bench and a potted plant: a stem and ten leaves on alpha-masked quads.

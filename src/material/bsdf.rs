@@ -10,9 +10,7 @@ use super::{
     PHOTON_SPECULAR_ALPHA,
 };
 use crate::microfacet;
-use crate::optics::{
-    conductor_reflectance, fresnel_dielectric, reflect, refract, thin_pass_probability, thin_slab_reflectance,
-};
+use crate::optics::{conductor_reflectance, fresnel_dielectric, reflect, refract, thin_slab_reflectance};
 use crate::sampling::{cosine_hemisphere, Frame};
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -588,7 +586,8 @@ fn reflect_thin_glass(frame: &SurfaceFrame, wo: Vec3, ior: f32, tint: Tint) -> O
     let (ng, ns) = frame.oriented(wo);
     let cos = wo.dot(ng).abs();
     let r = thin_slab_reflectance(cos, ior);
-    let stopped = 1.0 - thin_pass_probability(cos, ior, tint.transmit.x);
+    // 1 − thin_pass_probability, from the R′ just found.
+    let stopped = 1.0 - tint.transmit.x * (1.0 - r);
     let wi = reflect(wo, ns);
     if !(stopped > 0.0) || wi.dot(ng) <= 0.0 {
         return None;

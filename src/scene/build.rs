@@ -55,6 +55,8 @@ impl Scene {
         let zero_normals = meshes.iter().map(|m| m.zero_normals).sum();
         let mut materials = materials;
         for m in &mut materials {
+            // Thin sheets that can be passed in traversal are marked so.
+            m.bsdf = m.bsdf.passing_thin_sheets();
             match &m.opacity {
                 Some(o) if o.is_opaque() => m.opacity = None,
                 Some(_) if m.emission != Vec3::ZERO => {
@@ -160,12 +162,9 @@ impl Scene {
 
     /// Which kinds of material the scene's triangles use: (any passed as specular by photons,
     /// any glass, any non-delta, any absorbing interior, any normal map, any cut-out, any thin
-    /// sheet passed in traversal). Thin sheets that can be passed are marked so first
-    /// ([`Bsdf::passing_thin_sheets`]).
+    /// sheet passed in traversal: marked so at the start of [`Scene::build_lit`],
+    /// [`Bsdf::passing_thin_sheets`]).
     fn find_kinds(&mut self) {
-        for m in &mut self.materials {
-            m.bsdf = m.bsdf.passing_thin_sheets();
-        }
         let used = self.used_materials();
         for (m, _) in self.materials.iter().zip(&used).filter(|(_, u)| **u) {
             self.kinds.6 |= m.bsdf.thin_pass().is_some();

@@ -120,12 +120,13 @@ impl Environment {
         }
     }
 
-    /// The density of [`Environment::sample_from`] at `x` toward `wi`, given the map's density
-    /// `map_pdf` there (read with its radiance): the portals' when there are portals.
+    /// The density of [`Environment::sample_from`] at `x` toward `wi`: the portals' when there
+    /// are portals, else the map's, `map_pdf` (asked only then; a caller that read the
+    /// radiance has it already, [`Environment::radiance_pdf`]).
     #[must_use]
-    pub fn sampling_pdf(&self, x: Vec3, wi: Vec3, map_pdf: f32) -> f32 {
+    pub fn sampling_pdf(&self, x: Vec3, wi: Vec3, map_pdf: impl FnOnce() -> f32) -> f32 {
         if self.portals.is_empty() {
-            map_pdf
+            map_pdf()
         } else {
             self.portals.pdf(x, wi)
         }

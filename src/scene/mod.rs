@@ -482,7 +482,7 @@ impl Scene {
                     env.sample_from(p, [(2.0 * u[0] - 1.0).min(crate::sampling::ONE_BELOW), u[1]])?
                 };
                 let (radiance, map_pdf) = env.radiance_pdf(wi);
-                let env_pdf = env.sampling_pdf(p, wi, map_pdf);
+                let env_pdf = env.sampling_pdf(p, wi, || map_pdf);
                 let pdf = 0.5 * wi.dot(n).max(0.0) * std::f32::consts::FRAC_1_PI + 0.5 * env_pdf;
                 (pdf > 0.0 && wi.is_finite()).then(|| light::Incident {
                     wi,
@@ -519,11 +519,8 @@ impl Scene {
                 let Some((wi, pdf, radiance)) = env.sample([u[0], u[1]]) else {
                     return light::Emission { origin: centre, direction: Vec3::Y, power: Vec3::ZERO, normal: None };
                 };
-                let (dx, dy) = crate::sampling::concentric_disk([u[2], u[3]]);
-                let f = crate::sampling::Frame::new(wi);
-                let origin = centre + (f.s * dx + f.t * dy) * radius + wi * (2.0 * radius);
                 let power = radiance * (std::f32::consts::PI * radius * radius) / pdf;
-                light::Emission { origin, direction: -wi, power, normal: None }
+                light::Emission { origin: self.disk_origin(wi, [u[2], u[3]]), direction: -wi, power, normal: None }
             }
             (Light::Area { tri, .. }, _) if self.textured_emitter(*tri) => {
                 let t = self.triangle(*tri);
@@ -533,6 +530,16 @@ impl Scene {
             }
             _ => l.sample_emission(self.light_triangle(l).as_ref(), (centre, radius), u),
         }
+    }
+
+    /// Where a photon of light from direction `wi` (unit, away from the scene) starts: a point
+    /// uniform on the disk of the scene's radius across `wi` (two uniform numbers), moved 2 r
+    /// out along `wi`, outside the scene.
+    fn disk_origin(&self, wi: Vec3, u: [f32; 2]) -> Vec3 {
+        let (dx, dy) = crate::sampling::concentric_disk(u);
+        let f = crate::sampling::Frame::new(wi);
+        let radius = self.radius();
+        self.centre() + (f.s * dx + f.t * dy) * radius + wi * (2.0 * radius)
     }
 
     /// An environment photon in a scene with portals: with probability [`PORTAL_PHOTON_SHARE`]
@@ -554,9 +561,7 @@ impl Scene {
         } else {
             let u2 = ((u[2] - share) / (1.0 - share)).min(crate::sampling::ONE_BELOW);
             let Some(wi) = env.sample_direction([u[0], u[1]]) else { return dark };
-            let (dx, dy) = crate::sampling::concentric_disk([u2, u[3]]);
-            let f = crate::sampling::Frame::new(wi);
-            (centre + (f.s * dx + f.t * dy) * radius + wi * (2.0 * radius), -wi)
+            (self.disk_origin(wi, [u2, u[3]]), -wi)
         };
         let (radiance, map_pdf) = env.radiance_pdf(-dir);
         let across = (centre - origin).reject_from_normalized(dir).length();

@@ -17,6 +17,7 @@
 //! the disk's), so lines through no portal keep their light and the maps' expectation is the
 //! disk's alone ([`super::Scene::sample_emission`]).
 
+use crate::sampling::{cosine_hemisphere, Distribution1D, Frame, ONE_BELOW};
 use glam::Vec3;
 
 /// One portal: the parallelogram `corner + a·e1 + b·e2`, a and b in [0, 1].
@@ -92,25 +93,19 @@ impl Portal {
 }
 
 /// The scene's portals and the area distribution that picks one.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default)]
 pub struct Portals {
     list: Vec<Portal>,
-    /// Running sums of the areas, the last the total.
-    running: Vec<f32>,
+    /// Picks a portal by area (`None` without portals).
+    by_area: Option<Distribution1D>,
 }
 
 impl Portals {
     /// The portals `list` (none: an empty set, which samples nothing).
     #[must_use]
     pub fn new(list: Vec<Portal>) -> Portals {
-        let running = list
-            .iter()
-            .scan(0.0f32, |sum, p| {
-                *sum += p.area;
-                Some(*sum)
-            })
-            .collect();
-        Portals { list, running }
+        let areas: Vec<f64> = list.iter().map(|p| f64::from(p.area)).collect();
+        Portals { by_area: Distribution1D::try_new(&areas), list }
     }
 
     /// Whether there is none.
@@ -128,52 +123,42 @@ impl Portals {
     /// Their total area.
     #[must_use]
     pub fn area(&self) -> f32 {
-        self.running.last().copied().unwrap_or(0.0)
+        self.by_area.as_ref().map_or(0.0, |d| d.total() as f32)
     }
 
     /// The same portals relative to `origin` (the scene's frame).
     #[must_use]
     pub fn moved(&self, origin: Vec3) -> Portals {
-        Portals { list: self.list.iter().map(|p| p.moved(origin)).collect(), running: self.running.clone() }
+        Portals { list: self.list.iter().map(|p| p.moved(origin)).collect(), by_area: self.by_area.clone() }
+    }
+
+    /// A portal picked by area and a point uniform on it, from two uniform numbers; `None`
+    /// without portals.
+    fn point(&self, u: [f32; 2]) -> Option<(&Portal, Vec3)> {
+        let (k, a) = self.by_area.as_ref()?.sample_remapped(u[0]);
+        let p = &self.list[k];
+        Some((p, p.corner + p.e1 * a + p.e2 * u[1]))
     }
 
     /// A unit direction from `x` through a point of a portal (picked by area, the point uniform
     /// on it) with two uniform numbers; `None` without portals or for `x` on the point.
     #[must_use]
     pub fn sample(&self, x: Vec3, u: [f32; 2]) -> Option<Vec3> {
-        let total = self.area();
-        if !(total > 0.0) {
-            return None;
-        }
-        let target = u[0] * total;
-        let k = self.running.partition_point(|&s| s <= target).min(self.list.len() - 1);
-        let p = &self.list[k];
-        let below = if k == 0 { 0.0 } else { self.running[k - 1] };
-        let a = ((target - below) / p.area).clamp(0.0, 1.0);
-        let d = p.corner + p.e1 * a + p.e2 * u[1] - x;
+        let d = self.point(u)?.1 - x;
         let len = d.length();
         (len > 0.0 && len.is_finite()).then(|| d / len)
     }
 
-    /// A line of light through a portal, for a photon: a portal picked by area, a point
-    /// uniform on it, and a unit direction of travel cosine-weighted about its normal, to
-    /// either side with equal chance (which side is inside is not known), from four uniform
-    /// numbers: (the point, the direction). `None` without portals.
+    /// A line of light through a portal, for a photon: a portal and a point on it
+    /// (by area, uniform on it, from `u[2]` and `u[3]`), and a unit direction of travel
+    /// cosine-weighted about its normal, to either side with equal chance (which side is inside
+    /// is not known): (the point, the direction). `None` without portals.
     #[must_use]
     pub fn sample_line(&self, u: [f32; 4]) -> Option<(Vec3, Vec3)> {
-        let total = self.area();
-        if !(total > 0.0) {
-            return None;
-        }
-        let target = u[2] * total;
-        let k = self.running.partition_point(|&s| s <= target).min(self.list.len() - 1);
-        let p = &self.list[k];
-        let below = if k == 0 { 0.0 } else { self.running[k - 1] };
-        let a = ((target - below) / p.area).clamp(0.0, 1.0);
-        let y = p.corner + p.e1 * a + p.e2 * u[3];
+        let (p, y) = self.point([u[2], u[3]])?;
         let (side, u0) = if u[0] < 0.5 { (p.normal, 2.0 * u[0]) } else { (-p.normal, 2.0 * u[0] - 1.0) };
-        let local = crate::sampling::cosine_hemisphere([u0.min(crate::sampling::ONE_BELOW), u[1]]);
-        Some((y, crate::sampling::Frame::new(side).to_world(local)))
+        let local = cosine_hemisphere([u0.min(ONE_BELOW), u[1]]);
+        Some((y, Frame::new(side).to_world(local)))
     }
 
     /// The density of [`Portals::sample_line`]'s lines at the line `o + t·w` (unit `w`), per

@@ -189,7 +189,7 @@ pub fn light_density(ctx: &Context, r: &Receiver, light: usize, tri: u32, distan
 #[inline]
 pub fn environment_density(ctx: &Context, r: &Receiver, wi: Vec3) -> f32 {
     let Some(env) = &ctx.scene.environment else { return 0.0 };
-    density_with_map_pdf(ctx, r, wi, env.sampling_pdf(r.p, wi, env.pdf(wi)))
+    density_with_map_pdf(ctx, r, wi, env.sampling_pdf(r.p, wi, || env.pdf(wi)))
 }
 
 /// [`environment_density`] given the density of its second half toward `wi` (the map's, read
@@ -232,7 +232,7 @@ pub fn sky_found(ctx: &Context, r: &Receiver, d: Vec3, density: f32) -> Vec3 {
     if let Some(env) = &scene.environment {
         let (l, map_pdf) = env.radiance_pdf(d);
         if l != Vec3::ZERO {
-            let second = env.sampling_pdf(r.p, d, map_pdf);
+            let second = env.sampling_pdf(r.p, d, || map_pdf);
             sum += l * power_heuristic(density, density_with_map_pdf(ctx, r, d, second));
         }
     }
