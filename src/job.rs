@@ -5,10 +5,11 @@
 
 use crate::effects::Effects;
 use crate::error::{Error, Result};
+use crate::photon_map::reach::PhotonGuide;
 use crate::scene::Scene;
 use crate::settings::Settings;
 use crate::traversal_choice::TraversalChoice;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// What changes from pass to pass of a progressive render.
 #[derive(Clone, Debug, PartialEq)]
@@ -35,6 +36,11 @@ pub struct Job {
     /// The traversal kernel per ray queue (BVH2 packets, single rays or 8-wide packets), chosen
     /// in the first pass and kept by the others.
     pub traversal: Arc<TraversalChoice>,
+    /// Where the camera reads the photon maps and which lights photons come from, found once by
+    /// a pilot before the first photon pass ([`crate::transport::guide`]) and shared by every
+    /// pass. Empty (photons by power, every stored photon counted) in a job whose maps are built
+    /// without a camera, or with `--photon-guide off`.
+    pub guide: Arc<OnceLock<PhotonGuide>>,
 }
 
 impl Job {
@@ -48,6 +54,7 @@ impl Job {
             threads: settings.thread_count(),
             pass: Pass { seed: settings.seed, radii: None },
             traversal: Arc::new(TraversalChoice::timed()),
+            guide: Arc::default(),
         })
     }
 

@@ -21,6 +21,14 @@ pub const MAX_PATHS_PER_PHOTON: u64 = 256;
 /// the sun out of the scene spent 5.3 s of a 23.5 s render storing nothing before this.
 pub const EMPTY_PATHS_PER_PHOTON: u64 = 16;
 
+/// With the camera's cells ([`Settings::guide_photons`]), a map's target counts only photons
+/// stored where the camera reads it, and emission goes on past the path at which the map held
+/// its target in all photons for at most this many times as many paths: the map then costs at
+/// most twice its unguided paths, where the camera reads little of what it stores (a caustic map
+/// of window panes' reflections onto the ground outside: 1.5 % read, its caustic pass 8 times
+/// dearer without this bound, BENCHMARKS.md).
+pub const STEERED_PATHS: u64 = 2;
+
 /// Passes a `target_error` render runs before it trusts the spread between passes.
 pub const MIN_PASSES_FOR_TARGET: u32 = 4;
 
@@ -170,6 +178,13 @@ pub struct Settings {
     /// aimed pdf (`transport::aim`): the same caustic map in expectation from far fewer emitted
     /// paths. `false` emits them as the global photons are, for comparison.
     pub aim_caustics: bool,
+    /// Before the first photon pass a pilot follows a sample of the camera's paths and of the
+    /// global map's photon paths (`transport::guide`): the global map's target then counts only
+    /// photons stored where the camera reads it, and its photons leave the lights in proportion
+    /// to the power they bring there (a fifth of the choices stay by power), so a sun outside a
+    /// lit room does not take its photons. `false`: lights by power, every stored photon counted
+    /// (for comparison). The caustic map is never steered.
+    pub guide_photons: bool,
 }
 
 impl Default for Settings {
@@ -205,6 +220,7 @@ impl Default for Settings {
             boundary_correction: true,
             diagnostics: false,
             aim_caustics: true,
+            guide_photons: true,
         }
     }
 }
@@ -276,6 +292,8 @@ pub struct Overrides {
     pub no_boundary_correction: bool,
     /// `--no-aim-caustics`.
     pub no_aim_caustics: bool,
+    /// `--no-photon-guide`.
+    pub no_photon_guide: bool,
     /// `--no-mis`.
     pub no_mis: bool,
     /// `--light-sampler`.
@@ -326,6 +344,9 @@ impl Overrides {
         }
         if self.no_aim_caustics {
             s.aim_caustics = false;
+        }
+        if self.no_photon_guide {
+            s.guide_photons = false;
         }
         if self.no_mis {
             s.mis = false;

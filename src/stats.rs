@@ -44,6 +44,12 @@ pub struct MapStats {
     pub emitted: u64,
     /// Photons stored.
     pub stored: u64,
+    /// Photons stored where the camera reads the map, by the pilot's cells
+    /// ([`crate::photon_map::reach`]); all of them when the photons were not guided.
+    pub read: u64,
+    /// Whether the target counted only the photons stored where the camera reads (the photon
+    /// guide steered the pass), not every stored one.
+    pub steered: bool,
     /// The largest stored photon's power over the median photon's (each photon's largest
     /// channel): 1 where every photon keeps its path's emitted power; a spike shows as a large
     /// ratio. The largest over the passes of a progressive render; 0 for an empty map.
@@ -56,27 +62,30 @@ impl std::ops::AddAssign<&MapStats> for MapStats {
     fn add_assign(&mut self, o: &MapStats) {
         self.emitted += o.emitted;
         self.stored += o.stored;
+        self.read += o.read;
+        self.steered |= o.steered;
         self.power_max_over_median = self.power_max_over_median.max(o.power_max_over_median);
     }
 }
 
 impl MapStats {
-    /// A warning when the map holds fewer photons than `asked` because its photon pass hit the
-    /// cap of [`MAX_PATHS_PER_PHOTON`](crate::settings::MAX_PATHS_PER_PHOTON) paths per
-    /// photon asked, or stayed empty for
+    /// A warning when the map holds fewer photons than `asked` in all because its photon pass hit
+    /// the cap of [`MAX_PATHS_PER_PHOTON`](crate::settings::MAX_PATHS_PER_PHOTON) paths per
+    /// photon asked or stayed empty for
     /// [`EMPTY_PATHS_PER_PHOTON`](crate::settings::EMPTY_PATHS_PER_PHOTON): few light paths
     /// reach the surfaces it stores on, and its estimates are sparse (or, when it is empty,
-    /// zero).
+    /// zero). A guided map that holds its photons in all but fewer where the camera reads (its
+    /// steering bounded, [`STEERED_PATHS`](crate::settings::STEERED_PATHS)) is not warned of: it
+    /// holds at least the photons there that an unguided one would; the summary gives the share.
     #[must_use]
     pub fn shortfall(&self, name: &str, asked: u64) -> Option<String> {
+        use crate::settings::{EMPTY_PATHS_PER_PHOTON, MAX_PATHS_PER_PHOTON};
         (self.built && self.stored < asked).then(|| {
-            let cap = if self.stored == 0 {
-                crate::settings::EMPTY_PATHS_PER_PHOTON
-            } else {
-                crate::settings::MAX_PATHS_PER_PHOTON
-            };
+            let cap = if self.stored == 0 { EMPTY_PATHS_PER_PHOTON } else { MAX_PATHS_PER_PHOTON };
+            let there =
+                if self.steered { format!(" ({} where the camera reads it)", self.read) } else { String::new() };
             format!(
-                "{name} map: {} of {asked} photons stored from {} paths, the cap of {cap} per photon asked{} — \
+                "{name} map: {} of {asked} photons stored{there} from {} paths, the cap of {cap} per photon asked{} — \
                  few light paths reach the surfaces it stores on{}",
                 self.stored,
                 self.emitted,
@@ -221,6 +230,10 @@ pub struct RenderStats {
     pub caustic_map: MapStats,
     /// Points with precomputed irradiance (0 when not used).
     pub irradiance_points: u64,
+    /// The photon guide's pilot ([`crate::transport::guide`]): what it found, in a line;
+    /// absent without one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub guide: Option<String>,
     /// Phases that ran: photon passes, final gather or direct global-map reading, progressive
     /// passes (their count is `progressive.passes`).
     pub phases: Vec<String>,
@@ -310,8 +323,14 @@ impl RenderStats {
         let map = |name: &str, m: &MapStats| {
             if m.built {
                 let per = if m.emitted > 0 { m.stored as f64 / m.emitted as f64 } else { 0.0 };
+                let read = match (&self.guide, m.stored) {
+                    (Some(_), n) if n > 0 => {
+                        format!(", {:.1} % where the camera reads it", 100.0 * m.read as f64 / n as f64)
+                    }
+                    _ => String::new(),
+                };
                 format!(
-                    "  {name:<8} map: {} photons stored from {} emitted paths{over} ({per:.3} per path)\n",
+                    "  {name:<8} map: {} photons stored from {} emitted paths{over} ({per:.3} per path){read}\n",
                     m.stored, m.emitted
                 )
             } else {
@@ -352,7 +371,8 @@ impl RenderStats {
             self.numerics.load_normals,
             self.numerics.photon_escaped,
             self.numerics.photons_filtered,
-        ) + &self.progressive_summary()
+        ) + &self.guide.as_ref().map_or(String::new(), |g| format!("  photon guide: {g}\n"))
+            + &self.progressive_summary()
             + &self.parallel.map_or(String::new(), |p| p.summary() + "\n")
     }
 

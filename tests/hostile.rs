@@ -348,7 +348,8 @@ fn the_cli_prints_what_is_asked() {
 }
 
 /// `--photons N` stores exactly N photons, on both engines alike (20 000 stored 29 999 and 1
-/// stored about 26 600: whole batches of paths); progressive stats total the passes.
+/// stored about 26 600: whole batches of paths) — in the global map, N where the camera reads it
+/// (the photon guide's count); progressive stats total the passes.
 #[test]
 fn a_map_holds_the_photons_asked_for() {
     let d = scratch_dir("exact-photons");
@@ -362,8 +363,8 @@ fn a_map_holds_the_photons_asked_for() {
                 cli(&[&args[..], &["--spp", "1", "--engine", engine, "--photons", n, "--caustic-photons", n]].concat());
             assert_eq!(code, 0, "{e}");
             let v = json(&stats);
-            for map in ["global_map", "caustic_map"] {
-                assert_eq!(v[map]["stored"].to_string(), n, "{engine} {map}: {}", v[map]);
+            for (map, count) in [("global_map", "read"), ("caustic_map", "stored")] {
+                assert_eq!(v[map][count].to_string(), n, "{engine} {map}: {}", v[map]);
             }
             emitted.push((v["global_map"]["emitted"].clone(), v["caustic_map"]["emitted"].clone()));
         }
@@ -374,7 +375,7 @@ fn a_map_holds_the_photons_asked_for() {
     assert_eq!(code, 0, "{e}");
     let v = json(&stats);
     assert_eq!(v["progressive"]["passes"], 3);
-    assert_eq!(v["global_map"]["stored"], 9000, "totals over the passes");
+    assert_eq!(v["global_map"]["read"], 9000, "totals over the passes");
     assert_eq!(v["caustic_map"]["stored"], 6000);
     assert!(v["phases"].as_array().unwrap().iter().any(|p| p == "3 progressive passes"), "{}", v["phases"]);
 }

@@ -128,13 +128,9 @@ fn emit_photons_starts_a_batch_like_the_reference() {
     let q = &w.resource::<PhotonWork>().queue;
     assert_eq!(q.len(), photonwave::transport::photon::BATCH);
     for k in [0usize, 777, 16_383] {
-        let photonwave::transport::photon::Start::Photon(p) = photonwave::transport::photon::start_photon(
-            &shared.scene,
-            shared.job.pass.seed,
-            Domain::GlobalPhoton,
-            q.path[k],
-            true,
-        ) else {
+        let photonwave::transport::photon::Start::Photon(p) =
+            photonwave::transport::photon::start_photon(&shared.scene, &shared.job, Domain::GlobalPhoton, q.path[k])
+        else {
             panic!("path {k} starts no photon")
         };
         assert_eq!((q.rays.origin(k), q.rays.direction(k), q.power[k]), (p.origin, p.dir, p.power));

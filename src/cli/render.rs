@@ -84,6 +84,11 @@ pub struct RenderArgs {
     /// the mirrors, glass and smooth rough metal that make caustics (for comparison) [aimed].
     #[arg(long)]
     pub no_aim_caustics: bool,
+    /// Emit photons from the lights by power and count every stored photon toward a map's
+    /// target, instead of guiding both by a pilot of the camera's paths (where the camera reads
+    /// each map) (for comparison) [guided].
+    #[arg(long)]
+    pub no_photon_guide: bool,
     /// Leave emitters to light sampling alone instead of weighing light samples against the
     /// final-gather and glossy rays (the path tracer: its next bounce) by multiple importance
     /// sampling (for comparison) [MIS on].
@@ -218,6 +223,7 @@ fn overrides(args: &RenderArgs) -> Overrides {
         gather_rays: args.gather_rays,
         no_final_gather: args.no_final_gather,
         no_aim_caustics: args.no_aim_caustics,
+        no_photon_guide: args.no_photon_guide,
         no_mis: args.no_mis,
         light_sampler: args.light_sampler,
         secondary_gather: args.secondary_gather,

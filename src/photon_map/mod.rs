@@ -44,6 +44,7 @@ pub mod orientation;
 mod packing;
 pub mod query_packet;
 pub mod radius;
+pub mod reach;
 mod sum;
 mod tree;
 

@@ -79,12 +79,16 @@ pub fn pilot_seed(seed: u64) -> u64 {
 /// density-weighed median k-nearest radius where the camera reads it (`camera_knn_radii`),
 /// else the median over the pilot's photons ([`median_knn_radius`]), else the maximum radius (a
 /// map empty or too sparse); with `per_pixel_radii`, each pixel's own as well ([`pixel_radii`]).
-/// `job` is the render's, whose pass (the user's seed, no radii) is the first.
+/// `job` is the render's, whose pass (the user's seed, no radii) is the first; its photon guide
+/// is made here when it has none yet.
 #[must_use]
 pub fn initial_radii(scene: &Scene, rays: &CameraRays, job: &Job) -> FixedRadii {
     let settings = &job.settings;
     let d = scene.diagonal();
     let (r_global, r_caustic) = (settings.global_radius * d, settings.caustic_radius * d);
+    // The pilot map is guided as the passes' maps will be (the job shares the guide with them),
+    // so its radii follow the photons the passes will store where the camera reads.
+    crate::transport::guide::ensure(scene, rays, job);
     let pilot = Job {
         settings: Settings { precompute_irradiance: false, ..settings.clone() },
         pass: Pass { seed: pilot_seed(settings.seed), radii: None },

@@ -37,7 +37,7 @@ pub fn render(
 pub fn render_job(scene: &Scene, camera: &CameraRays, job: &Job, progress: &dyn Progress) -> (Film, RenderStats) {
     let start = Instant::now();
     let mut stats = RenderStats::new("reference", scene, &job.settings, job.threads);
-
+    stats.guide = crate::transport::guide::ensure(scene, camera, job).map(|g| g.summary.clone());
     let maps = photon_passes(scene, job, progress, &mut stats);
     stats.effects = Some(job.plan.clone());
 
@@ -73,6 +73,8 @@ pub fn photon_passes(scene: &Scene, job: &Job, progress: &dyn Progress, stats: &
         let map = if domain == Domain::CausticPhoton { &mut stats.caustic_map } else { &mut stats.global_map };
         map.emitted = p.emitted;
         map.stored = p.photons.len() as u64;
+        map.read = p.read;
+        map.steered = crate::transport::guide::steers(job, domain);
         map.power_max_over_median = power_max_over_median(&p.photons);
         p.photons
     };

@@ -23,12 +23,14 @@ pub mod camera;
 pub mod direct;
 pub mod estimate;
 pub mod gather;
+pub mod guide;
 pub mod lobe;
 pub mod maps;
 pub mod mis;
 pub mod photon;
 pub mod specular;
 pub mod streams;
+pub mod tally;
 
 pub use maps::PhotonMaps;
 

@@ -23,17 +23,15 @@
 //! holds its target, so the photon set is the same at any thread count and in every engine.
 //! Stored power = Φ-weighted path power divided by the number of paths emitted.
 
+pub use super::tally::{normalise_power, PathCounts, PathEnd, Tally, TracedPhotons, BATCH};
 use crate::geometry::offset::{barycentric_error, offset_ray_origin};
+use crate::job::Job;
 use crate::material::{Bsdf, SurfaceFrame, Transport};
 use crate::photon_map::{flags, Photon};
 use crate::rng::{Domain, Sampler};
+use crate::sampling::Distribution1D;
 use crate::scene::{Scene, SurfacePoint};
-use crate::settings::{EMPTY_PATHS_PER_PHOTON, MAX_PATHS_PER_PHOTON};
-use crate::stats::Numerics;
 use glam::Vec3;
-
-/// Paths per batch: emission runs batch by batch until a map reaches its target.
-pub const BATCH: usize = 16_384;
 
 /// The most each of the two factors of Veach's shading-normal correction may be (see
 /// [`shading_normal_correction`]).
@@ -67,169 +65,6 @@ pub const CORRECTION_MAX: f32 = 4.0;
 /// the clamped power is a bias the count measures.
 pub const POWER_GROWTH_MAX: f32 = 16.0;
 
-/// A map's photons as batches of paths come in, and the stopping rule: emission stops at the
-/// path that stores the target's last photon, so a map holds exactly the photons asked for and
-/// its power is divided by the paths emitted up to that one. That path's later bounces are not
-/// stored (as in Jensen 1996, where emission stops when the map is full): one path of thousands,
-/// a bias far below the estimate's noise. Emission also stops after
-/// [`MAX_PATHS_PER_PHOTON`] paths per wanted photon, for scenes that store almost nothing.
-///
-/// The counts of [`PathCounts`] are summed over the kept paths only: the paths of the last
-/// batch past the one that stores the last photon are traced but their rays and numerics are
-/// not counted, so both engines count what the map holds, however a wave is cut.
-#[derive(Debug, Default)]
-pub struct Tally {
-    target: u64,
-    cap: u64,
-    photons: Vec<Photon>,
-    emitted: u64,
-    rays: u64,
-    numerics: Numerics,
-}
-
-impl Tally {
-    /// An empty tally for a map of `target` photons.
-    #[must_use]
-    pub fn new(target: u32) -> Self {
-        let target = u64::from(target);
-        Tally {
-            target,
-            cap: (target * MAX_PATHS_PER_PHOTON).max(BATCH as u64),
-            photons: Vec::new(),
-            emitted: 0,
-            rays: 0,
-            numerics: Numerics::default(),
-        }
-    }
-
-    /// Whether another batch should be emitted: the map is short of its target, below the path
-    /// cap, and not still empty after [`EMPTY_PATHS_PER_PHOTON`] paths per photon asked.
-    #[must_use]
-    pub fn wants_more(&self) -> bool {
-        let empty = self.photons.is_empty() && self.emitted >= self.target * EMPTY_PATHS_PER_PHOTON;
-        (self.photons.len() as u64) < self.target && self.emitted < self.cap && !empty
-    }
-
-    /// Index of the next batch's first path (the paths emitted so far).
-    #[must_use]
-    pub fn emitted(&self) -> u64 {
-        self.emitted
-    }
-
-    /// Photons stored so far.
-    #[must_use]
-    pub fn stored(&self) -> u64 {
-        self.photons.len() as u64
-    }
-
-    /// Batches left before the path cap.
-    #[must_use]
-    pub fn batches_left(&self) -> usize {
-        (self.cap - self.emitted.min(self.cap)).div_ceil(BATCH as u64) as usize
-    }
-
-    /// Adds the next batch, paths `emitted()..emitted() + BATCH`: the photons its paths stored,
-    /// in path order (and bounce order within a path), each with its path index, and what each
-    /// path of the batch counted (`counts[j]` for path `emitted() + j`; only the kept paths'
-    /// are summed).
-    pub fn add_batch(&mut self, stored: impl IntoIterator<Item = (u64, Photon)>, counts: &[PathCounts]) {
-        let start = self.emitted;
-        let end = start + BATCH as u64;
-        self.emitted = end;
-        for (path, photon) in stored {
-            debug_assert!((start..end).contains(&path), "path {path} is not in this batch");
-            self.photons.push(photon);
-            if self.photons.len() as u64 == self.target {
-                self.emitted = path + 1;
-                break;
-            }
-        }
-        let kept = ((self.emitted - start) as usize).min(counts.len());
-        for c in &counts[..kept] {
-            self.rays += u64::from(c.rays);
-            c.add_to(&mut self.numerics);
-        }
-    }
-
-    /// The stored photons, each carrying its path's power over the paths emitted, with the
-    /// paths emitted and what they counted.
-    #[must_use]
-    pub fn finish(mut self) -> TracedPhotons {
-        normalise_power(&mut self.photons, self.emitted);
-        TracedPhotons { photons: self.photons, emitted: self.emitted, rays: self.rays, numerics: self.numerics }
-    }
-}
-
-/// What a photon pass produced for one map.
-#[derive(Debug)]
-pub struct TracedPhotons {
-    /// Stored photons, power already divided by `emitted`.
-    pub photons: Vec<Photon>,
-    /// Paths emitted.
-    pub emitted: u64,
-    /// Ray segments traced by those paths.
-    pub rays: u64,
-    /// Those paths' photon counters (the photon fields of [`Numerics`]).
-    pub numerics: Numerics,
-}
-
-/// What one photon path counted, kept per path until the tally knows whether the path is kept.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct PathCounts {
-    /// Ray segments traced.
-    pub rays: u16,
-    /// Bounces whose power [`POWER_GROWTH_MAX`] clamped.
-    pub capped: u16,
-    /// How the path ended, where that is counted.
-    pub end: PathEnd,
-}
-
-/// How a photon path ended, for the counters of [`Numerics`].
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum PathEnd {
-    /// Absorbed, stored its last photon, or still going: nothing counted.
-    #[default]
-    Quiet,
-    /// Its emission was not finite (`photon_emission`).
-    EmissionNonFinite,
-    /// Its power stopped being finite at a bounce (`photon_scatter`).
-    ScatterNonFinite,
-    /// A BSDF sample of zero pdf (`photon_zero_pdf`).
-    ZeroPdf,
-    /// It left a scene closed around its lights (`photon_escaped`).
-    Escaped,
-    /// Still going after `max_depth` bounces (`photon_depth_cut`).
-    DepthCut,
-}
-
-impl PathCounts {
-    /// One more ray segment.
-    pub fn ray(&mut self) {
-        self.rays = self.rays.saturating_add(1);
-    }
-
-    /// Adds this path's counts to `n`.
-    pub fn add_to(&self, n: &mut Numerics) {
-        n.photon_power_capped += u64::from(self.capped);
-        match self.end {
-            PathEnd::Quiet => {}
-            PathEnd::EmissionNonFinite => n.photon_emission += 1,
-            PathEnd::ScatterNonFinite => n.photon_scatter += 1,
-            PathEnd::ZeroPdf => n.photon_zero_pdf += 1,
-            PathEnd::Escaped => n.photon_escaped += 1,
-            PathEnd::DepthCut => n.photon_depth_cut += 1,
-        }
-    }
-}
-
-/// Divides stored photons' power by the number of paths emitted: each then carries Φ/N.
-pub fn normalise_power(photons: &mut [Photon], emitted: u64) {
-    let scale = 1.0 / emitted as f32;
-    for p in photons {
-        p.power *= scale;
-    }
-}
-
 /// A photon between bounces.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PhotonRay {
@@ -258,14 +93,30 @@ pub enum Start {
     NonFinite,
 }
 
-/// Starts photon path `index` of `domain` with the random streams of `seed`: picks a light by
-/// power and samples its emission; with `aim` the caustic pass aims at the scene's specular
-/// objects ([`super::aim`]).
+/// The lights' distribution that photons of `domain` leave from in `job`: its guide's
+/// ([`super::guide`]) when it has one for that map, else the scene's, by power.
 #[must_use]
-pub fn start_photon(scene: &Scene, seed: u64, domain: Domain, index: u64, aim: bool) -> Start {
-    let s = Sampler::new(seed, domain, index);
-    let li = scene.light_power.sample(s.get(0, 0));
-    let pmf = scene.light_power.pmf(li) as f32;
+pub fn photon_lights<'a>(scene: &'a Scene, job: &'a Job, domain: Domain) -> &'a Distribution1D {
+    let guide = job.guide.get().map(|g| if domain == Domain::CausticPhoton { &g.caustic } else { &g.global });
+    guide.and_then(|g| g.lights.as_ref()).unwrap_or(&scene.light_power)
+}
+
+/// The light that photon path `index` of `domain` leaves from in `job`, and its probability.
+#[must_use]
+pub fn photon_light(scene: &Scene, job: &Job, domain: Domain, index: u64) -> (usize, f32) {
+    let lights = photon_lights(scene, job, domain);
+    let li = lights.sample(Sampler::new(job.pass.seed, domain, index).get(0, 0));
+    (li, lights.pmf(li) as f32)
+}
+
+/// Starts photon path `index` of `domain` with the random streams of `job`'s pass: picks a
+/// light ([`photon_light`]) and samples its emission; the caustic pass aims at the scene's
+/// specular objects ([`super::aim`]) unless the settings say not to.
+#[must_use]
+pub fn start_photon(scene: &Scene, job: &Job, domain: Domain, index: u64) -> Start {
+    let s = Sampler::new(job.pass.seed, domain, index);
+    let (li, pmf) = photon_light(scene, job, domain, index);
+    let aim = job.settings.aim_caustics;
     let light = &scene.lights[li];
     let tri = scene.light_triangle(light);
     let u = [s.get(0, 1), s.get(0, 2), s.get(0, 3), s.get(0, 4)];
@@ -415,6 +266,56 @@ pub fn roulette(power: Vec3, emitted: f32, u: f32) -> Roulette {
     }
 }
 
+/// Traces photon path `index` of `domain` one bounce at a time (the scalar oracle's photon path,
+/// and the guide's pilot), appending stored photons (un-normalised power) to
+/// `out`; returns what the path counted.
+pub fn trace_path(scene: &Scene, job: &Job, domain: Domain, index: u64, out: &mut Vec<Photon>) -> PathCounts {
+    let mut counts = PathCounts::default();
+    let mut photon = match start_photon(scene, job, domain, index) {
+        Start::Photon(p) => p,
+        Start::Dark => return counts,
+        Start::NonFinite => {
+            counts.end = PathEnd::EmissionNonFinite;
+            return counts;
+        }
+    };
+    let s = Sampler::new(job.pass.seed, domain, index);
+    for bounce in 0..job.settings.max_depth {
+        counts.ray();
+        let Some(hit) = scene.intersect(photon.origin, photon.dir, f32::INFINITY) else {
+            if scene.encloses_lights {
+                counts.end = PathEnd::Escaped;
+            }
+            return counts;
+        };
+        photon.power *= scene.interior_transmittance(&hit, photon.dir);
+        let sp = scene.surface(&hit);
+        let bsdf = scene.bsdf(&sp);
+        if !bsdf.is_delta() && !deposit_photon(domain, &sp, &bsdf, &photon, bounce, out) {
+            return counts;
+        }
+        match scatter_photon(&s, &sp, &bsdf, &photon, bounce) {
+            Scattered::Continue(next) => photon = next,
+            Scattered::Capped(next) => {
+                counts.capped += 1;
+                photon = next;
+            }
+            Scattered::Absorbed => return counts,
+            Scattered::NonFinite => {
+                counts.end = PathEnd::ScatterNonFinite;
+                return counts;
+            }
+            Scattered::ZeroPdf => {
+                counts.end = PathEnd::ZeroPdf;
+                return counts;
+            }
+        }
+    }
+    // Russian roulette did not end it within max_depth bounces: the safety cap does.
+    counts.end = PathEnd::DepthCut;
+    counts
+}
+
 /// Veach's adjoint correction for shading normals, `|wo·ns||wi·ng| / (|wo·ng||wi·ns|)`, as the
 /// arrival factor `|wo·ns| / |wo·ng|` times the departure factor `|wi·ng| / |wi·ns|`, each at
 /// most [`CORRECTION_MAX`] (whose bias is derived there); 1 where the shading normal is the
@@ -465,54 +366,6 @@ pub fn first_hit_power(photons: &[Photon]) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Emission stops at the path that stores the target's last photon: paths storing nothing
-    /// are passed over, a path whose photons straddle the count is the one emission stops at,
-    /// and a batch that falls short counts whole.
-    #[test]
-    fn emission_stops_at_the_path_that_stores_the_last_photon() {
-        let p = Photon { position: Vec3::ZERO, power: Vec3::ONE, wi: Vec3::Z, normal: Vec3::Z, flags: 0 };
-        // Paths 0..5 store 0, 2, 0, 3 and 1 photons.
-        let batch: Vec<(u64, Photon)> = [1u64, 1, 3, 3, 3, 4].iter().map(|&path| (path, p)).collect();
-        let cuts: Vec<u64> = (1..=6)
-            .map(|need| {
-                let mut t = Tally::new(need);
-                t.add_batch(batch.iter().copied(), &[]);
-                assert_eq!(t.stored(), u64::from(need));
-                t.emitted()
-            })
-            .collect();
-        assert_eq!(cuts, [2, 2, 4, 4, 4, 5]);
-        let mut short = Tally::new(100_000);
-        short.add_batch(batch.iter().copied(), &[]);
-        assert_eq!((short.stored(), short.emitted(), short.wants_more()), (6, BATCH as u64, true));
-        // A map of 10 photons may emit one batch at most (the path cap is at least a batch).
-        let mut capped = Tally::new(10);
-        capped.add_batch(batch.iter().copied(), &[]);
-        assert!(!capped.wants_more());
-        let traced = short.finish();
-        assert_eq!((traced.photons[0].power, traced.emitted), (Vec3::splat(1.0 / BATCH as f32), BATCH as u64));
-    }
-
-    /// Only the kept paths' counts are summed: with 3 photons wanted the tally stops at path 3
-    /// (paths 0..4 kept), so path 4's rays and its escape are not counted.
-    #[test]
-    fn only_kept_paths_are_counted() {
-        let p = Photon { position: Vec3::ZERO, power: Vec3::ONE, wi: Vec3::Z, normal: Vec3::Z, flags: 0 };
-        let batch: Vec<(u64, Photon)> = [1u64, 1, 3, 3, 3, 4].iter().map(|&path| (path, p)).collect();
-        let mut counts = vec![PathCounts { rays: 2, ..Default::default() }; BATCH];
-        counts[1].end = PathEnd::ScatterNonFinite;
-        counts[2].capped = 3;
-        counts[4].end = PathEnd::Escaped;
-        let mut t = Tally::new(3);
-        t.add_batch(batch.iter().copied(), &counts);
-        let traced = t.finish();
-        assert_eq!((traced.emitted, traced.rays), (4, 8));
-        assert_eq!(
-            (traced.numerics.photon_scatter, traced.numerics.photon_power_capped, traced.numerics.photon_escaped),
-            (1, 3, 0)
-        );
-    }
 
     /// Russian roulette at the emitted power: below it a photon survives with probability
     /// m / emitted at exactly the emitted power (so the expected power is unchanged), at or

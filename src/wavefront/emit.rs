@@ -15,7 +15,7 @@ use glam::Vec3;
 /// Starts the piece's photon paths at its first path index.
 pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats: ResMut<StageStats>) {
     let t = StageClock::start();
-    let (scene, seed) = (&*shared.scene, shared.job.pass.seed);
+    let scene = &*shared.scene;
     let domain = work.domain.unwrap_or(Domain::GlobalPhoton);
     let first = work.first_path;
     let n = work.paths;
@@ -26,7 +26,7 @@ pub fn emit_photons(shared: Res<Shared>, mut work: ResMut<PhotonWork>, mut stats
     w.queue.reserve(n);
     for i in 0..n {
         let path = first + i as u64;
-        match start_photon(scene, seed, domain, path, shared.job.settings.aim_caustics) {
+        match start_photon(scene, &shared.job, domain, path) {
             Start::Photon(p) => w.queue.push(PhotonLane {
                 origin: p.origin,
                 dir: p.dir,

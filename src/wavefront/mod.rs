@@ -170,6 +170,7 @@ pub fn render_job(scene: Arc<Scene>, camera: &CameraRays, job: &Job, progress: &
     let mut stats =
         RenderStats { effects: Some(job.plan.clone()), ..RenderStats::new("wavefront", &scene, settings, job.threads) };
     let mut stages = StageStats::default();
+    stats.guide = crate::transport::guide::ensure(&scene, camera, job).map(|g| g.summary.clone());
     let maps = Arc::new(photon_pass(&scene, job, &mut stats, &mut stages, progress));
 
     // Camera pass, tile by tile on every worker, with the camera rays' kernel chosen first.

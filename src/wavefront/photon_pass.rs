@@ -116,7 +116,11 @@ pub fn photon_pass(
         let t = Instant::now();
         let name = if domain == Domain::CausticPhoton { "caustic photons" } else { "global photons" };
         progress.start(name, u64::from(target));
-        let mut tally = Tally::new(target);
+        let mut tally = Tally::reading(
+            target,
+            crate::transport::guide::cells(job, domain),
+            crate::transport::guide::steers(job, domain),
+        );
         let mut reported = 0u64;
         // A wave holds several batches — enough pieces to keep every worker busy — sized from
         // the photons per batch seen so far. The tally is then fed batch by batch, so the
@@ -124,7 +128,7 @@ pub fn photon_pass(
         let mut per_batch = 0.0f64;
         while tally.wants_more() {
             let wanted = if per_batch > 0.0 {
-                ((f64::from(target) - tally.stored() as f64) / per_batch).ceil() as usize
+                ((f64::from(target) - tally.counted() as f64) / per_batch).ceil() as usize
             } else {
                 1
             };
@@ -140,8 +144,8 @@ pub fn photon_pass(
                 tally.add_batch(rest[..n].iter().map(|(path, _, p)| (*path, *p)), counts);
                 rest = &rest[n..];
             }
-            per_batch = tally.stored() as f64 / (tally.emitted() / BATCH as u64) as f64;
-            let now = tally.stored().min(u64::from(target));
+            per_batch = tally.counted() as f64 / (tally.emitted() / BATCH as u64) as f64;
+            let now = tally.counted().min(u64::from(target));
             progress.advance(now - reported);
             reported = now;
         }
@@ -157,6 +161,8 @@ pub fn photon_pass(
         };
         map.emitted = emitted;
         map.stored = photons.len() as u64;
+        map.read = traced.read;
+        map.steered = crate::transport::guide::steers(job, domain);
         map.power_max_over_median = power_max_over_median(&photons);
         *time = t.elapsed().as_secs_f64();
         stats.phases.push(format!("{name} (wavefront)"));
