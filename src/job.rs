@@ -39,7 +39,8 @@ pub struct Job {
     /// Where the camera reads the photon maps and which lights photons come from, found once by
     /// a pilot before the first photon pass ([`crate::transport::guide`]) and shared by every
     /// pass. Empty (photons by power, every stored photon counted) in a job whose maps are built
-    /// without a camera, or with `--photon-guide off`.
+    /// without a camera; with `--no-photon-guide` it holds the cells (for the record) and no
+    /// light distribution, and does not steer.
     pub guide: Arc<OnceLock<PhotonGuide>>,
 }
 

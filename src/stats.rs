@@ -45,7 +45,7 @@ pub struct MapStats {
     /// Photons stored.
     pub stored: u64,
     /// Photons stored where the camera reads the map, by the pilot's cells
-    /// ([`crate::photon_map::reach`]); all of them when the photons were not guided.
+    /// ([`crate::photon_map::reach`]); all of them in maps built without a camera (no pilot).
     pub read: u64,
     /// Whether the target counted only the photons stored where the camera reads (the photon
     /// guide steered the pass), not every stored one.
@@ -80,17 +80,26 @@ impl MapStats {
     #[must_use]
     pub fn shortfall(&self, name: &str, asked: u64) -> Option<String> {
         use crate::settings::{EMPTY_PATHS_PER_PHOTON, MAX_PATHS_PER_PHOTON};
-        (self.built && self.stored < asked).then(|| {
-            let cap = if self.stored == 0 { EMPTY_PATHS_PER_PHOTON } else { MAX_PATHS_PER_PHOTON };
-            let there =
-                if self.steered { format!(" ({} where the camera reads it)", self.read) } else { String::new() };
+        // A steered map stops as an empty one when none of its photons lies where the camera reads.
+        let empty = if self.steered { self.read == 0 } else { self.stored == 0 };
+        (self.built && (self.stored < asked || empty)).then(|| {
+            let cap = if empty { EMPTY_PATHS_PER_PHOTON } else { MAX_PATHS_PER_PHOTON };
+            let (there, stays) = if self.steered {
+                (format!(" ({} where the camera reads it)", self.read), " where the camera reads it")
+            } else {
+                (String::new(), "")
+            };
             format!(
                 "{name} map: {} of {asked} photons stored{there} from {} paths, the cap of {cap} per photon asked{} — \
                  few light paths reach the surfaces it stores on{}",
                 self.stored,
                 self.emitted,
-                if self.stored == 0 { " for a map that stays empty" } else { "" },
-                if self.stored == 0 { "; it is empty and adds nothing" } else { "" }
+                if empty { format!(" for a map that stays empty{stays}") } else { String::new() },
+                match (empty, self.steered) {
+                    (false, _) => "",
+                    (true, false) => "; it is empty and adds nothing",
+                    (true, true) => "; it adds nothing there",
+                }
             )
         })
     }

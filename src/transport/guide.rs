@@ -145,7 +145,11 @@ fn camera_cells(scene: &Scene, rays: &CameraRays, pilot: &Job) -> (ReadCells, Re
     let maps = PhotonMaps::default();
     let ctx = Context::new(scene, &maps, pilot);
     let gather = pilot.plan.final_gather.on;
-    let (width, pixels) = (settings.width as usize, settings.width as usize * settings.height as usize);
+    // Columns and rows of the pilot's grid over the image, and a grid cell's size in pixels.
+    let (width, height) = (settings.width as f32, settings.height as f32);
+    let columns = ((PILOT_PIXELS as f32 * width / height).sqrt().ceil() as usize).clamp(1, PILOT_PIXELS);
+    let rows = PILOT_PIXELS.div_ceil(columns);
+    let cell = (width / columns as f32, height / rows as f32);
     let found = map_chunks(
         PILOT_PIXELS,
         256,
@@ -154,13 +158,12 @@ fn camera_cells(scene: &Scene, rays: &CameraRays, pilot: &Job) -> (ReadCells, Re
             let mut counts = RayCounts::default();
             range
                 .map(|i| {
-                    // Spread evenly over the image whatever its size: a small image gets several
-                    // points per pixel, each jittered within it.
-                    let pixel = (i as f64 + 0.5) * pixels as f64 / PILOT_PIXELS as f64;
-                    let pixel = (pixel as usize).min(pixels - 1);
+                    // Stratified over the image whatever its size: a grid of about square cells,
+                    // one jittered point in each (a small image gets several per pixel).
                     let s = Sampler::new(pilot.pass.seed, Domain::Camera, i as u64);
                     let (jx, jy) = (s.get(JITTER_BOUNCE, 0), s.get(JITTER_BOUNCE, 1));
-                    let (o, d) = rays.ray((pixel % width) as f32 + jx, (pixel / width) as f32 + jy);
+                    let (cx, cy) = ((i % columns) as f32, (i / columns) as f32);
+                    let (o, d) = rays.ray((cx + jx) * cell.0, (cy + jy) * cell.1);
                     let Some(end) = first_non_specular(&ctx, o, d, &s, CAMERA_CHAIN_BOUNCE, &mut counts) else {
                         return (None, Vec::new());
                     };

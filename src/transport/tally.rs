@@ -115,7 +115,11 @@ impl<'a> Tally<'a> {
     /// Batches left before the path cap.
     #[must_use]
     pub fn batches_left(&self) -> usize {
-        (self.cap - self.emitted.min(self.cap)).div_ceil(BATCH as u64) as usize
+        let end = match (self.steer, self.full_at) {
+            (true, Some(full)) => self.cap.min(STEERED_PATHS * full),
+            _ => self.cap,
+        };
+        (end - self.emitted.min(end)).div_ceil(BATCH as u64) as usize
     }
 
     /// Adds the next batch, paths `emitted()..emitted() + BATCH`: the photons its paths stored,
@@ -144,6 +148,10 @@ impl<'a> Tally<'a> {
                 self.emitted = path + 1;
                 break;
             }
+        }
+        if let (true, Some(full)) = (self.steered_out(self.emitted), self.full_at) {
+            // The paths past the bound stored nothing: the map's paths end at it.
+            self.emitted = self.emitted.min(STEERED_PATHS * full).max(start);
         }
         let kept = ((self.emitted - start) as usize).min(counts.len());
         for c in &counts[..kept] {
@@ -296,8 +304,9 @@ mod tests {
     /// marked cell; photons at x = 5 lie outside it). Paths 0..4 storing a read, an unread, a
     /// read and a read photon: 2 read stop emission at path 2, holding the unread one too.
     /// Paths 0..5 storing 2 unread, 1 read, 0, 2 (one read) and 1 read: the map held 2 photons
-    /// after path 0, so emission stops before path 2 · 1 = 2's successors are taken, at path 3,
-    /// with 1 read. Unsteered, the same cells only count: 2 stored photons stop at path 0.
+    /// after path 0, so emission ends at 2 · 1 paths, with 1 read (path 2 stored nothing, path
+    /// 3's photons are not taken). Unsteered, the same cells only count: 2 stored photons stop
+    /// at path 0.
     #[test]
     fn a_steered_target_counts_only_the_photons_read() {
         let at = |x: f32, path: u64| {
@@ -316,7 +325,7 @@ mod tests {
         let reached = [at(0.5, 0), at(5.0, 1), at(0.5, 2), at(0.5, 3)];
         assert_eq!(tally(&reached, true), (2, 3, 3, false));
         let bounded = [at(5.0, 0), at(5.0, 0), at(0.5, 1), at(5.0, 3), at(0.5, 3), at(0.5, 4)];
-        assert_eq!(tally(&bounded, true), (1, 3, 3, false));
+        assert_eq!(tally(&bounded, true), (1, 3, 2, false));
         assert_eq!(tally(&bounded, false), (0, 2, 1, false));
     }
 }
