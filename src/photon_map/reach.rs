@@ -69,12 +69,6 @@ impl ReadCells {
         }
     }
 
-    /// The cell width.
-    #[must_use]
-    pub fn width(&self) -> f32 {
-        1.0 / self.inv_width
-    }
-
     /// Marked keys (cells whole and fine layers, each side counted).
     #[must_use]
     pub fn len(&self) -> usize {
@@ -91,15 +85,14 @@ impl ReadCells {
     /// query reads).
     pub fn mark(&mut self, p: Vec3, normal: Vec3) {
         let Some(fine) = self.fine(p) else { return };
-        let sides: Vec<u64> = (0..6u64).filter(|&side| lean(normal, side) >= SIDE_LEAN).collect();
-        let mask = sides.iter().fold(0u64, |m, s| m | 1 << s);
+        let mask = (0..6u64).filter(|&side| lean(normal, side) >= SIDE_LEAN).fold(0u64, |m, s| m | 1 << s);
         let slab = normal.abs().max_element() >= ALONG_AXIS;
         let c = fine.map(|f| f.div_euclid(LAYERS));
         let own = if slab { key(fine, 64 | mask, false) } else { key(c, mask, true) };
         if !self.seen.insert(own) {
             return;
         }
-        for side in sides {
+        for side in (0..6u64).filter(|s| mask >> s & 1 == 1) {
             let axis = (side / 2) as usize;
             for d in neighbours() {
                 let mut cell = [c[0] + d[0], c[1] + d[1], c[2] + d[2]];
@@ -170,10 +163,8 @@ pub struct PhotonGuide {
     pub global: MapGuide,
     /// The caustic map's.
     pub caustic: MapGuide,
-    /// What the pilot found, in a line for `--stats`.
+    /// What the pilot found and how long it took, in a line for `--stats`.
     pub summary: String,
-    /// Seconds the pilot took.
-    pub seconds: f64,
 }
 
 /// The component of `n` along signed axis `side` (0: +x, 1: −x, 2: +y, …).

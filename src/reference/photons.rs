@@ -1,6 +1,6 @@
 //! The oracle's photon pass: batches of photon paths, each traced one bounce at a time with
 //! the transport core's emission, deposit and scattering, until the map holds its target
-//! ([`Tally`]).
+//! ([`Tally`](crate::transport::tally::Tally)).
 
 use crate::job::Job;
 use crate::parallel::map_chunks;
@@ -9,21 +9,18 @@ use crate::rng::Domain;
 use crate::scene::Scene;
 pub use crate::transport::photon::trace_path;
 pub use crate::transport::photon::TracedPhotons;
-use crate::transport::photon::{Tally, BATCH};
+use crate::transport::photon::BATCH;
 
 /// Paths per work chunk inside a batch.
 const CHUNK: usize = 1024;
 
 /// Emits batches of paths until `target` photons are stored where the camera reads the map (any
-/// stored photon without the job's guide), or a cap is reached ([`Tally`]).
+/// stored photon without the job's guide), or a cap is reached
+/// ([`Tally`](crate::transport::tally::Tally)).
 pub fn trace_photons(scene: &Scene, job: &Job, domain: Domain, target: u32, progress: &dyn Progress) -> TracedPhotons {
     let name = if domain == Domain::CausticPhoton { "caustic photons" } else { "global photons" };
     progress.start(name, u64::from(target));
-    let mut tally = Tally::reading(
-        target,
-        crate::transport::guide::cells(job, domain),
-        crate::transport::guide::steers(job, domain),
-    );
+    let mut tally = crate::transport::guide::tally(job, domain, target);
     let mut reported = 0u64;
     while tally.wants_more() {
         let first = tally.emitted();

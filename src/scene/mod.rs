@@ -221,18 +221,30 @@ impl Scene {
     /// emitter gets a material of its own, so each shape is one), every other light one.
     #[must_use]
     pub fn light_sources(&self) -> (usize, usize) {
-        let mut emitters: Vec<u32> = self
-            .lights
+        let sources = self.light_source_of().into_iter().max().map_or(0, |s| s + 1);
+        let triangles = self.lights.iter().filter(|l| matches!(l, Light::Area { .. })).count();
+        (sources, triangles)
+    }
+
+    /// Each light's source ([`Scene::light_sources`]), numbered in the order of the lights: the
+    /// emissive triangles of one material share theirs.
+    #[must_use]
+    pub fn light_source_of(&self) -> Vec<usize> {
+        let mut of_material = std::collections::HashMap::new();
+        let mut sources = 0;
+        self.lights
             .iter()
-            .filter_map(|l| match l {
-                Light::Area { tri, .. } => Some(self.material[*tri as usize]),
-                _ => None,
+            .map(|l| {
+                let mut next = || {
+                    sources += 1;
+                    sources - 1
+                };
+                match l {
+                    Light::Area { tri, .. } => *of_material.entry(self.material[*tri as usize]).or_insert_with(next),
+                    _ => next(),
+                }
             })
-            .collect();
-        let triangles = emitters.len();
-        emitters.sort_unstable();
-        emitters.dedup();
-        (emitters.len() + self.lights.len() - triangles, triangles)
+            .collect()
     }
 
     /// Whether any material the triangles use has an alpha cut-out.

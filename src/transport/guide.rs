@@ -27,6 +27,7 @@ use super::gather::trace_gather_rays;
 use super::photon::{photon_light, trace_path};
 use super::specular::{first_non_specular, Chain};
 use super::streams::{self, CAMERA_CHAIN_BOUNCE, JITTER_BOUNCE};
+use super::tally::Tally;
 use super::{Context, PhotonMaps};
 use crate::job::{Job, Pass};
 use crate::parallel::map_chunks;
@@ -84,6 +85,13 @@ pub fn steers_lights(job: &Job, domain: Domain) -> bool {
     job.settings.guide_photons && domain == Domain::GlobalPhoton
 }
 
+/// The tally of `domain`'s photon pass in `job` for `target` photons: reading the guide's cells,
+/// steered by them where [`steers`] says so.
+#[must_use]
+pub fn tally(job: &Job, domain: Domain, target: u32) -> Tally<'_> {
+    Tally::reading(target, cells(job, domain), steers(job, domain))
+}
+
 /// Runs the pilot of `job` with camera `rays` once (the passes of a progressive render share
 /// it); nothing for a job without photon maps. Returns the guide.
 pub fn ensure<'a>(scene: &Scene, rays: &CameraRays, job: &'a Job) -> Option<&'a PhotonGuide> {
@@ -104,7 +112,6 @@ fn pilot(scene: &Scene, rays: &CameraRays, job: &Job) -> PhotonGuide {
         global: MapGuide { cells: global, lights: None },
         caustic: MapGuide { cells: caustic, lights: None },
         summary: String::new(),
-        seconds: 0.0,
     };
     let mut said = Vec::new();
     for (domain, on, name) in [
@@ -124,8 +131,7 @@ fn pilot(scene: &Scene, rays: &CameraRays, job: &Job) -> PhotonGuide {
             said.push(format!("{name} photons from {shares}"));
         }
     }
-    guide.seconds = start.elapsed().as_secs_f64();
-    guide.summary = format!("{} ({:.2} s)", said.join("; "), guide.seconds);
+    guide.summary = format!("{} ({:.2} s)", said.join("; "), start.elapsed().as_secs_f64());
     guide
 }
 
@@ -208,38 +214,24 @@ fn camera_cells(scene: &Scene, rays: &CameraRays, pilot: &Job) -> (ReadCells, Re
     (global, caustic)
 }
 
-/// The light sources a user counts ([`Scene::light_sources`]): the emissive triangles of one
-/// material form one, every other light is its own. Returns each light's source and the
-/// sources' names.
+/// Each light's source ([`Scene::light_source_of`]) and the sources' names.
 fn light_sources(scene: &Scene) -> (Vec<usize>, Vec<String>) {
-    let (mut of_light, mut names, mut emitters) = (Vec::new(), Vec::new(), Vec::<(u32, usize)>::new());
-    for light in &scene.lights {
-        let source = match light {
+    let of_light = scene.light_source_of();
+    let mut names = Vec::new();
+    for (light, &source) in scene.lights.iter().zip(&of_light) {
+        if source < names.len() {
+            continue;
+        }
+        names.push(match light {
             Light::Area { tri, .. } => {
-                let material = scene.material[*tri as usize];
-                if let Some(&(_, g)) = emitters.iter().find(|(m, _)| *m == material) {
-                    g
-                } else {
-                    emitters.push((material, names.len()));
-                    names.push(format!("emitter '{}'", scene.materials[material as usize].name));
-                    names.len() - 1
-                }
+                format!("emitter '{}'", scene.materials[scene.material[*tri as usize] as usize].name)
             }
-            other => {
-                names.push(
-                    match other {
-                        Light::Point { .. } => "point light",
-                        Light::Spot { .. } => "spot light",
-                        Light::Directional { .. } => "directional light",
-                        Light::Sun { .. } => "sun",
-                        _ => "environment",
-                    }
-                    .to_string(),
-                );
-                names.len() - 1
-            }
-        };
-        of_light.push(source);
+            Light::Point { .. } => "point light".into(),
+            Light::Spot { .. } => "spot light".into(),
+            Light::Directional { .. } => "directional light".into(),
+            Light::Sun { .. } => "sun".into(),
+            Light::Environment => "environment".into(),
+        });
     }
     (of_light, names)
 }
@@ -262,8 +254,9 @@ fn light_choice(scene: &Scene, pilot: &Job, domain: Domain, cells: &ReadCells) -
                 .map(|i| {
                     out.clear();
                     trace_path(scene, pilot, domain, i as u64, &mut out);
+                    let light = photon_light(scene, pilot, domain, &Sampler::new(pilot.pass.seed, domain, i as u64)).0;
                     let read = out.iter().filter(|p| cells.reads(p.position, p.normal));
-                    (photon_light(scene, pilot, domain, i as u64).0, read.map(|p| f64::from(luminance(p.power))).sum())
+                    (light, read.map(|p| f64::from(luminance(p.power))).sum())
                 })
                 .collect::<Vec<(usize, f64)>>()
         },

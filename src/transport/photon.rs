@@ -101,11 +101,12 @@ pub fn photon_lights<'a>(scene: &'a Scene, job: &'a Job, domain: Domain) -> &'a 
     guide.and_then(|g| g.lights.as_ref()).unwrap_or(&scene.light_power)
 }
 
-/// The light that photon path `index` of `domain` leaves from in `job`, and its probability.
+/// The light that the photon path of `domain` with random stream `s` (its path's) leaves from
+/// in `job`, and its probability.
 #[must_use]
-pub fn photon_light(scene: &Scene, job: &Job, domain: Domain, index: u64) -> (usize, f32) {
+pub fn photon_light(scene: &Scene, job: &Job, domain: Domain, s: &Sampler) -> (usize, f32) {
     let lights = photon_lights(scene, job, domain);
-    let li = lights.sample(Sampler::new(job.pass.seed, domain, index).get(0, 0));
+    let li = lights.sample(s.get(0, 0));
     (li, lights.pmf(li) as f32)
 }
 
@@ -115,7 +116,7 @@ pub fn photon_light(scene: &Scene, job: &Job, domain: Domain, index: u64) -> (us
 #[must_use]
 pub fn start_photon(scene: &Scene, job: &Job, domain: Domain, index: u64) -> Start {
     let s = Sampler::new(job.pass.seed, domain, index);
-    let (li, pmf) = photon_light(scene, job, domain, index);
+    let (li, pmf) = photon_light(scene, job, domain, &s);
     let aim = job.settings.aim_caustics;
     let light = &scene.lights[li];
     let tri = scene.light_triangle(light);

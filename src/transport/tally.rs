@@ -133,8 +133,7 @@ impl<'a> Tally<'a> {
         for (path, photon) in stored {
             debug_assert!((start..end).contains(&path), "path {path} is not in this batch");
             if self.steered_out(path) {
-                // Steered past its bound: the paths before this one are the map's.
-                self.emitted = path;
+                // Steered past its bound: ended below, at the bound.
                 break;
             }
             self.photons.push(photon);

@@ -1,6 +1,7 @@
 //! The wavefront photon pass: for each map the plan wants, waves of photon paths run through
-//! the photon schedule, and the transport core's [`Tally`] applied batch by batch, so the maps
-//! hold exactly the photons of the oracle's pass; then the maps are built.
+//! the photon schedule, and the transport core's tally
+//! ([`Tally`](crate::transport::tally::Tally)) applied batch by batch, so the maps hold exactly
+//! the photons of the oracle's pass; then the maps are built.
 //!
 //! A wave's batches are cut into pieces of up to [`PIECE`] paths, and each worker traces the pieces it
 //! takes through the whole photon schedule on its own world, one thread per piece, as the
@@ -19,7 +20,7 @@ use crate::progress::Progress;
 use crate::rng::Domain;
 use crate::scene::Scene;
 use crate::stats::RenderStats;
-use crate::transport::photon::{power_max_over_median, PathCounts, Tally, BATCH};
+use crate::transport::photon::{power_max_over_median, PathCounts, BATCH};
 use crate::transport::PhotonMaps;
 use std::sync::Arc;
 use std::time::Instant;
@@ -116,11 +117,7 @@ pub fn photon_pass(
         let t = Instant::now();
         let name = if domain == Domain::CausticPhoton { "caustic photons" } else { "global photons" };
         progress.start(name, u64::from(target));
-        let mut tally = Tally::reading(
-            target,
-            crate::transport::guide::cells(job, domain),
-            crate::transport::guide::steers(job, domain),
-        );
+        let mut tally = crate::transport::guide::tally(job, domain, target);
         let mut reported = 0u64;
         // A wave holds several batches — enough pieces to keep every worker busy — sized from
         // the photons per batch seen so far. The tally is then fed batch by batch, so the
