@@ -105,3 +105,24 @@ fn non_finite_pixels_are_refused_with_their_layer() {
     let e = compare_files(&a, &b).unwrap_err().to_string();
     assert!(e.contains("a.exr") && e.contains("`beauty`") && e.contains("1 of 2 pixels"), "{e}");
 }
+
+#[test]
+fn a_larger_reference_is_box_filtered_and_blocks_and_speckle_are_reported() {
+    let d = scratch_dir("compare-reduced");
+    let (a, b, odd) = (d.join("a.exr"), d.join("b.exr"), d.join("odd.exr"));
+    // Reference 4×2; each 2×2 square averages to the image's pixel (0.5 and 1.0 grey).
+    let grey = |v: f32| Terms { direct: Vec3::splat(v), ..Default::default() };
+    let reference = [0.4, 0.6, 0.9, 1.1, 0.6, 0.4, 1.1, 0.9].map(grey);
+    Film::new(4, 2, reference.to_vec()).write_exr(&b).unwrap();
+    film([Vec3::splat(0.5), Vec3::ONE], [Vec3::ZERO; 2]).write_exr(&a).unwrap();
+    let c = compare_files(&a, &b).unwrap();
+    assert_eq!(c.reference_reduced, 2);
+    assert!(c.layers.iter().all(|l| l.rmse < 1e-6), "{:?}", c.layers);
+    // One block (the image is smaller than 32 pixels), exact; no speckle in either.
+    assert_eq!((c.blocks.columns, c.blocks.rows, c.blocks.measured), (1, 1, 1));
+    assert!(c.blocks.worst.abs() < 1e-6 && c.speckle == 0.0 && c.reference_speckle == 0.0, "{c:?}");
+    // 3×2 is not a whole multiple of 2×1: refused, naming both sizes.
+    Film::new(3, 2, vec![Terms::default(); 6]).write_exr(&odd).unwrap();
+    let e = compare_files(&a, &odd).unwrap_err().to_string();
+    assert!(e.contains("2×1") && e.contains("3×2") && e.contains("multiple"), "{e}");
+}

@@ -1,8 +1,10 @@
 //! How far an image is from a reference: RMSE, relative MSE and the ratio of means, for the
-//! beauty image and for each Jensen term layer present in both files.
+//! beauty image and for each Jensen term layer present in both files; for the beauty image also
+//! the error of its blocks' means and its share of speckled pixels ([`super::local`]).
 
 use crate::error::{Error, Result};
 use crate::film::{read_exr, ExrLayers};
+use crate::tools::local::{block_errors, box_reduce, speckle_fraction, BlockErrors};
 use glam::Vec3;
 use serde::Serialize;
 use std::path::Path;
@@ -79,9 +81,21 @@ pub struct Comparison {
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
+    /// The reference was this many times larger in both axes and was box-filtered down to the
+    /// image's size (1: same size).
+    pub reference_reduced: u32,
     /// Beauty first, then each term layer present in both files.
     pub layers: Vec<LayerError>,
+    /// The beauty image's block-mean errors.
+    pub blocks: BlockErrors,
+    /// The share of the beauty image's pixels that are speckled ([`speckle_fraction`]).
+    pub speckle: f64,
+    /// The same share in the reference (at the image's size): the floor its own noise sets.
+    pub reference_speckle: f64,
 }
+
+/// The default block side of `compare`'s block errors, in pixels.
+pub const BLOCK: u32 = 32;
 
 /// Reads every RGB layer of the EXR at `path`, refusing NaN or infinite pixels with the layer's
 /// name and count.
@@ -101,17 +115,27 @@ pub fn read_finite_exr(path: &Path) -> Result<ExrLayers> {
     Ok(img)
 }
 
-/// Compares the EXR at `image` with the reference EXR at `reference`: both must have the same
-/// size and finite values; layers present in only one file are skipped.
+/// Compares the EXR at `image` with the reference EXR at `reference` in blocks of [`BLOCK`]
+/// pixels ([`compare_files_in_blocks`]).
 pub fn compare_files(image: &Path, reference: &Path) -> Result<Comparison> {
+    compare_files_in_blocks(image, reference, BLOCK)
+}
+
+/// Compares the EXR at `image` with the reference EXR at `reference`: both must be finite and of
+/// the same size, or the reference an integer multiple of the image's size in both axes (then
+/// box-filtered down to it); layers present in only one file are skipped. Block errors are over
+/// blocks of about `block`×`block` pixels.
+pub fn compare_files_in_blocks(image: &Path, reference: &Path, block: u32) -> Result<Comparison> {
     let a = read_finite_exr(image)?;
-    let b = read_finite_exr(reference)?;
-    if (a.width, a.height) != (b.width, b.height) {
+    let mut b = read_finite_exr(reference)?;
+    let k = b.width.checked_div(a.width).unwrap_or(0);
+    let reduced = k >= 1 && b.width == k * a.width && b.height == k * a.height;
+    if !reduced {
         return Err(Error::parse(
             image,
             0,
             format!(
-                "is {}×{} but the reference {} is {}×{}",
+                "is {}×{} but the reference {} is {}×{} (it must be the same size or a whole multiple of it)",
                 a.width,
                 a.height,
                 reference.display(),
@@ -120,16 +144,32 @@ pub fn compare_files(image: &Path, reference: &Path) -> Result<Comparison> {
             ),
         ));
     }
+    if k > 1 {
+        for (_, pixels) in &mut b.layers {
+            *pixels = box_reduce(pixels, b.width, b.height, k).expect("sides divide by k");
+        }
+    }
     let layers = layer_errors(&a.layers, &b.layers);
     if layers.is_empty() {
         return Err(Error::parse(image, 0, format!("shares no RGB layer with {}", reference.display())));
     }
+    let beauty = |l: &ExrLayers| l.layers.iter().find(|(n, _)| n.is_empty()).map(|(_, p)| p.clone());
+    let (pa, pb) = match (beauty(&a), beauty(&b)) {
+        (Some(pa), Some(pb)) => (pa, pb),
+        _ => {
+            return Err(Error::parse(image, 0, format!("it or {} has no beauty image (R, G, B)", reference.display())))
+        }
+    };
     Ok(Comparison {
         image: image.display().to_string(),
         reference: reference.display().to_string(),
         width: a.width,
         height: a.height,
+        reference_reduced: k,
         layers,
+        blocks: block_errors(&pa, &pb, a.width, a.height, block),
+        speckle: speckle_fraction(&pa, a.width, a.height),
+        reference_speckle: speckle_fraction(&pb, a.width, a.height),
     })
 }
 
@@ -172,6 +212,28 @@ impl Comparison {
                 sci(l.reference_mean)
             );
         }
+        if self.reference_reduced > 1 {
+            s += &format!("the reference box-filtered down {}× to the image's size\n", self.reference_reduced);
+        }
+        let b = &self.blocks;
+        s += &format!(
+            "blocks of ~{0}×{0} ({1}×{2}): {3} measured, {4} dark; worst {5:+.2} % at ({6}, {7}), RMS {8:.2} %, {9} over 3 %\n",
+            b.size,
+            b.columns,
+            b.rows,
+            b.measured,
+            b.dark,
+            100.0 * b.worst,
+            b.worst_at.0,
+            b.worst_at.1,
+            100.0 * b.rms,
+            b.over_3_percent
+        );
+        s += &format!(
+            "speckled pixels: {:.2} % (the reference: {:.2} %)\n",
+            100.0 * self.speckle,
+            100.0 * self.reference_speckle
+        );
         s
     }
 }
