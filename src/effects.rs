@@ -95,7 +95,18 @@ impl Effects {
             ),
         };
         let thin_glass = thin_glass_part(scene);
-        Effects { caustic_map, global_map, final_gather, refraction, shadow_rays, absorption, cut_outs, thin_glass }
+        let media = media_part(scene);
+        Effects {
+            caustic_map,
+            global_map,
+            final_gather,
+            refraction,
+            shadow_rays,
+            absorption,
+            cut_outs,
+            thin_glass,
+            media,
+        }
     }
 }
 
@@ -123,5 +134,27 @@ fn thin_glass_part(scene: &Scene) -> Part {
                 plural(n)
             ),
         ),
+    }
+}
+
+/// The plan's `media` line: on for a scene-filling medium, saying what it does to the rays.
+fn media_part(scene: &Scene) -> Part {
+    match &scene.medium {
+        None => Part::new(false, "no participating medium"),
+        Some(m) if !m.scatters() => Part::new(
+            true,
+            "the scene is filled with a purely absorbing medium: every ray keeps exp(−σ_a·d) (path tracer only)",
+        ),
+        Some(m) => {
+            let a = m.albedo();
+            Part::new(
+                true,
+                format!(
+                    "the scene is filled with a scattering medium (albedo {:.2}/{:.2}/{:.2}, g {}): free-flight \
+                     sampling, in-scattered light by light sampling and the phase function (path tracer only)",
+                    a.x, a.y, a.z, m.g
+                ),
+            )
+        }
     }
 }

@@ -66,11 +66,18 @@ pub fn render(
 
 /// Refuses what `job` cannot render with `engine` (progressively or not): a map the plan needs
 /// left empty, more memory than the machine has (before any of it is allocated), diagnostics
-/// from the path tracer.
+/// from the path tracer, a participating medium in a photon-mapping engine.
 pub fn check_planned(job: &Job, scene: &Scene, engine: Engine, progressive: bool) -> Result<()> {
     let settings = &job.settings;
     if engine != Engine::Path {
         job.plan.check(settings)?;
+        if scene.medium.is_some() {
+            return Err(Error::setting(
+                "--engine",
+                "the scene has a participating medium ([medium]): the photon-mapping engines do not render media \
+                 yet (no volume photon map); render it with `--engine path`",
+            ));
+        }
     }
     // Refuse what would exhaust memory before any of it is allocated.
     if let Some((available, total)) = crate::memory::machine() {

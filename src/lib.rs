@@ -26,6 +26,8 @@
 //! - [`microfacet`]: GGX rough conductors, dielectrics and Mitsuba's rough plastic with its coat
 //!   tables (eval, pdf, visible-normal sampling);
 //! - [`material`]: BSDFs (Lambert, glossy Phong, mirror, glass, thin glass, the rough ones) and their textures;
+//! - [`medium`]: homogeneous participating media — transmittance, free-flight sampling, the
+//!   Henyey–Greenstein phase function;
 //! - [`photon_map`]: the 20-byte photon, the 8-wide photon tree, k-NN and fixed-radius density estimates;
 //! - [`settings`]: the user's knobs, their layering and validation;
 //! - [`scene`]: the scene model — triangles in BVH order, materials, lights (area, point, spot,
@@ -80,6 +82,7 @@ pub mod fuzzing;
 pub mod geometry;
 pub mod job;
 pub mod material;
+pub mod medium;
 pub mod memory;
 pub mod microfacet;
 pub mod optics;

@@ -10,10 +10,18 @@
 //! at a non-specular first hit), `specular` (everything seen when the first hit is a mirror or
 //! glass), `indirect` (everything else; the photon mapper splits it into caustic, indirect and the
 //! glossy lobe's share of specular).
+//!
+//! In a scene filled with a participating medium ([`crate::medium`]) each segment samples its
+//! first interaction by free flight: where it scatters, the medium point takes light by light
+//! sampling through the phase function ([`crate::transport::media`], weighted by MIS against
+//! the phase-function sample that continues the path); shadow rays carry the medium's
+//! transmittance. Light scattered at the camera's first vertex counts as `direct`, later as
+//! `indirect` (there is no `volume` layer yet).
 
 use crate::error::Result;
 use crate::film::{Film, Term, Terms};
 use crate::job::Job;
+use crate::medium::FreeFlight;
 use crate::progress::Progress;
 use crate::rng::Sampler;
 use crate::scene::camera::CameraRays;
@@ -22,6 +30,7 @@ use crate::settings::Settings;
 use crate::stats::{MapStats, Numerics, PhaseTimes, RayCounts, RenderStats};
 use crate::transport::camera::render_pixels;
 use crate::transport::direct::weighted_direct_light;
+use crate::transport::media::{attenuated_direct_light, in_scattered_light, medium_receiver};
 use crate::transport::mis::{emission_found, receiver, sky_found, Strategies};
 use crate::transport::specular::{continue_ray, emission_toward};
 use crate::transport::{streams, Context, PhotonMaps};
@@ -100,8 +109,44 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
     let mis = if ctx.settings.mis { Strategies::Whole } else { Strategies::LightOnly };
     for depth in 0..=ctx.settings.max_depth {
         rays.camera += 1;
-        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else {
-            // The environment and the sun, counted where light sampling does not (as emitters);
+        let found = scene.intersect(o, d, f32::INFINITY);
+        if let Some(medium) = &scene.medium {
+            // Free flight along this segment: bounce `depth`, dims 4–5.
+            let length = found.map_or(f32::INFINITY, |h| h.t * d.length());
+            match medium.free_flight(length, s.get(depth, 4), s.get(depth, 5)) {
+                FreeFlight::Pass { weight } => beta *= weight,
+                FreeFlight::Scatter { distance, weight } => {
+                    beta *= weight;
+                    let dir = d.normalize();
+                    let p = o + dir * distance;
+                    if depth == ctx.settings.max_depth || beta == Vec3::ZERO {
+                        break;
+                    }
+                    let light_stream = s.fork(streams::path_light(depth));
+                    let l = in_scattered_light(ctx, medium, p, dir, &light_stream, ctx.settings.mis, rays);
+                    terms.add(path_term(Term::Direct, depth, via_specular), beta * l);
+                    // The phase-function sample continues the path: bounce depth + 1, dims 0–1.
+                    let phase = medium.phase();
+                    let next = phase.sample(dir, [s.get(depth + 1, 0), s.get(depth + 1, 1)]);
+                    last_delta = false;
+                    if ctx.settings.mis {
+                        bsdf_density = phase.eval(dir, next);
+                        from = medium_receiver(p, dir);
+                    }
+                    if depth >= RR_DEPTH {
+                        let q = beta.max_element().min(0.95);
+                        if !(q > 0.0) || s.get(depth + 1, 3) >= q {
+                            break;
+                        }
+                        beta /= q;
+                    }
+                    (o, d) = (p, next);
+                    continue;
+                }
+            }
+        }
+        let Some(hit) = found else {
+            // The environment and the suns, counted where light sampling does not (as emitters);
             // after a BSDF sample, the environment weighed against light sampling.
             if last_delta && scene.has_background() {
                 terms.add(path_term(Term::Emitted, depth, via_specular), beta * scene.background(d));
@@ -129,8 +174,12 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
             break;
         }
         if !bsdf.is_delta() {
-            let l = beta * weighted_direct_light(ctx, &sp, &bsdf, wo, &s.fork(streams::path_light(depth)), &mis, rays);
-            terms.add(path_term(Term::Direct, depth, via_specular), l);
+            let light_stream = s.fork(streams::path_light(depth));
+            let l = match &scene.medium {
+                None => weighted_direct_light(ctx, &sp, &bsdf, wo, &light_stream, &mis, rays),
+                Some(m) => attenuated_direct_light(ctx, m, &sp, &bsdf, wo, &light_stream, &mis, rays),
+            };
+            terms.add(path_term(Term::Direct, depth, via_specular), beta * l);
         }
         let Some(bs) = continue_ray(&sp, &bsdf, wo, s, streams::CAMERA_CHAIN_BOUNCE + depth) else { break };
         beta *= bs.weight;

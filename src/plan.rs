@@ -52,6 +52,10 @@ pub struct Effects {
     /// as off).
     #[serde(default = "Part::not_recorded")]
     pub thin_glass: Part,
+    /// A participating medium: free-flight sampling, in-scattering by light sampling and the
+    /// phase function (absent from plans written before it existed: read as off).
+    #[serde(default = "Part::not_recorded")]
+    pub media: Part,
 }
 
 impl Effects {
@@ -86,6 +90,7 @@ impl Effects {
             line("absorption", &self.absorption),
             line("cut-outs", &self.cut_outs),
             line("thin glass", &self.thin_glass),
+            line("media", &self.media),
         ]
         .concat()
     }

@@ -144,6 +144,7 @@ impl Scene {
             open_edges: open_edges::OpenEdges::default(),
             caustic_targets: Vec::new(),
             load_times,
+            medium: None,
         };
         scene.find_kinds();
         // Placing the triangles in BVH order (and listing the emitting ones) counts with them.

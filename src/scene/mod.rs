@@ -171,6 +171,9 @@ pub struct Scene {
     pub caustic_targets: Vec<targets::Target>,
     /// Where loading it spent its time.
     pub load_times: LoadTimes,
+    /// A participating medium filling the whole scene (the TOML file's `[medium]`), or none:
+    /// rendered by the path tracer only so far ([`crate::medium`]).
+    pub medium: Option<crate::medium::Medium>,
     bvh: Bvh,
     /// (any passed on as specular by photons, any glass, any non-delta, any absorbing interior,
     /// any normal map, any cut-out, any thin sheet passed in traversal) material on a triangle,

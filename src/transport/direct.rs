@@ -11,8 +11,8 @@ use super::Context;
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::Bsdf;
 use crate::rng::Sampler;
-use crate::scene::light::Light;
-use crate::scene::SurfacePoint;
+use crate::scene::light::{Incident, Light};
+use crate::scene::{Receiver, SurfacePoint};
 use crate::stats::RayCounts;
 use glam::Vec3;
 
@@ -32,10 +32,80 @@ pub struct ShadowRay {
     pub contribution: Vec3,
 }
 
+/// Light sampling at receiver `r`: every delta light once, then (unless `delta_only`)
+/// `light_samples` area-light samples, each light chosen by
+/// [`crate::scene::Scene::choose_light`] from the sub-stream `s` (sample `j`: dim 0 the light,
+/// dims 1–2 the point on it). `visit` gets each sample's light index, the incident light and
+/// its weight 1/(pmf · samples) (1 for a delta light). Lights that send nothing toward `r.p`
+/// (back faces, outside a spot cone) are skipped.
+pub fn light_samples(
+    ctx: &Context,
+    r: &Receiver,
+    s: &Sampler,
+    delta_only: bool,
+    mut visit: impl FnMut(u32, &Incident, f32),
+) {
+    let scene = ctx.scene;
+    let mut add = |light_index: u32, u: [f32; 2], weight: f32| {
+        let light = &scene.lights[light_index as usize];
+        if let Some(inc) = scene.sample_incident(light, r.p, r.n, u) {
+            visit(light_index, &inc, weight);
+        }
+    };
+    for &li in &scene.delta_lights {
+        add(li, [0.5, 0.5], 1.0);
+    }
+    if delta_only {
+        return;
+    }
+    let n = ctx.settings.light_samples;
+    for j in 0..n {
+        if let Some((light, pmf)) = scene.choose_light(ctx.settings.light_sampler, r, s.get(j, 0)) {
+            add(light, [s.get(j, 1), s.get(j, 2)], 1.0 / (pmf * n as f32));
+        }
+    }
+}
+
+/// The density with which light sampling at `r` drew `inc` from light `light_index`, where a
+/// BSDF or phase-function sample can find the same light ([`super::mis`]): an emissive
+/// triangle weighed by MIS, the environment, a sun; `None` (unweighted) otherwise or for
+/// [`Strategies::LightOnly`].
+#[must_use]
+pub fn light_sample_density(
+    ctx: &Context,
+    r: &Receiver,
+    mis: &Strategies,
+    light_index: u32,
+    inc: &Incident,
+) -> Option<f32> {
+    match (mis, &ctx.scene.lights[light_index as usize]) {
+        (Strategies::LightOnly, _) => None,
+        (_, Light::Area { tri, .. }) => {
+            weighed_light(ctx.scene, *tri).map(|k| light_density(ctx, r, k, *tri, inc.distance, inc.wi))
+        }
+        (_, Light::Environment) => Some(environment_density(ctx, r, inc.wi)),
+        (_, Light::Sun { .. }) => Some(sun_density(ctx, r, light_index)),
+        _ => None,
+    }
+}
+
+/// The direction (not unit for a light point, which lies at t = 1) and the t_max of a shadow
+/// ray from `origin` to the light sample `inc`.
+#[must_use]
+pub fn shadow_segment(origin: Vec3, inc: &Incident) -> (Vec3, f32) {
+    match inc.point {
+        // The light point moved off its emitter toward the shading point, out of its error
+        // box, as the origin is off the surface (pbrt-v4's spawn-ray-to between two surface
+        // points).
+        Some((q, n)) => (offset_ray_origin(q, inc.point_error, n, -inc.wi) - origin, 1.0 - SHADOW_SHORTEN),
+        None => (inc.wi, f32::INFINITY),
+    }
+}
+
 /// The shadow rays of direct light at `sp` toward `wo`: every delta light once, then (unless
-/// `delta_only`) `light_samples` area-light samples ([`crate::scene::Scene::choose_light`]), an emissive triangle's
-/// weighted by MIS against `mis`. Lights that cannot contribute (behind the surface, back
-/// faces, outside a spot cone) get no ray.
+/// `delta_only`) `light_samples` area-light samples ([`light_samples`]), an emissive
+/// triangle's weighted by MIS against `mis`. Lights that cannot contribute (behind the surface,
+/// back faces, outside a spot cone) get no ray.
 #[allow(clippy::too_many_arguments)]
 pub fn direct_light_rays(
     ctx: &Context,
@@ -47,24 +117,12 @@ pub fn direct_light_rays(
     mis: &Strategies,
     mut emit: impl FnMut(ShadowRay),
 ) {
-    let scene = ctx.scene;
     // The point, its shading normal on wo's side, and whether it takes light from behind.
     let r = receiver(sp, bsdf, wo);
     let ns = r.n;
-    let mut add = |light_index: u32, u: [f32; 2], weight: f32| {
-        let light = &scene.lights[light_index as usize];
-        let Some(inc) = scene.sample_incident(light, sp.p, ns, u) else { return };
+    light_samples(ctx, &r, s, delta_only, |light_index, inc, weight| {
         // The density of the light sample where a BSDF ray can find the same light.
-        let density = match (mis, light) {
-            (Strategies::LightOnly, _) => None,
-            (_, Light::Area { tri, .. }) => {
-                weighed_light(scene, *tri).map(|k| light_density(ctx, &r, k, *tri, inc.distance, inc.wi))
-            }
-            (_, Light::Environment) => Some(environment_density(ctx, &r, inc.wi)),
-            (_, Light::Sun { .. }) => Some(sun_density(ctx, &r, light_index)),
-            _ => None,
-        };
-        let f = match density {
+        let f = match light_sample_density(ctx, &r, mis, light_index, inc) {
             Some(density) => mis.weighted_f(sp, bsdf, wo, inc.wi, density),
             None => bsdf.eval(&sp.frame, wo, inc.wi),
         };
@@ -79,27 +137,9 @@ pub fn direct_light_rays(
             return;
         }
         let origin = offset_ray_origin(sp.p, sp.p_error, sp.frame.ng, inc.wi);
-        let (direction, t_max) = match inc.point {
-            // The light point moved off its emitter toward the shading point, out of its error
-            // box, as the origin is off the surface (pbrt-v4's spawn-ray-to between two
-            // surface points).
-            Some((q, n)) => (offset_ray_origin(q, inc.point_error, n, -inc.wi) - origin, 1.0 - SHADOW_SHORTEN),
-            None => (inc.wi, f32::INFINITY),
-        };
+        let (direction, t_max) = shadow_segment(origin, inc);
         emit(ShadowRay { origin, direction, t_max, contribution: f * inc.value * (cos * weight) });
-    };
-    for &li in &scene.delta_lights {
-        add(li, [0.5, 0.5], 1.0);
-    }
-    if delta_only {
-        return;
-    }
-    let n = ctx.settings.light_samples;
-    for j in 0..n {
-        if let Some((light, pmf)) = scene.choose_light(ctx.settings.light_sampler, &r, s.get(j, 0)) {
-            add(light, [s.get(j, 1), s.get(j, 2)], 1.0 / (pmf * n as f32));
-        }
-    }
+    });
 }
 
 /// Direct light at `sp` toward `wo` by light sampling alone: the unblocked shadow rays'

@@ -8,6 +8,8 @@
 //! - [`photon`]: photon emission, deposit, scattering and the exact-count emission tally;
 //! - [`direct`]: direct light by light sampling (shadow rays);
 //! - [`mis`]: multiple importance sampling of emitters, light samples against BSDF samples;
+//! - [`media`]: light in a scene-filling medium (shadow-ray transmittance, in-scattering), for
+//!   the path tracer;
 //! - [`gather`]: final-gather and glossy ray generation, and where the secondary gather applies;
 //! - [`estimate`]: photon-map density estimates at a surface point;
 //! - [`lobe`]: where gather and glossy rays land on a narrow lobe, its own ray;
@@ -26,6 +28,7 @@ pub mod gather;
 pub mod guide;
 pub mod lobe;
 pub mod maps;
+pub mod media;
 pub mod mis;
 pub mod photon;
 pub mod specular;

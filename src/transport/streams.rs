@@ -25,7 +25,11 @@
 //! dim 0 picks the light, dims 1–4 sample its emission; bounce `b + 1` dims 0–2 sample the BSDF
 //! at the `b`-th hit and dim 3 decides Russian roulette.
 //!
-//! The path tracer's direct light at depth `d` forks [`path_light`]`(d)`.
+//! The path tracer's direct light at depth `d` forks [`path_light`]`(d)`. In a medium, the
+//! free flight of the path tracer's segment `d` (the camera ray is segment 0) draws bounce `d`
+//! dims 4–5 (the channel, the distance); where it scatters, the phase-function sample that
+//! continues the path draws bounce `d + 1` dims 0–1, and its in-scattered light forks
+//! [`path_light`]`(d)`.
 
 /// Tags of the per-hit sub-streams of a camera path (added to the hit's depth).
 const GATHER: u64 = 1 << 32;

@@ -29,6 +29,11 @@
 //! scale = 1.0
 //! rotation = 0                  # degrees about +y
 //!
+//! [medium]                      # a participating medium filling the scene (path tracer only)
+//! sigma_a = [0.01, 0.01, 0.01]  # absorption per scene unit, and
+//! sigma_s = [0.1, 0.1, 0.1]     # scattering per scene unit; or albedo = [..] and density = ..
+//! g = 0.0                       # Henyey–Greenstein asymmetry in (−1, 1)
+//!
 //! [[portal]]                    # where the environment's light enters (a window); optional
 //! corners = [[-1, 1, -2], [1, 1, -2], [1, 2, -2], [-1, 2, -2]]   # in order around it
 //!
@@ -76,8 +81,51 @@ struct SceneFile {
     environment: Option<EnvironmentEntry>,
     #[serde(default)]
     portal: Vec<PortalEntry>,
+    medium: Option<MediumEntry>,
     #[serde(default)]
     render: Option<Settings>,
+}
+
+/// `[medium]`: a homogeneous medium filling the scene, by its coefficients (`sigma_a`,
+/// `sigma_s`) or by `albedo` and `density` (σ_s = albedo·density, σ_a = density − σ_s), with
+/// the Henyey–Greenstein `g`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct MediumEntry {
+    sigma_a: Option<[f32; 3]>,
+    sigma_s: Option<[f32; 3]>,
+    albedo: Option<[f32; 3]>,
+    density: Option<f32>,
+    #[serde(default)]
+    g: f32,
+}
+
+impl MediumEntry {
+    fn to_medium(&self) -> Result<crate::medium::Medium> {
+        let (sigma_a, sigma_s) = match (self.sigma_a, self.sigma_s, self.albedo, self.density) {
+            (a, s, None, None) if a.is_some() || s.is_some() => {
+                (colour("medium.sigma_a", a.unwrap_or([0.0; 3]))?, colour("medium.sigma_s", s.unwrap_or([0.0; 3]))?)
+            }
+            (None, None, Some(albedo), Some(density)) => {
+                let albedo = colour("medium.albedo", albedo)?;
+                if albedo.max_element() > 1.0 {
+                    return Err(Error::setting("medium.albedo", "must lie in [0, 1] in each channel"));
+                }
+                if !(density >= 0.0 && density.is_finite()) {
+                    return Err(Error::setting("medium.density", "must be a finite number ≥ 0 (σ_t per scene unit)"));
+                }
+                (Vec3::splat(density) * (Vec3::ONE - albedo), Vec3::splat(density) * albedo)
+            }
+            _ => {
+                return Err(Error::setting(
+                    "medium",
+                    "give `sigma_a` and/or `sigma_s` (per scene unit), or `albedo` and `density`, not a mix",
+                ))
+            }
+        };
+        let field = if self.g.abs() >= 1.0 || !self.g.is_finite() { "medium.g" } else { "medium" };
+        crate::medium::Medium::new(sigma_a, sigma_s, self.g).map_err(|e| Error::setting(field, e))
+    }
 }
 
 /// `[[portal]]`: a parallelogram (a window, a door) where the environment's light enters, its
@@ -327,6 +375,18 @@ pub fn load(path: &Path, added: AddedLights) -> Result<LoadedScene> {
             .collect::<Result<Vec<_>>>()?;
         environment = Some(env.with_portals(Portals::new(portals)));
     }
-    let scene = Scene::build_lit(meshes, table.materials, lights, environment, warnings)?;
+    let medium = file.medium.as_ref().map(MediumEntry::to_medium).transpose()?;
+    let mut scene = Scene::build_lit(meshes, table.materials, lights, environment, warnings)?;
+    if let Some(m) = medium {
+        let distant = scene.lights.iter().any(|l| matches!(l, Light::Sun { .. } | Light::Directional { .. }));
+        if scene.environment.is_some() || distant {
+            scene.warnings.push(
+                "the [medium] fills all space, so the light of the environment, suns and directional lights, which \
+                 comes from infinitely far, is extinguished in every channel whose σ_t is above 0"
+                    .to_string(),
+            );
+        }
+        scene.medium = Some(m);
+    }
     Ok(LoadedScene::framed(scene, camera, brought.cameras, settings, inputs))
 }

@@ -1,0 +1,180 @@
+//! A scene-filling participating medium (`[medium]`) in the path tracer, against analytic
+//! answers: an absorbing medium keeps exp(−σ_a·d) of an emitter's light; a furnace (a closed
+//! box whose walls all emit Le and reflect ρ) filled with a medium of albedo 1 stays at
+//! Le/(1 − ρ) everywhere, with MIS and without; single scattering from a point light equals its
+//! integral along the camera ray by quadrature. Bad media are errors naming the field, and the
+//! photon-mapping engines refuse a scene with a medium.
+
+mod common;
+
+use common::{mean_and_se, scratch_dir};
+use glam::Vec3;
+use photonwave::engine::{render, Engine};
+use photonwave::formats::{load_scene, LoadedScene};
+use photonwave::progress::NoProgress;
+use photonwave::settings::Settings;
+use std::path::Path;
+use std::sync::Arc;
+
+/// Writes `name`.toml in `dir` with `body` and the OBJ/MTL files in `files`, and loads it.
+fn scene(dir: &Path, name: &str, body: &str, files: &[(&str, &str)]) -> photonwave::error::Result<LoadedScene> {
+    for (file, text) in files {
+        std::fs::write(dir.join(file), text).unwrap();
+    }
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, body).unwrap();
+    load_scene(&path)
+}
+
+/// Path-traces `loaded` at `settings`' size.
+fn path_traced(loaded: &LoadedScene, settings: &Settings) -> photonwave::film::Film {
+    let rays = loaded.camera.unwrap().prepare(settings.width, settings.height).unwrap();
+    photonwave::path::render_path_traced(&loaded.scene, &rays, settings, &NoProgress).unwrap().0
+}
+
+/// A 40×40 emitter of radiance 1 at z = −2 facing +z.
+const EMITTER_OBJ: &str = "mtllib e.mtl\nv -20 -20 -2\nv 20 -20 -2\nv 20 20 -2\nv -20 20 -2\nusemtl light\nf 1 2 3 4\n";
+const EMITTER_MTL: &str = "newmtl light\nKd 0 0 0\nKe 1 1 1\n";
+
+#[test]
+fn an_absorbing_medium_keeps_exp_minus_sigma_d() {
+    // The camera at z = 2 looks at the emitter 4 away through a 2° field: every pixel ray's
+    // length is 4·sec θ ≤ 4 × 1.0002. With σ_s = 0 a path either passes (weight T/P, P the
+    // mean of the channels' T) or is absorbed (0): each pixel sample is unbiased for
+    // exp(−σ_a·L). Tolerance: 4 standard errors of the mean over the 8×8 pixels (each the
+    // mean of 64 samples), at each of 8 seeds; the sec θ spread (0.02 % of the exponent) is
+    // far below it.
+    let d = scratch_dir("media-absorbing");
+    let sigma = Vec3::new(0.25, 0.5, 1.0);
+    let body = "[[mesh]]\nfile = \"e.obj\"\n[camera]\neye = [0, 0, 2]\ntarget = [0, 0, -2]\nfov = 2\n\
+[medium]\nsigma_a = [0.25, 0.5, 1.0]\n";
+    let loaded = scene(&d, "absorbing", body, &[("e.obj", EMITTER_OBJ), ("e.mtl", EMITTER_MTL)]).unwrap();
+    let expected = (-sigma * 4.0).exp();
+    for seed in 1..9 {
+        let settings = Settings { width: 8, height: 8, spp: 64, seed, ..Settings::default() };
+        let film = path_traced(&loaded, &settings);
+        for c in 0..3 {
+            let values: Vec<f32> = film.beauty().iter().map(|p| p[c]).collect();
+            let (mean, se) = mean_and_se(&values);
+            let want = f64::from(expected[c]);
+            assert!((mean - want).abs() <= 4.0 * se, "seed {seed} channel {c}: {mean} ± {se}, exp(−σd) = {want}");
+            assert!(se < 0.1 * want, "seed {seed} channel {c}: the test has no power ({se} against {want})");
+        }
+    }
+}
+
+/// A closed cube [−1, 1]³ whose six walls face inward, reflect 0.5 and emit 1.
+fn furnace_files() -> [(&'static str, &'static str); 2] {
+    const OBJ: &str =
+        "mtllib f.mtl\nv -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+usemtl wall\nf 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n";
+    const MTL: &str = "newmtl wall\nKd 0.5 0.5 0.5\nKe 1 1 1\n";
+    [("f.obj", OBJ), ("f.mtl", MTL)]
+}
+
+#[test]
+fn a_furnace_filled_with_a_white_medium_stays_at_le_over_one_minus_rho() {
+    // Every wall emits Le = 1 and reflects ρ = 0.5 inward, so without a medium the radiance is
+    // Le/(1 − ρ) = 2 everywhere; a medium that only scatters (albedo 1) moves light between
+    // directions and keeps it at 2 (the radiative transfer equation's uniform solution). A
+    // forward-scattering phase function (g = 0.6) and σ_s = 1 (mean free path half the box)
+    // give several medium vertices per path. Tolerance: 4 standard errors over the 8×8 pixels,
+    // at each of 6 seeds, with MIS of lights against the phase function and BSDF and without.
+    // The cap of 64 vertices (roulette ends paths before it) drops under 0.5^20 of the light.
+    let d = scratch_dir("media-furnace");
+    let body = "[[mesh]]\nfile = \"f.obj\"\n[camera]\neye = [0, 0, 0.5]\ntarget = [0, 0, -1]\nfov = 70\n\
+[medium]\nalbedo = [1, 1, 1]\ndensity = 1.0\ng = 0.6\n";
+    let loaded = scene(&d, "furnace", body, &furnace_files()).unwrap();
+    assert!(loaded.scene.medium.is_some());
+    for mis in [true, false] {
+        for seed in 1..7 {
+            let settings = Settings { width: 8, height: 8, spp: 256, seed, mis, ..Settings::default() };
+            let film = path_traced(&loaded, &settings);
+            let values = common::grey(&film);
+            let (mean, se) = mean_and_se(&values);
+            eprintln!("furnace mis {mis} seed {seed}: {mean:.4} ± {se:.4}");
+            assert!((mean - 2.0).abs() <= 4.0 * se, "mis {mis} seed {seed}: {mean} ± {se}, want 2");
+            assert!(se < 0.03, "mis {mis} seed {seed}: the test has no power (SE {se})");
+        }
+    }
+}
+
+/// Single scattering along the ray from the origin down −z, from a point light of intensity
+/// `i` at `light`, in a medium (σ_s, σ_t, g): ∫ σ_s T(t) p(cos θ) I T(r)/r² dt by Simpson's
+/// rule over [0, 80] (T(80) = e^{−32}) in 400 000 steps.
+fn single_scattering(i: f64, light: [f64; 3], sigma_s: f64, sigma_t: f64, g: f64) -> f64 {
+    let n = 400_000;
+    let (a, b) = (0.0, 80.0);
+    let h = (b - a) / n as f64;
+    let f = |t: f64| {
+        let v = [light[0], light[1], light[2] + t];
+        let r2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        let r = r2.sqrt();
+        // The cosine between the camera ray's direction (0, 0, −1) and the way to the light.
+        let cos = -v[2] / r;
+        let p = (1.0 - g * g) / (4.0 * std::f64::consts::PI * (1.0 + g * g - 2.0 * g * cos).powf(1.5));
+        sigma_s * (-sigma_t * t).exp() * p * i * (-sigma_t * r).exp() / r2
+    };
+    let mut sum = f(a) + f(b);
+    for k in 1..n {
+        sum += f(a + k as f64 * h) * if k % 2 == 1 { 4.0 } else { 2.0 };
+    }
+    sum * h / 3.0
+}
+
+#[test]
+fn single_scattering_from_a_point_light_matches_quadrature() {
+    // max_depth = 1 keeps the light scattered once: the camera segment's medium vertex takes
+    // the point light through the phase function; the next segment's vertex is past the cap.
+    // One small black triangle far behind the camera is the scene's only geometry. The pixel
+    // is 0.05° wide, so its rays leave within 0.0004 rad of −z; the integral changes by far
+    // less than the tolerance over that. Tolerance: 4 standard errors of the mean of 16
+    // seeds' pixels (each 4 096 samples).
+    let d = scratch_dir("media-single");
+    let obj = "mtllib b.mtl\nv -0.1 0 50\nv 0.1 0 50\nv 0 0.1 50\nusemtl black\nf 1 2 3\n";
+    let mtl = "newmtl black\nKd 0 0 0\n";
+    let body = "[[mesh]]\nfile = \"b.obj\"\n[camera]\neye = [0, 0, 0]\ntarget = [0, 0, -1]\nfov = 0.05\n\
+[[light]]\ntype = \"point\"\nposition = [0, 1, -2]\nintensity = [10, 10, 10]\n\
+[medium]\nsigma_a = [0.1, 0.1, 0.1]\nsigma_s = [0.3, 0.3, 0.3]\ng = 0.5\n";
+    let loaded = scene(&d, "single", body, &[("b.obj", obj), ("b.mtl", mtl)]).unwrap();
+    let expected = single_scattering(10.0, [0.0, 1.0, -2.0], 0.3, 0.4, 0.5);
+    let values: Vec<f32> = (1..17)
+        .map(|seed| {
+            let settings = Settings { width: 1, height: 1, spp: 4096, max_depth: 1, seed, ..Settings::default() };
+            common::grey(&path_traced(&loaded, &settings))[0]
+        })
+        .collect();
+    let (mean, se) = mean_and_se(&values);
+    eprintln!("single scattering: {mean:.6} ± {se:.6}, quadrature {expected:.6}");
+    assert!((mean - expected).abs() <= 4.0 * se, "{mean} ± {se}, quadrature {expected}");
+    assert!(se < 0.02 * expected, "the test has no power (SE {se} against {expected})");
+}
+
+#[test]
+fn bad_media_are_named_and_photon_engines_refuse_media() {
+    let d = scratch_dir("media-bad");
+    let files = [("e.obj", EMITTER_OBJ), ("e.mtl", EMITTER_MTL)];
+    let head = "[[mesh]]\nfile = \"e.obj\"\n[camera]\neye = [0, 0, 2]\ntarget = [0, 0, -2]\n";
+    for (medium, field) in [
+        ("sigma_a = [-1, 0, 0]", "medium.sigma_a"),
+        ("sigma_s = [0, 1e40, 0]", "medium.sigma_s"),
+        ("sigma_s = [1, 1, 1]\ng = 1.0", "medium.g"),
+        ("albedo = [1.2, 1, 1]\ndensity = 1", "medium.albedo"),
+        ("albedo = [1, 1, 1]\ndensity = -2", "medium.density"),
+        ("albedo = [1, 1, 1]\nsigma_s = [1, 1, 1]", "medium"),
+        ("g = 0.3", "medium"),
+    ] {
+        let e = scene(&d, "bad", &format!("{head}[medium]\n{medium}\n"), &files).err().unwrap().to_string();
+        assert!(e.contains(field), "`{medium}`: {e}");
+    }
+    let loaded = scene(&d, "fog", &format!("{head}[medium]\nsigma_s = [0.1, 0.1, 0.1]\n"), &files).unwrap();
+    let rays = loaded.camera.unwrap().prepare(4, 4).unwrap();
+    let settings = Settings { width: 4, height: 4, ..Settings::default() };
+    let scene = Arc::new(loaded.scene);
+    for engine in [Engine::Reference, Engine::Wavefront] {
+        let e = render(&scene, &rays, &settings, engine, None, &NoProgress).err().unwrap().to_string();
+        assert!(e.contains("medium") && e.contains("--engine path"), "{e}");
+    }
+    let job = common::job(&scene, &settings);
+    assert!(job.plan.media.on && job.plan.media.reason.contains("scattering medium"), "{:?}", job.plan.media);
+}
