@@ -137,24 +137,37 @@ fn thin_glass_part(scene: &Scene) -> Part {
     }
 }
 
-/// The plan's `media` line: on for a scene-filling medium, saying what it does to the rays.
+/// The plan's `media` line: on for a scene-filling medium or a dielectric's scattering interior,
+/// saying what each engine does with it.
 fn media_part(scene: &Scene) -> Part {
-    match &scene.medium {
-        None => Part::new(false, "no participating medium"),
-        Some(m) if !m.scatters() => Part::new(
-            true,
-            "the scene is filled with a purely absorbing medium: every ray keeps exp(−σ_a·d) (path tracer only)",
+    let interiors = scene.materials.iter().filter(|m| m.interior_scattering.is_some()).count();
+    let inside = match interiors {
+        0 => String::new(),
+        n => format!(
+            "{n} dielectric{} enclose{} a scattering medium: the path tracer scatters in it, the photon-mapping \
+             engines only attenuate by its σ_t",
+            if n == 1 { "" } else { "s" },
+            if n == 1 { "s" } else { "" }
+        ),
+    };
+    let filling = match &scene.medium {
+        None => None,
+        Some(m) if !m.scatters() => Some(
+            "the scene is filled with a purely absorbing medium: every ray keeps exp(−σ_a·d) (path tracer only)".into(),
         ),
         Some(m) => {
             let a = m.albedo();
-            Part::new(
-                true,
-                format!(
-                    "the scene is filled with a scattering medium (albedo {:.2}/{:.2}/{:.2}, g {}): free-flight \
-                     sampling, in-scattered light by light sampling and the phase function (path tracer only)",
-                    a.x, a.y, a.z, m.g
-                ),
-            )
+            Some(format!(
+                "the scene is filled with a scattering medium (albedo {:.2}/{:.2}/{:.2}, g {}): free-flight sampling, \
+                 in-scattered light by light sampling and the phase function (path tracer only)",
+                a.x, a.y, a.z, m.g
+            ))
         }
+    };
+    match (filling, interiors) {
+        (None, 0) => Part::new(false, "no participating medium"),
+        (None, _) => Part::new(true, inside),
+        (Some(f), 0) => Part::new(true, f),
+        (Some(f), _) => Part::new(true, format!("{f}; {inside}")),
     }
 }

@@ -11,8 +11,9 @@
 //! glass), `indirect` (everything else; the photon mapper splits it into caustic, indirect and the
 //! glossy lobe's share of specular).
 //!
-//! In a scene filled with a participating medium ([`crate::medium`]) each segment samples its
-//! first interaction by free flight: where it scatters, the medium point takes light by light
+//! In a participating medium ([`crate::medium`]: one filling the scene, or a dielectric's
+//! scattering interior, [`Scene::segment_medium`]) each segment samples its first interaction
+//! by free flight: where it scatters, the medium point takes light by light
 //! sampling through the phase function ([`crate::transport::media`], weighted by MIS against
 //! the phase-function sample that continues the path); shadow rays carry the medium's
 //! transmittance. Light scattered at the camera's first vertex counts as `direct`, later as
@@ -110,7 +111,7 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
     for depth in 0..=ctx.settings.max_depth {
         rays.camera += 1;
         let found = scene.intersect(o, d, f32::INFINITY);
-        if let Some(medium) = &scene.medium {
+        if let Some(medium) = scene.segment_medium(found.as_ref(), d) {
             // Free flight along this segment: bounce `depth`, dims 4–5.
             let length = found.map_or(f32::INFINITY, |h| h.t * d.length());
             match medium.free_flight(length, s.get(depth, 4), s.get(depth, 5)) {
@@ -156,7 +157,9 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
             }
             break;
         };
-        beta *= scene.interior_transmittance(&hit, d);
+        if scene.scattering_interior(&hit, d).is_none() {
+            beta *= scene.interior_transmittance(&hit, d);
+        }
         let sp = scene.surface(&hit);
         let bsdf = scene.bsdf(&sp);
         let wo = -d;

@@ -2,8 +2,10 @@
 //! answers: an absorbing medium keeps exp(−σ_a·d) of an emitter's light; a furnace (a closed
 //! box whose walls all emit Le and reflect ρ) filled with a medium of albedo 1 stays at
 //! Le/(1 − ρ) everywhere, with MIS and without; single scattering from a point light equals its
-//! integral along the camera ray by quadrature. Bad media are errors naming the field, and the
-//! photon-mapping engines refuse a scene with a medium.
+//! integral along the camera ray by quadrature; a glass cube of index 1 holding a white
+//! scattering interior keeps the furnace at Le/(1 − ρ) too. Bad media are errors naming the
+//! field; the photon-mapping engines refuse a scene-filling medium; Mitsuba's scattering interior
+//! media are read whole.
 
 mod common;
 
@@ -97,6 +99,89 @@ fn a_furnace_filled_with_a_white_medium_stays_at_le_over_one_minus_rho() {
             assert!(se < 0.03, "mis {mis} seed {seed}: the test has no power (SE {se})");
         }
     }
+}
+
+/// An OBJ box [−w, w]² × [−h, h] along z of material `m` (from `c.mtl`), its faces outward.
+fn box_obj(w: f32, h: f32, m: &str) -> String {
+    let v: String = (0..8)
+        .map(|i| {
+            let (x, y, z) = ([-w, w, w, -w][i % 4], [-w, -w, w, w][i % 4], if i < 4 { -h } else { h });
+            format!("v {x} {y} {z}\n")
+        })
+        .collect();
+    format!("mtllib c.mtl\n{v}usemtl {m}\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n")
+}
+
+#[test]
+fn a_scattering_interior_keeps_the_furnace_at_le_over_one_minus_rho() {
+    // The furnace above without a scene-filling medium, holding a cube [−0.5, 0.5]³ of glass of
+    // index 1 (no reflection, no bending) whose interior scatters (σ_s = 2, g = −0.3): paths
+    // cross its faces as delta bounces and scatter inside; the radiance stays 2. Same
+    // tolerances as above.
+    let d = scratch_dir("media-interior");
+    let cube = box_obj(0.5, 0.5, "clear");
+    let [(fo, fobj), (fm, fmtl)] = furnace_files();
+    let files = [(fo, fobj), (fm, fmtl), ("c.obj", cube.as_str()), ("c.mtl", "newmtl clear\nKd 0 0 0\n")];
+    let body = "[[mesh]]\nfile = \"f.obj\"\n[[mesh]]\nfile = \"c.obj\"\n[camera]\neye = [0, 0, 0.9]\ntarget = [0, 0, -1]\nfov = 70\n\
+[materials.clear]\ntype = \"glass\"\nior = 1.0\nscattering = [2, 2, 2]\ng = -0.3\n";
+    let loaded = scene(&d, "interior", body, &files).unwrap();
+    let inside = loaded.scene.materials.iter().find_map(|m| m.interior_scattering).expect("the interior is read");
+    assert_eq!((inside.sigma_s, inside.g), (Vec3::splat(2.0), -0.3));
+    for seed in 1..7 {
+        let settings = Settings { width: 8, height: 8, spp: 256, seed, ..Settings::default() };
+        let values = common::grey(&path_traced(&loaded, &settings));
+        let (mean, se) = mean_and_se(&values);
+        eprintln!("furnace with a scattering cube, seed {seed}: {mean:.4} ± {se:.4}");
+        assert!((mean - 2.0).abs() <= 4.0 * se, "seed {seed}: {mean} ± {se}, want 2");
+        assert!(se < 0.03, "seed {seed}: the test has no power (SE {se})");
+    }
+}
+
+#[test]
+fn a_scattering_interior_attenuates_once() {
+    // The emitter seen through a cube of index-1 glass 1 thick whose interior absorbs σ_a = 1
+    // and barely scatters (σ_s = 0.001): a pixel sees exp(−1.001) of the emitter's light, plus
+    // light scattered into the ray, at most albedo × Le ≈ 0.001 (added to the tolerance with
+    // 4 standard errors over the 8×8 pixels, at each of 4 seeds). Attenuating by free flight and
+    // again by Beer–Lambert at the back face would give exp(−2).
+    let d = scratch_dir("media-interior-once");
+    let cube = box_obj(3.0, 0.5, "murky");
+    let files = [
+        ("e.obj", EMITTER_OBJ),
+        ("e.mtl", EMITTER_MTL),
+        ("c.obj", cube.as_str()),
+        ("c.mtl", "newmtl murky\nKd 0 0 0\n"),
+    ];
+    let body = "[[mesh]]\nfile = \"e.obj\"\n[[mesh]]\nfile = \"c.obj\"\n[camera]\neye = [0, 0, 2]\ntarget = [0, 0, -2]\nfov = 2\n\
+[materials.murky]\ntype = \"glass\"\nior = 1.0\nabsorption = [1, 1, 1]\nscattering = [0.001, 0.001, 0.001]\n";
+    let loaded = scene(&d, "murky", body, &files).unwrap();
+    let want = (-1.001f64).exp();
+    for seed in 1..5 {
+        let settings = Settings { width: 8, height: 8, spp: 64, seed, ..Settings::default() };
+        let (mean, se) = mean_and_se(&common::grey(&path_traced(&loaded, &settings)));
+        assert!((mean - want).abs() <= 4.0 * se + 0.001, "seed {seed}: {mean} ± {se}, exp(−σ_t·d) = {want}");
+        assert!(se < 0.02, "seed {seed}: the test has no power (SE {se})");
+    }
+}
+
+#[test]
+fn mitsuba_scattering_interiors_are_read_whole() {
+    let d = scratch_dir("media-mitsuba");
+    let xml = "<scene version=\"3.0.0\">\n<shape type=\"cube\"><bsdf type=\"dielectric\"/>\n\
+<medium name=\"interior\" type=\"homogeneous\"><rgb name=\"sigma_t\" value=\"2, 2, 2\"/>\
+<rgb name=\"albedo\" value=\"0.5, 0.75, 1\"/><phase type=\"hg\"><float name=\"g\" value=\"0.4\"/></phase></medium>\n\
+</shape>\n<emitter type=\"point\"><point name=\"position\" x=\"0\" y=\"3\" z=\"0\"/></emitter>\n</scene>\n";
+    let path = d.join("milk.xml");
+    std::fs::write(&path, xml).unwrap();
+    let loaded = load_scene(&path).unwrap();
+    let m = loaded.scene.materials.iter().find_map(|m| m.interior_scattering).expect("the scattering interior is kept");
+    assert!((m.sigma_s - Vec3::new(1.0, 1.5, 2.0)).abs().max_element() < 1e-6, "{m:?}");
+    assert!((m.sigma_a - Vec3::new(1.0, 0.5, 0.0)).abs().max_element() < 1e-6 && m.g == 0.4, "{m:?}");
+    assert!(
+        loaded.scene.warnings.iter().any(|w| w.contains("photon-mapping engines attenuate")),
+        "{:?}",
+        loaded.scene.warnings
+    );
 }
 
 /// Single scattering along the ray from the origin down −z, from a point light of intensity

@@ -164,6 +164,11 @@ pub struct Material {
     /// `KHR_materials_volume` attenuation). Zero for a clear interior and for every material
     /// that is not a dielectric.
     pub interior: Vec3,
+    /// The whole medium of that interior when it also scatters (σ_a, σ_s, g; σ_a + σ_s is
+    /// `interior`): the path tracer samples free flight in it and scatters light back in; the
+    /// photon-mapping engines attenuate by `interior` alone. `None` for a clear or purely
+    /// absorbing interior.
+    pub interior_scattering: Option<crate::medium::Medium>,
     /// A tangent-space normal map that bends the shading normal ([`NormalMap`]).
     pub normal_map: Option<NormalMap>,
     /// An alpha cut-out: where the surface is absent ([`Opacity`]); `None`: opaque everywhere.
@@ -242,6 +247,7 @@ impl Material {
             emission,
             maps: Maps::default(),
             interior: Vec3::ZERO,
+            interior_scattering: None,
             normal_map: None,
             opacity: None,
         }

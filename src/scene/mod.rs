@@ -667,6 +667,38 @@ impl Scene {
         self.kinds.2
     }
 
+    /// The scattering medium a ray along `d` crossed to reach `hit`: the interior of the
+    /// dielectric whose back face it hit, if that interior scatters
+    /// ([`Material::interior_scattering`]).
+    #[must_use]
+    pub fn scattering_interior(&self, hit: &Hit, d: Vec3) -> Option<&crate::medium::Medium> {
+        let tri = hit.tri as usize;
+        if d.dot(self.ng[tri]) <= 0.0 {
+            return None;
+        }
+        self.materials[self.material[tri] as usize].interior_scattering.as_ref()
+    }
+
+    /// The medium a ray along `d` travels in before `hit` (`None`: it leaves the scene): a
+    /// scattering interior it is inside of ([`Self::scattering_interior`]); none inside any
+    /// other solid dielectric (clear or absorbing glass, whose Beer–Lambert
+    /// [`Self::interior_transmittance`] covers it); else the medium filling the scene, if any.
+    /// Interiors are not nested: what matters is the face the ray reaches.
+    #[must_use]
+    pub fn segment_medium(&self, hit: Option<&Hit>, d: Vec3) -> Option<&crate::medium::Medium> {
+        if let Some(h) = hit {
+            if let Some(m) = self.scattering_interior(h, d) {
+                return Some(m);
+            }
+            let tri = h.tri as usize;
+            let bsdf = &self.materials[self.material[tri] as usize].bsdf;
+            if d.dot(self.ng[tri]) > 0.0 && matches!(bsdf, Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. }) {
+                return None;
+            }
+        }
+        self.medium.as_ref()
+    }
+
     /// True if any triangle's dielectric encloses an absorbing interior ([`Material::interior`]).
     #[must_use]
     pub fn has_absorbing_interiors(&self) -> bool {

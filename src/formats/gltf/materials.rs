@@ -228,7 +228,16 @@ pub(super) fn convert(
         .filter(|o| !o.is_opaque());
     let emission = if emission.is_finite() { emission } else { Vec3::ZERO };
     Ok(Converted {
-        material: Material { name: name.to_string(), bsdf, emission, maps, interior, normal_map, opacity },
+        material: Material {
+            name: name.to_string(),
+            bsdf,
+            emission,
+            maps,
+            interior,
+            interior_scattering: None,
+            normal_map,
+            opacity,
+        },
         uv: uv.flatten(),
     })
 }

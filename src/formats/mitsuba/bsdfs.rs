@@ -429,6 +429,7 @@ impl Ctx<'_> {
                 emission: Vec3::ZERO,
                 maps,
                 interior: Vec3::ZERO,
+                interior_scattering: None,
                 normal_map: None,
                 opacity: None,
             },

@@ -4,9 +4,10 @@
 //! it keeps exp(−σ_t·d) (Beer–Lambert, [`crate::material::Material::interior`]).
 //!
 //! σ_t is Mitsuba 3's `sigma_t` (1 by default) or 0.5's `sigmaT`, or `sigmaA` + `sigmaS`, times
-//! `scale`. A medium that scatters (`albedo` or `sigmaS` above 0) loses its scattered light here:
-//! the beam is attenuated by the whole σ_t and nothing is scattered back in (scattering media are
-//! issue 59's), warned of. Exterior media, other medium types, an interior behind a BSDF that is
+//! `scale`. A medium that scatters (`albedo` or `sigmaS` above 0) is kept whole as well
+//! ([`crate::material::Material::interior_scattering`], with its `hg` phase function's `g` or an
+//! isotropic one): the path tracer scatters in it; the photon-mapping engines attenuate by the
+//! whole σ_t and scatter nothing back in, warned of. Exterior media, other medium types, an interior behind a BSDF that is
 //! not a solid dielectric and media no shape encloses are warned of by line and left out.
 //!
 //! Reads `<medium>` elements and `<ref>`s to them; writes the σ_t of a shape's interior.
@@ -14,6 +15,7 @@
 use super::Ctx;
 use crate::error::Result;
 use crate::material::Bsdf;
+use crate::medium::Medium;
 use glam::Vec3;
 use roxmltree::Node;
 
@@ -32,9 +34,10 @@ impl<'a> Ctx<'a> {
         Ok(Some((medium, c.attribute("name").unwrap_or("").to_string())))
     }
 
-    /// σ_t of the interior medium of `<shape>` element `shape` whose material is `bsdf`, or
-    /// `None` (no interior medium, or one left out and warned of).
-    pub(super) fn interior(&mut self, shape: Node<'a, 'a>, bsdf: &Bsdf) -> Result<Option<Vec3>> {
+    /// σ_t of the interior medium of `<shape>` element `shape` whose material is `bsdf`, with
+    /// the whole medium when it scatters, or `None` (no interior medium, or one left out and
+    /// warned of).
+    pub(super) fn interior(&mut self, shape: Node<'a, 'a>, bsdf: &Bsdf) -> Result<Option<(Vec3, Option<Medium>)>> {
         let mut interior = None;
         for c in shape.children().filter(Node::is_element) {
             let Some((medium, name)) = self.medium_of(c)? else { continue };
@@ -81,17 +84,34 @@ impl<'a> Ctx<'a> {
                 .r
                 .error(medium, format!("the medium's `scale` is {scale}: it must be a finite number ≥ 0")));
         }
-        if scattering.max_element() > 0.0 {
-            self.warn(
-                medium,
-                format!(
-                    "the medium scatters (σ_s = {}): photonwave attenuates by the whole σ_t = {} and does not scatter \
-                     light back in, so it renders darker than Mitsuba",
-                    scattering * scale,
-                    sigma_t * scale
-                ),
-            );
+        if scattering.max_element() <= 0.0 {
+            return Ok(Some((sigma_t * scale, None)));
         }
-        Ok(Some(sigma_t * scale))
+        self.warn(
+            medium,
+            format!(
+                "the medium scatters (σ_s = {}): the path tracer (`--engine path`) scatters in it; the photon-mapping \
+                 engines attenuate by the whole σ_t = {} and do not scatter light back in, so they render it darker",
+                scattering * scale,
+                sigma_t * scale
+            ),
+        );
+        let g = match medium.children().find(|c| c.is_element() && c.tag_name().name() == "phase") {
+            None => 0.0,
+            Some(p) => match p.attribute("type").unwrap_or("") {
+                "isotropic" => 0.0,
+                "hg" => self.r.float(p, "g", 0.8)?,
+                other => {
+                    self.warn(
+                        p,
+                        format!("phase function `{other}` is not read (only `hg` and `isotropic`): isotropic"),
+                    );
+                    0.0
+                }
+            },
+        };
+        let whole = Medium::new((sigma_t - scattering) * scale, scattering * scale, g)
+            .map_err(|e| self.r.error(medium, format!("the interior medium: {e}")))?;
+        Ok(Some((sigma_t * scale, Some(whole))))
     }
 }

@@ -136,10 +136,11 @@ impl<'a> Ctx<'a> {
             }
         };
         let bsdf_kind = self.table.materials[material as usize].bsdf;
-        if let Some(sigma) = self.interior(node, &bsdf_kind)? {
+        if let Some((sigma, scattering)) = self.interior(node, &bsdf_kind)? {
             let mut inside = self.table.materials[material as usize].clone();
             inside.name = format!("{} (interior medium of the shape at line {})", inside.name, self.r.line(node));
             inside.interior = sigma;
+            inside.interior_scattering = scattering;
             material = self.table.insert(self.r.path, inside, self.warnings);
         }
         if let Some(e) = node.children().find(|c| c.is_element() && c.tag_name().name() == "emitter") {

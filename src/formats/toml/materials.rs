@@ -60,6 +60,12 @@ pub(super) enum MaterialEntry {
         /// σ_a of the interior, per scene unit (Beer–Lambert; clear when absent).
         #[serde(default)]
         absorption: Option<[f32; 3]>,
+        /// σ_s of the interior, per scene unit: it scatters (the path tracer).
+        #[serde(default)]
+        scattering: Option<[f32; 3]>,
+        /// Henyey–Greenstein g of the interior's scattering.
+        #[serde(default)]
+        g: Option<f32>,
         #[serde(default)]
         emission: Option<[f32; 3]>,
     },
@@ -88,6 +94,12 @@ pub(super) enum MaterialEntry {
         /// (Beer–Lambert; clear when absent).
         #[serde(default)]
         absorption: Option<[f32; 3]>,
+        /// σ_s of the interior, per scene unit: it scatters (the path tracer).
+        #[serde(default)]
+        scattering: Option<[f32; 3]>,
+        /// Henyey–Greenstein g of the interior's scattering.
+        #[serde(default)]
+        g: Option<f32>,
         #[serde(default)]
         emission: Option<[f32; 3]>,
     },
@@ -243,12 +255,25 @@ impl MaterialEntry {
             Some(e) => colour(&f("emission"), e)?,
             None => Vec3::ZERO,
         };
-        let interior = match *self {
-            MaterialEntry::Glass { absorption: Some(a), .. }
-            | MaterialEntry::RoughDielectric { absorption: Some(a), .. } => colour(&f("absorption"), a)?,
-            _ => Vec3::ZERO,
+        let (absorption, scattering, g) = match *self {
+            MaterialEntry::Glass { absorption, scattering, g, .. }
+            | MaterialEntry::RoughDielectric { absorption, scattering, g, .. } => (absorption, scattering, g),
+            _ => (None, None, None),
         };
-        Ok(Material { interior, ..Material::new(name, bsdf, emission) })
+        let sigma_a = absorption.map_or(Ok(Vec3::ZERO), |a| colour(&f("absorption"), a))?;
+        let sigma_s = scattering.map_or(Ok(Vec3::ZERO), |a| colour(&f("scattering"), a))?;
+        if g.is_some() && sigma_s == Vec3::ZERO {
+            return Err(Error::setting(f("g"), "is the interior's phase function: give `scattering` too"));
+        }
+        let interior_scattering = if sigma_s == Vec3::ZERO {
+            None
+        } else {
+            Some(
+                crate::medium::Medium::new(sigma_a, sigma_s, g.unwrap_or(0.0))
+                    .map_err(|e| Error::setting(f("g"), e))?,
+            )
+        };
+        Ok(Material { interior: sigma_a + sigma_s, interior_scattering, ..Material::new(name, bsdf, emission) })
     }
 }
 
