@@ -54,7 +54,8 @@ pub fn render_path_traced(
 fn trace_image(scene: &Scene, camera: &CameraRays, job: &Job, progress: &dyn Progress) -> (Film, RayCounts, Numerics) {
     let empty = PhotonMaps::default();
     let ctx = Context::new(scene, &empty, job);
-    render_pixels(job, camera, progress, |_, o, d, s, rays, _| trace_path(&ctx, o, d, s, rays))
+    let media = scene.has_media();
+    render_pixels(job, camera, progress, |_, o, d, s, rays, _| trace_path(&ctx, media, o, d, s, rays))
 }
 
 /// Renders `job` by path tracing, with the CLI's summary.
@@ -94,7 +95,8 @@ fn path_term(first: Term, depth: u32, via_specular: bool) -> Term {
 }
 
 /// Radiance along one camera ray, split into the path tracer's terms.
-fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut RayCounts) -> Terms {
+/// `media`: the scene has a participating medium somewhere ([`Scene::has_media`]).
+fn trace_path(ctx: &Context, media: bool, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut RayCounts) -> Terms {
     let scene = ctx.scene;
     let mut terms = Terms::default();
     let mut beta = Vec3::ONE;
@@ -111,7 +113,9 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
     for depth in 0..=ctx.settings.max_depth {
         rays.camera += 1;
         let found = scene.intersect(o, d, f32::INFINITY);
-        if let Some(medium) = scene.segment_medium(found.as_ref(), d) {
+        // The medium this segment travels in.
+        let arrived = if media { scene.segment_medium(found.as_ref(), d) } else { None };
+        if let Some(medium) = arrived {
             // Free flight along this segment: bounce `depth`, dims 4–5.
             let length = found.map_or(f32::INFINITY, |h| h.t * d.length());
             match medium.free_flight(length, s.get(depth, 4), s.get(depth, 5)) {
@@ -178,9 +182,12 @@ fn trace_path(ctx: &Context, mut o: Vec3, mut d: Vec3, s: &Sampler, rays: &mut R
         }
         if !bsdf.is_delta() {
             let light_stream = s.fork(streams::path_light(depth));
-            let l = match &scene.medium {
-                None => weighted_direct_light(ctx, &sp, &bsdf, wo, &light_stream, &mis, rays),
-                Some(m) => attenuated_direct_light(ctx, m, &sp, &bsdf, wo, &light_stream, &mis, rays),
+            let l = if media {
+                // Each shadow ray in the medium on its side of the surface.
+                let toward = |dir: Vec3| scene.medium_leaving(hit.tri, wo, dir, arrived);
+                attenuated_direct_light(ctx, toward, &sp, &bsdf, wo, &light_stream, &mis, rays)
+            } else {
+                weighted_direct_light(ctx, &sp, &bsdf, wo, &light_stream, &mis, rays)
             };
             terms.add(path_term(Term::Direct, depth, via_specular), beta * l);
         }

@@ -679,6 +679,38 @@ impl Scene {
         self.materials[self.material[tri] as usize].interior_scattering.as_ref()
     }
 
+    /// The medium a ray leaving triangle `tri` along `dir` travels in, when it reached the
+    /// triangle through `arrived` (the medium on its own side): across a solid dielectric's
+    /// face, its interior (a scattering one, or none) going in and the scene's medium going
+    /// out; on the same side, or at any other surface (the same medium on both sides),
+    /// `arrived`.
+    #[must_use]
+    pub fn medium_leaving<'a>(
+        &'a self,
+        tri: u32,
+        wo: Vec3,
+        dir: Vec3,
+        arrived: Option<&'a crate::medium::Medium>,
+    ) -> Option<&'a crate::medium::Medium> {
+        let (ng, m) = (self.ng[tri as usize], &self.materials[self.material[tri as usize] as usize]);
+        let dielectric = matches!(m.bsdf, Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. });
+        if !dielectric || (dir.dot(ng) > 0.0) == (wo.dot(ng) > 0.0) {
+            return arrived;
+        }
+        if dir.dot(ng) < 0.0 {
+            m.interior_scattering.as_ref()
+        } else {
+            self.medium.as_ref()
+        }
+    }
+
+    /// True if the scene has a participating medium anywhere: one filling it or a scattering
+    /// interior.
+    #[must_use]
+    pub fn has_media(&self) -> bool {
+        self.medium.is_some() || self.materials.iter().any(|m| m.interior_scattering.is_some())
+    }
+
     /// The medium a ray along `d` travels in before `hit` (`None`: it leaves the scene): a
     /// scattering interior it is inside of ([`Self::scattering_interior`]); none inside any
     /// other solid dielectric (clear or absorbing glass, whose Beer–Lambert

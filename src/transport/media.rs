@@ -29,12 +29,13 @@ pub fn shadow_transmittance(medium: &Medium, ray: &ShadowRay) -> Vec3 {
 }
 
 /// Direct light at `sp` toward `wo` by light sampling, each unblocked shadow ray's
-/// contribution times the medium's transmittance along it (the path tracer's
-/// [`super::direct::weighted_direct_light`] in a medium).
+/// contribution times the transmittance of the medium it travels in, `medium_toward` its
+/// direction (none: clear) — the path tracer's [`super::direct::weighted_direct_light`] in
+/// media.
 #[allow(clippy::too_many_arguments)]
-pub fn attenuated_direct_light(
+pub fn attenuated_direct_light<'m>(
     ctx: &Context,
-    medium: &Medium,
+    medium_toward: impl Fn(Vec3) -> Option<&'m Medium>,
     sp: &SurfacePoint,
     bsdf: &Bsdf,
     wo: Vec3,
@@ -43,7 +44,15 @@ pub fn attenuated_direct_light(
     rays: &mut RayCounts,
 ) -> Vec3 {
     let mut sum = Vec3::ZERO;
-    direct_light_rays(ctx, sp, bsdf, wo, s, false, mis, |r| sum += through(ctx, medium, &r, rays));
+    direct_light_rays(ctx, sp, bsdf, wo, s, false, mis, |r| match medium_toward(r.direction) {
+        Some(m) => sum += through(ctx, m, &r, rays),
+        None => {
+            rays.shadow += 1;
+            if !ctx.scene.occluded(r.origin, r.direction, r.t_max) {
+                sum += r.contribution;
+            }
+        }
+    });
     sum
 }
 
