@@ -165,6 +165,42 @@ fn a_scattering_interior_attenuates_once() {
 }
 
 #[test]
+fn shadow_rays_into_a_dielectric_leave_the_fog_outside() {
+    // A point light inside a clear rough-glass cube [−0.5, 0.5]³, seen from 3 away through a fog
+    // that only absorbs (σ_a = 0.5) and without it. Light sampling at the cube's faces reaches
+    // the light through the glass without crossing the fog, so the foggy image is the clear one
+    // times the camera segment's transmittance exp(−σ_a·t), t from 2.5 to 2.5 × 1.008 over the
+    // 10° field (so within 1 % of exp(−1.25)). Both renders draw the same light and BSDF
+    // samples; the fog only ends camera paths (free flight at bounce 0, dims 4–5). Tolerance on
+    // the ratio of the image means: 4 standard errors over 6 seeds, plus that 1 %; shadow rays
+    // attenuated by the fog inside the cube too (by up to exp(−0.43)) make it about 22 % low.
+    let d = scratch_dir("media-globe");
+    let cube = box_obj(0.5, 0.5, "globe");
+    let files = [("c.obj", cube.as_str()), ("c.mtl", "newmtl globe\nKd 0 0 0\n")];
+    let body = |fog: &str| {
+        format!(
+            "[[mesh]]\nfile = \"c.obj\"\n[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nfov = 10\n\
+[[light]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = [1, 1, 1]\n\
+[materials.globe]\ntype = \"rough_dielectric\"\nior = 1.5\nroughness = 0.4\n{fog}"
+        )
+    };
+    let clear = scene(&d, "clear", &body(""), &files).unwrap();
+    let foggy = scene(&d, "foggy", &body("[medium]\nsigma_a = [0.5, 0.5, 0.5]\n"), &files).unwrap();
+    let t = (-1.25f64).exp();
+    let ratios: Vec<f32> = (1..7)
+        .map(|seed| {
+            let settings = Settings { width: 16, height: 16, spp: 512, seed, ..Settings::default() };
+            let (a, b) = (path_traced(&foggy, &settings).mean(), path_traced(&clear, &settings).mean());
+            a.element_sum() / b.element_sum()
+        })
+        .collect();
+    let (ratio, se) = mean_and_se(&ratios);
+    eprintln!("globe: foggy ÷ clear = {ratio:.5} ± {se:.5}, exp(−1.25) = {t:.5}");
+    assert!((ratio / t - 1.0).abs() <= 4.0 * se / t + 0.01, "foggy ÷ clear = {ratio} ± {se}, want {t}");
+    assert!(se < 0.02 * t, "the test has no power (SE {se} against {t})");
+}
+
+#[test]
 fn mitsuba_scattering_interiors_are_read_whole() {
     let d = scratch_dir("media-mitsuba");
     let xml = "<scene version=\"3.0.0\">\n<shape type=\"cube\"><bsdf type=\"dielectric\"/>\n\
