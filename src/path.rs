@@ -184,7 +184,7 @@ fn trace_path(ctx: &Context, media: bool, mut o: Vec3, mut d: Vec3, s: &Sampler,
             let light_stream = s.fork(streams::path_light(depth));
             let l = if media {
                 // Each shadow ray in the medium on its side of the surface.
-                let toward = |dir: Vec3| scene.medium_leaving(hit.tri, wo, dir, arrived);
+                let toward = |dir: Vec3| scene.medium_on_side(hit.tri, dir);
                 attenuated_direct_light(ctx, toward, &sp, &bsdf, wo, &light_stream, &mis, rays)
             } else {
                 weighted_direct_light(ctx, &sp, &bsdf, wo, &light_stream, &mis, rays)

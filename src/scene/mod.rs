@@ -679,25 +679,15 @@ impl Scene {
         self.materials[self.material[tri] as usize].interior_scattering.as_ref()
     }
 
-    /// The medium a ray leaving triangle `tri` along `dir` travels in, when it reached the
-    /// triangle through `arrived` (the medium on its own side): across a solid dielectric's
-    /// face, its interior (a scattering one, or none) going in and the scene's medium going
-    /// out; on the same side, or at any other surface (the same medium on both sides),
-    /// `arrived`.
+    /// The medium on the side of triangle `tri` that `v` points to: a solid dielectric's
+    /// interior behind its face (its scattering medium, or none for clear or Beer–Lambert
+    /// absorbing glass); the medium filling the scene, if any, everywhere else. Interiors are
+    /// not nested. A shadow ray leaving the surface along `v` travels in it; a ray that reached
+    /// the surface along `d` travelled in the one on the side of −d.
     #[must_use]
-    pub fn medium_leaving<'a>(
-        &'a self,
-        tri: u32,
-        wo: Vec3,
-        dir: Vec3,
-        arrived: Option<&'a crate::medium::Medium>,
-    ) -> Option<&'a crate::medium::Medium> {
-        let (ng, m) = (self.ng[tri as usize], &self.materials[self.material[tri as usize] as usize]);
-        let dielectric = matches!(m.bsdf, Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. });
-        if !dielectric || (dir.dot(ng) > 0.0) == (wo.dot(ng) > 0.0) {
-            return arrived;
-        }
-        if dir.dot(ng) < 0.0 {
+    pub fn medium_on_side(&self, tri: u32, v: Vec3) -> Option<&crate::medium::Medium> {
+        let m = &self.materials[self.material[tri as usize] as usize];
+        if v.dot(self.ng[tri as usize]) < 0.0 && matches!(m.bsdf, Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. }) {
             m.interior_scattering.as_ref()
         } else {
             self.medium.as_ref()
@@ -711,24 +701,15 @@ impl Scene {
         self.medium.is_some() || self.materials.iter().any(|m| m.interior_scattering.is_some())
     }
 
-    /// The medium a ray along `d` travels in before `hit` (`None`: it leaves the scene): a
-    /// scattering interior it is inside of ([`Self::scattering_interior`]); none inside any
-    /// other solid dielectric (clear or absorbing glass, whose Beer–Lambert
-    /// [`Self::interior_transmittance`] covers it); else the medium filling the scene, if any.
-    /// Interiors are not nested: what matters is the face the ray reaches.
+    /// The medium a ray along `d` travels in before `hit` (`None`: it leaves the scene): the
+    /// one on the side of `hit`'s triangle it came from ([`Self::medium_on_side`]), or the
+    /// medium filling the scene when it hits nothing.
     #[must_use]
     pub fn segment_medium(&self, hit: Option<&Hit>, d: Vec3) -> Option<&crate::medium::Medium> {
-        if let Some(h) = hit {
-            if let Some(m) = self.scattering_interior(h, d) {
-                return Some(m);
-            }
-            let tri = h.tri as usize;
-            let bsdf = &self.materials[self.material[tri] as usize].bsdf;
-            if d.dot(self.ng[tri]) > 0.0 && matches!(bsdf, Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. }) {
-                return None;
-            }
+        match hit {
+            Some(h) => self.medium_on_side(h.tri, -d),
+            None => self.medium.as_ref(),
         }
-        self.medium.as_ref()
     }
 
     /// True if any triangle's dielectric encloses an absorbing interior ([`Material::interior`]).

@@ -153,7 +153,9 @@ pub fn compare_files_in_blocks(image: &Path, reference: &Path, block: u32) -> Re
     if layers.is_empty() {
         return Err(Error::parse(image, 0, format!("shares no RGB layer with {}", reference.display())));
     }
-    let beauty = |l: &ExrLayers| l.layers.iter().find(|(n, _)| n.is_empty()).map(|(_, p)| p.clone());
+    fn beauty(l: &ExrLayers) -> Option<&[Vec3]> {
+        l.layers.iter().find(|(n, _)| n.is_empty()).map(|(_, p)| p.as_slice())
+    }
     let (pa, pb) = match (beauty(&a), beauty(&b)) {
         (Some(pa), Some(pb)) => (pa, pb),
         _ => {
@@ -167,9 +169,9 @@ pub fn compare_files_in_blocks(image: &Path, reference: &Path, block: u32) -> Re
         height: a.height,
         reference_reduced: k,
         layers,
-        blocks: block_errors(&pa, &pb, a.width, a.height, block),
-        speckle: speckle_fraction(&pa, a.width, a.height),
-        reference_speckle: speckle_fraction(&pb, a.width, a.height),
+        blocks: block_errors(pa, pb, a.width, a.height, block),
+        speckle: speckle_fraction(pa, a.width, a.height),
+        reference_speckle: speckle_fraction(pb, a.width, a.height),
     })
 }
 

@@ -44,22 +44,15 @@ pub fn attenuated_direct_light<'m>(
     rays: &mut RayCounts,
 ) -> Vec3 {
     let mut sum = Vec3::ZERO;
-    direct_light_rays(ctx, sp, bsdf, wo, s, false, mis, |r| match medium_toward(r.direction) {
-        Some(m) => sum += through(ctx, m, &r, rays),
-        None => {
-            rays.shadow += 1;
-            if !ctx.scene.occluded(r.origin, r.direction, r.t_max) {
-                sum += r.contribution;
-            }
-        }
-    });
+    direct_light_rays(ctx, sp, bsdf, wo, s, false, mis, |r| sum += through(ctx, medium_toward(r.direction), &r, rays));
     sum
 }
 
-/// What shadow ray `r` carries through the medium: its contribution times the transmittance
-/// along it, if nothing blocks it (no ray is traced where the medium lets nothing through).
-fn through(ctx: &Context, medium: &Medium, r: &ShadowRay, rays: &mut RayCounts) -> Vec3 {
-    let t = shadow_transmittance(medium, r);
+/// What shadow ray `r` carries through `medium` (none: clear): its contribution times the
+/// transmittance along it, if nothing blocks it (no ray is traced where the medium lets
+/// nothing through).
+fn through(ctx: &Context, medium: Option<&Medium>, r: &ShadowRay, rays: &mut RayCounts) -> Vec3 {
+    let t = medium.map_or(Vec3::ONE, |m| shadow_transmittance(m, r));
     if t == Vec3::ZERO {
         return Vec3::ZERO;
     }
@@ -103,7 +96,7 @@ pub fn in_scattered_light(
         }
         let (direction, t_max) = shadow_segment(p, inc);
         let ray = ShadowRay { origin: p, direction, t_max, contribution: inc.value * (f * w * weight) };
-        sum += through(ctx, medium, &ray, rays);
+        sum += through(ctx, Some(medium), &ray, rays);
     });
     sum
 }

@@ -123,8 +123,8 @@ impl MediumEntry {
                 ))
             }
         };
-        let field = if self.g.abs() >= 1.0 || !self.g.is_finite() { "medium.g" } else { "medium" };
-        crate::medium::Medium::new(sigma_a, sigma_s, self.g).map_err(|e| Error::setting(field, e))
+        // σ_a and σ_s are checked above: what is left to refuse is g.
+        crate::medium::Medium::new(sigma_a, sigma_s, self.g).map_err(|e| Error::setting("medium.g", e))
     }
 }
 
