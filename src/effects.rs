@@ -16,7 +16,15 @@ impl Effects {
         let diffuse = scene.has_diffuse_surfaces();
         let glass = scene.has_glass();
         let forced = |name: &str| settings.force.iter().any(|f| f == name);
+        // A medium filling the scene that scatters holds photons as diffuse surfaces do (its
+        // volume maps come from the same passes).
+        let fog = scene.medium.as_ref().is_some_and(crate::medium::Medium::scatters);
+        let into_fog = if fog { "; and into the scattering medium (volumetric caustics)" } else { "" };
         let caustic_map = match (delta, diffuse) {
+            (true, false) if fog => Part::new(
+                true,
+                "mirror or glass surfaces can focus light into the scattering medium (volumetric caustics)",
+            ),
             (true, true) => {
                 let aimed = match scene.caustic_targets.len() {
                     n if settings.aim_caustics && n > 0 => {
@@ -28,7 +36,7 @@ impl Effects {
                     true,
                     format!(
                         "mirror or glass surfaces (or frosted glass, or metal with roughness below 0.3, which pass \
-                         photons on as specular) can focus light onto diffuse surfaces{aimed}"
+                         photons on as specular) can focus light onto diffuse surfaces{into_fog}{aimed}"
                     ),
                 )
             }
@@ -36,8 +44,12 @@ impl Effects {
             (false, _) => Part::new(false, "no mirror or glass in the scene"),
             (true, false) => Part::new(false, "no diffuse surface to receive caustics"),
         };
-        let global_map = if diffuse {
+        let global_map = if diffuse && fog {
+            Part::new(true, "diffuse surfaces reflect indirect light, and the medium scatters it (its volume map)")
+        } else if diffuse {
             Part::new(true, "diffuse surfaces reflect indirect light")
+        } else if fog {
+            Part::new(true, "the medium filling the scene scatters light (its volume map)")
         } else if forced("global_map") {
             Part::new(true, "forced on by the `force` setting")
         } else {
@@ -153,13 +165,17 @@ fn media_part(scene: &Scene) -> Part {
     let filling = match &scene.medium {
         None => None,
         Some(m) if !m.scatters() => Some(
-            "the scene is filled with a purely absorbing medium: every ray keeps exp(−σ_a·d) (path tracer only)".into(),
+            "the scene is filled with a purely absorbing medium: every ray and photon keeps exp(−σ_a·d), no volume \
+             map (path tracer and reference engine)"
+                .into(),
         ),
         Some(m) => {
             let a = m.albedo();
             Some(format!(
-                "the scene is filled with a scattering medium (albedo {:.2}/{:.2}/{:.2}, g {}): free-flight sampling, \
-                 in-scattered light by light sampling and the phase function (path tracer only)",
+                "the scene is filled with a scattering medium (albedo {:.2}/{:.2}/{:.2}, g {}): free-flight sampling on \
+                 every segment; the path tracer scatters by light sampling and the phase function, the reference \
+                 engine stores photons that scatter in volume maps and takes single scattering by light sampling, \
+                 multiple scattering and volumetric caustics from the maps (not the wavefront engine yet)",
                 a.x, a.y, a.z, m.g
             ))
         }

@@ -71,11 +71,19 @@ pub fn check_planned(job: &Job, scene: &Scene, engine: Engine, progressive: bool
     let settings = &job.settings;
     if engine != Engine::Path {
         job.plan.check(settings)?;
-        if scene.medium.is_some() {
+        if scene.medium.is_some() && engine == Engine::Wavefront {
             return Err(Error::setting(
                 "--engine",
-                "the scene has a participating medium ([medium]): the photon-mapping engines do not render media \
-                 yet (no volume photon map); render it with `--engine path`",
+                "the scene has a participating medium ([medium]): the wavefront engine does not render media yet; \
+                 render it with `--engine reference` (photon mapping with a volume photon map) or `--engine path`",
+            ));
+        }
+        if scene.medium.is_some() && progressive {
+            return Err(Error::setting(
+                "--passes",
+                "the scene has a participating medium ([medium]): progressive photon mapping does not shrink the \
+                 volume maps' radii yet; render it in one pass (no --passes, --time or --target-error) or with \
+                 `--engine path`",
             ));
         }
     }

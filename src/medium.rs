@@ -93,6 +93,11 @@ impl Medium {
     /// distance, `u` the distance.
     #[must_use]
     pub fn free_flight(&self, length: f32, u_channel: f32, u: f32) -> FreeFlight {
+        if !self.scatters() {
+            // Nothing would scatter where a distance fell: every ray passes with exactly its
+            // transmittance, no noise.
+            return FreeFlight::Pass { weight: self.transmittance(length) };
+        }
         let sigma_t = self.sigma_t();
         let channel = ((u_channel * 3.0) as usize).min(2);
         let s = sigma_t[channel];

@@ -44,6 +44,8 @@ pub struct MapStats {
     pub emitted: u64,
     /// Photons stored.
     pub stored: u64,
+    /// Of those, the photons stored in the medium filling the scene (its volume map).
+    pub volume: u64,
     /// Photons stored where the camera reads the map, by the pilot's cells
     /// ([`crate::photon_map::reach`]); all of them in maps built without a camera (no pilot).
     pub read: u64,
@@ -62,6 +64,7 @@ impl std::ops::AddAssign<&MapStats> for MapStats {
     fn add_assign(&mut self, o: &MapStats) {
         self.emitted += o.emitted;
         self.stored += o.stored;
+        self.volume += o.volume;
         self.read += o.read;
         self.steered |= o.steered;
         self.power_max_over_median = self.power_max_over_median.max(o.power_max_over_median);
@@ -338,8 +341,13 @@ impl RenderStats {
                     }
                     _ => String::new(),
                 };
+                let volume = if m.volume > 0 {
+                    format!(" ({} of them in the medium, the volume map)", m.volume)
+                } else {
+                    String::new()
+                };
                 format!(
-                    "  {name:<8} map: {} photons stored from {} emitted paths{over} ({per:.3} per path){read}\n",
+                    "  {name:<8} map: {} photons stored{volume} from {} emitted paths{over} ({per:.3} per path){read}\n",
                     m.stored, m.emitted
                 )
             } else {

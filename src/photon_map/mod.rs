@@ -67,6 +67,13 @@ pub mod flags {
     /// Stored on a flat-shaded triangle: an estimate at it (an irradiance point precomputed
     /// there) sets photons off its plane aside ([`super::Filter::plane`]). Never masked.
     pub const FLAT: u8 = 4;
+    /// Stored in the medium filling the scene, not on a surface: set by the photon passes on
+    /// the photons of the volume maps, and cleared when [`crate::transport::PhotonMaps::build`]
+    /// sorts them there; never in a tree.
+    pub const VOLUME: u8 = 8;
+    /// The normal a volume photon is stored with (it has none): every volume lookup's filter
+    /// ([`super::Filter::volume`]) faces it.
+    pub const VOLUME_NORMAL: glam::Vec3 = glam::Vec3::Z;
 }
 
 /// A stored photon.
@@ -230,6 +237,16 @@ impl Filter {
         Filter { n, flags_mask, plane: 0.0, slack: position_slack(p, n) }
     }
 
+    /// The filter of a lookup in a volume map: every photon within the radius that carries
+    /// none of `flags_mask`. Volume photons are stored with [`flags::VOLUME_NORMAL`], which this
+    /// filter's normal is, so the normal test passes them all; and its plane test can set none
+    /// aside — a photon's height is at most its distance, and the bound is twice that.
+    #[inline]
+    #[must_use]
+    pub fn volume(flags_mask: u8) -> Filter {
+        Filter { n: flags::VOLUME_NORMAL, flags_mask, plane: 2.0, slack: 0.0 }
+    }
+
     /// This filter with the plane test of a flat query ([`Filter::plane`]).
     #[inline]
     #[must_use]
@@ -366,7 +383,7 @@ impl PhotonMap {
 /// Uniform numbers in [0, 1) from a 64-bit linear congruential generator seeded with `seed`:
 /// the photon-map tests' fixed random photons and queries.
 #[cfg(test)]
-fn test_uniforms(mut seed: u64) -> impl FnMut() -> f32 {
+pub(crate) fn test_uniforms(mut seed: u64) -> impl FnMut() -> f32 {
     move || {
         seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         (seed >> 40) as f32 / (1u64 << 24) as f32

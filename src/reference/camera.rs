@@ -2,8 +2,9 @@
 //! tracing; at the first non-specular hit, Jensen's terms — direct light by light sampling,
 //! caustics from the caustic map, indirect diffuse by final gather over the global map (with the
 //! secondary gather where a gather ray lands near; or the global map read directly), and the
-//! glossy lobe by one traced ray. Every vertex is the
-//! transport core's; only the loops are here.
+//! glossy lobe by one traced ray. In a medium filling the scene every segment samples free
+//! flight, and where it stops the volume maps and light sampling say what the medium scatters
+//! (`transport::volume`). Every vertex is the transport core's; only the loops are here.
 //!
 //! Double counting is avoided by construction: emission that a final-gather or glossy ray hits
 //! straight away belongs to the direct term, weighted by MIS against the light samples
@@ -26,7 +27,8 @@ use crate::transport::estimate::{camera_indirect_estimate, caustic_estimate, ind
 use crate::transport::gather::{glossy_density, glossy_ray, lands_near, trace_gather_rays};
 use crate::transport::lobe::{gather_landing, lobe_escape, lobe_ray, Found};
 use crate::transport::mis::{emission_found, receiver, sky_found, Strategies};
-use crate::transport::specular::{continue_chain, emission_toward, follow_chain, Chain, ChainEnd};
+use crate::transport::specular::{continue_chain, emission_toward, follow_chain, segment_flight, Chain, ChainEnd};
+use crate::transport::volume::{camera_in_medium, gather_in_medium};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
 
@@ -63,7 +65,23 @@ pub fn trace_camera_path(
     let mut through_specular = false;
     for depth in 0..=ctx.settings.max_depth {
         rays.camera += 1;
-        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else {
+        let hit = scene.intersect(o, d, f32::INFINITY);
+        // In a medium filling the scene the segment's free flight may stop short of the hit:
+        // the light the medium scatters there, by term (`transport::volume`).
+        match segment_flight(scene, o, d, hit.as_ref(), s, streams::segment(depth)) {
+            Ok(weight) => beta *= weight,
+            Err((medium, p, weight)) => {
+                // The phase-function sample draws where the chain's next bounce would.
+                let u = [s.get(depth + 1, 0), s.get(depth + 1, 1)];
+                let l = camera_in_medium(ctx, &medium, p, d, &s.fork(streams::light(depth)), u, rays, scratch);
+                let w = beta * weight;
+                terms.add(Term::Direct.seen(through_specular), w * l.direct);
+                terms.add(Term::Caustic.seen(through_specular), w * l.caustic);
+                terms.add(Term::Indirect.seen(through_specular), w * l.indirect);
+                break;
+            }
+        }
+        let Some(hit) = hit else {
             // Leaving the scene: the environment and the sun, seen directly or through mirrors.
             if scene.has_background() {
                 terms.add(Term::Emitted.seen(through_specular), beta * scene.background(d));
@@ -179,6 +197,11 @@ pub fn final_gather(
                 emission += w * emission_found(ctx, &r, &end.hit, end.dir, mis.gather_density(sp, wo, wi));
             }
         }
+        // Stopped in the medium filling the scene: the global volume map there.
+        Chain::Medium(end) => {
+            let w = if varies { bsdf.gather_weight(&sp.frame, wo, wi) } else { Vec3::ONE };
+            sum += w * gather_in_medium(ctx, end, rays, scratch);
+        }
         // Leaving the scene straight away: the environment, weighed against its light samples.
         Chain::Escaped { dir, bounces: 0, .. } => {
             let w = if varies { bsdf.gather_weight(&sp.frame, wo, wi) } else { Vec3::ONE };
@@ -212,11 +235,15 @@ fn gather_hit(
     let mut far = Estimated::default();
     // A black surface sends no gather ray (as in `final_gather` and the wavefront engine).
     if kd != Vec3::ZERO {
-        trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, stream, rays| {
-            if let Chain::Hit(z) = z {
+        trace_gather_rays(ctx, y, wo, 1, &chain.fork(streams::SECONDARY_GATHER), rays, |z, _, stream, rays| match z {
+            Chain::Hit(z) => {
                 let e = gather_landing(ctx, z, stream, rays, scratch);
                 far = Estimated { radiance: z.beta * e.radiance, bias: z.beta * e.bias, emission: Vec3::ZERO };
             }
+            Chain::Medium(z) => {
+                far = Estimated { radiance: gather_in_medium(ctx, z, rays, scratch), ..Default::default() }
+            }
+            _ => {}
         });
     }
     Estimated {
@@ -260,6 +287,13 @@ pub fn glossy_reflection(
                 Estimated { emission: sky, ..Default::default() }
             } else {
                 Estimated { radiance: sky, ..Default::default() }
+            };
+        }
+        // Stopped in the medium filling the scene: the global volume map there.
+        Chain::Medium(end) => {
+            return Estimated {
+                radiance: ray.weight * gather_in_medium(ctx, &end, rays, scratch),
+                ..Default::default()
             };
         }
         _ => return Estimated::default(),

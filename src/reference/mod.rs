@@ -73,6 +73,7 @@ pub fn photon_passes(scene: &Scene, job: &Job, progress: &dyn Progress, stats: &
         let map = if domain == Domain::CausticPhoton { &mut stats.caustic_map } else { &mut stats.global_map };
         map.emitted = p.emitted;
         map.stored = p.photons.len() as u64;
+        map.volume = p.photons.iter().filter(|ph| ph.flags & crate::photon_map::flags::VOLUME != 0).count() as u64;
         map.read = p.read;
         map.steered = crate::transport::guide::steers(job, domain);
         map.power_max_over_median = power_max_over_median(&p.photons);

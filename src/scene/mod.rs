@@ -686,11 +686,40 @@ impl Scene {
     /// the surface along `d` travelled in the one on the side of −d.
     #[must_use]
     pub fn medium_on_side(&self, tri: u32, v: Vec3) -> Option<&crate::medium::Medium> {
-        let m = &self.materials[self.material[tri as usize] as usize];
-        if v.dot(self.ng[tri as usize]) < 0.0 && matches!(m.bsdf, Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. }) {
-            m.interior_scattering.as_ref()
+        if self.behind_dielectric(tri, v) {
+            self.materials[self.material[tri as usize] as usize].interior_scattering.as_ref()
         } else {
             self.medium.as_ref()
+        }
+    }
+
+    /// Whether `v` points from triangle `tri` into a solid dielectric's interior (behind the
+    /// face of glass or a rough dielectric).
+    #[must_use]
+    #[inline]
+    pub fn behind_dielectric(&self, tri: u32, v: Vec3) -> bool {
+        let m = &self.materials[self.material[tri as usize] as usize];
+        v.dot(self.ng[tri as usize]) < 0.0 && matches!(m.bsdf, Bsdf::Glass { .. } | Bsdf::RoughDielectric { .. })
+    }
+
+    /// The photon-mapping engines' rule: the medium filling the scene on the side of triangle
+    /// `tri` that `v` points to, none inside a solid dielectric (whose interior they only
+    /// attenuate, [`Self::interior_transmittance`]).
+    #[must_use]
+    #[inline]
+    pub fn filling_medium_toward(&self, tri: u32, v: Vec3) -> Option<&crate::medium::Medium> {
+        self.medium.as_ref().filter(|_| !self.behind_dielectric(tri, v))
+    }
+
+    /// The medium filling the scene that a ray along `d` crosses before `hit` (or to infinity),
+    /// for the photon-mapping engines ([`Self::filling_medium_toward`] of the side it came
+    /// from).
+    #[must_use]
+    #[inline]
+    pub fn filling_medium(&self, hit: Option<&Hit>, d: Vec3) -> Option<&crate::medium::Medium> {
+        match hit {
+            Some(h) => self.filling_medium_toward(h.tri, -d),
+            None => self.medium.as_ref(),
         }
     }
 

@@ -4,12 +4,14 @@
 //! subtends or by area ([`crate::scene::light`]), each a shadow ray that
 //! carries its contribution if nothing blocks it. Where BSDF samples can find the same emitters
 //! ([`super::mis::Strategies`]), an emissive triangle's, the environment's and a sun's samples
-//! are weighted against them.
+//! are weighted against them. In a medium filling the scene a shadow ray carries its
+//! transmittance ([`unblocked`]).
 
 use super::mis::{environment_density, light_density, receiver, sun_density, weighed_light, Strategies};
 use super::Context;
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::Bsdf;
+use crate::medium::Medium;
 use crate::rng::Sampler;
 use crate::scene::light::{Incident, Light};
 use crate::scene::{Receiver, SurfacePoint};
@@ -167,13 +169,35 @@ pub fn weighted_direct_light(
     rays: &mut RayCounts,
 ) -> Vec3 {
     let mut sum = Vec3::ZERO;
+    let scene = ctx.scene;
     direct_light_rays(ctx, sp, bsdf, wo, s, false, mis, |r| {
-        rays.shadow += 1;
-        if !ctx.scene.occluded(r.origin, r.direction, r.t_max) {
-            sum += r.contribution;
-        }
+        sum += unblocked(ctx, scene.filling_medium_toward(sp.tri, r.direction), &r, rays);
     });
     sum
+}
+
+/// The fraction of a shadow ray's light `medium` lets through over its length (the whole ray
+/// for a distant light: none where σ_t > 0).
+#[must_use]
+pub fn shadow_transmittance(medium: &Medium, ray: &ShadowRay) -> Vec3 {
+    let length = if ray.t_max.is_finite() { ray.direction.length() * ray.t_max } else { f32::INFINITY };
+    medium.transmittance(length)
+}
+
+/// What shadow ray `r` carries through `medium` (none: clear): its contribution times the
+/// transmittance along it if nothing blocks it. No ray is traced where the medium lets
+/// nothing through.
+pub fn unblocked(ctx: &Context, medium: Option<&Medium>, r: &ShadowRay, rays: &mut RayCounts) -> Vec3 {
+    let t = medium.map_or(Vec3::ONE, |m| shadow_transmittance(m, r));
+    if t == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    rays.shadow += 1;
+    if ctx.scene.occluded(r.origin, r.direction, r.t_max) {
+        Vec3::ZERO
+    } else {
+        r.contribution * t
+    }
 }
 
 /// Direct light from the delta lights alone (point, spot, directional) at a surface that camera
@@ -181,11 +205,9 @@ pub fn weighted_direct_light(
 /// light, and the other lights are found as emission along the sampled path.
 pub fn delta_light(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler, rays: &mut RayCounts) -> Vec3 {
     let mut sum = Vec3::ZERO;
+    let scene = ctx.scene;
     direct_light_rays(ctx, sp, bsdf, wo, s, true, &Strategies::LightOnly, |r| {
-        rays.shadow += 1;
-        if !ctx.scene.occluded(r.origin, r.direction, r.t_max) {
-            sum += r.contribution;
-        }
+        sum += unblocked(ctx, scene.filling_medium_toward(sp.tri, r.direction), &r, rays);
     });
     sum
 }

@@ -118,6 +118,9 @@ pub fn lobe_ray(
             let sky = lobe_escape(ctx, &receiver(y, bsdf, wo), dir, bounces, density);
             Found { radiance: ray.weight * beta * sky, bias: Vec3::ZERO }
         }
+        Chain::Medium(end) => {
+            Found { radiance: ray.weight * super::volume::gather_in_medium(ctx, &end, rays, scratch), bias: Vec3::ZERO }
+        }
         Chain::Lost => Found::default(),
     }
 }

@@ -1,5 +1,6 @@
-//! The photon maps of one render: the global and caustic trees, and the irradiance
-//! precomputed at global photons for final gathering (Christensen 1999).
+//! The photon maps of one render: the global and caustic trees, the volume maps of a medium
+//! filling the scene, and the irradiance precomputed at global photons for final gathering
+//! (Christensen 1999).
 
 use super::estimate::{complete_off_plane, photon_visibility};
 use crate::job::Job;
@@ -20,6 +21,23 @@ pub struct PhotonMaps {
     /// Irradiance at every [`IRRADIANCE_STRIDE`]-th global photon (`power` holds E); empty unless
     /// `precompute_irradiance` is on.
     pub irradiance: PhotonMap,
+    /// The global pass's photons stored in the medium filling the scene (a volume map:
+    /// [`crate::photon_map::Filter::volume`]); empty without one.
+    pub volume: PhotonMap,
+    /// The caustic pass's photons stored in the medium: volumetric caustics (`LS+V`).
+    pub volume_caustic: PhotonMap,
+}
+
+/// Splits a pass's photons into those on surfaces and those in the medium
+/// ([`flags::VOLUME`], cleared here), each in the order they were stored.
+#[must_use]
+pub fn split_volume(photons: Vec<Photon>) -> (Vec<Photon>, Vec<Photon>) {
+    if !photons.iter().any(|p| p.flags & flags::VOLUME != 0) {
+        return (photons, Vec::new());
+    }
+    let (volume, surface): (Vec<Photon>, Vec<Photon>) = photons.into_iter().partition(|p| p.flags & flags::VOLUME != 0);
+    let volume = volume.into_iter().map(|p| Photon { flags: p.flags & !flags::VOLUME, ..p }).collect();
+    (surface, volume)
 }
 
 /// Irradiance is precomputed at every this-many-th global photon (Christensen 1999 used 4).
@@ -30,10 +48,17 @@ impl PhotonMaps {
     /// (and is not a progressive pass), the irradiance map.
     #[must_use]
     pub fn build(scene: &Scene, job: &Job, global: Vec<Photon>, caustic: Vec<Photon>) -> Self {
+        let ((global, volume), (caustic, volume_caustic)) = (split_volume(global), split_volume(caustic));
         // One after the other, each on every thread (its root's subtrees at once): two trees
         // side by side kept at most two threads busy, and only while the smaller lasted.
-        let (global, caustic) = (PhotonMap::build_on(global, job.threads), PhotonMap::build_on(caustic, job.threads));
-        let mut maps = PhotonMaps { global, caustic, irradiance: PhotonMap::default() };
+        let build = |photons| PhotonMap::build_on(photons, job.threads);
+        let mut maps = PhotonMaps {
+            global: build(global),
+            caustic: build(caustic),
+            irradiance: PhotonMap::default(),
+            volume: build(volume),
+            volume_caustic: build(volume_caustic),
+        };
         // Not under a progressive pass's fixed radii: reading the nearest precomputed point is
         // biased low there (see `precompute_irradiance`).
         if job.plan.final_gather.on

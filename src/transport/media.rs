@@ -1,5 +1,5 @@
 //! Light in a scene-filling participating medium ([`crate::medium`]), for the path tracer:
-//! the transmittance of shadow rays, direct light at a surface attenuated by the medium, and
+//! direct light at a surface attenuated by the medium ([`super::direct::unblocked`]), and
 //! the light a medium point scatters toward the camera path (in-scattering by light sampling
 //! through the phase function, weighted by MIS against the phase function's own sample).
 //!
@@ -7,10 +7,10 @@
 //! two-sided [`Receiver`] whose normal is the path's direction), so light choice and the MIS
 //! densities are those of [`super::direct`] and [`super::mis`] for that receiver.
 //!
-//! Reads the scene's lights and medium; writes radiance. The photon-mapping engines do not use
-//! it yet: a scene with a medium is refused there (`crate::engine::check_planned`).
+//! Reads the scene's lights and medium; writes radiance. The reference photon mapper uses the
+//! in-scattering for its single scattering ([`super::volume`]).
 
-use super::direct::{direct_light_rays, light_sample_density, light_samples, shadow_segment, ShadowRay};
+use super::direct::{direct_light_rays, light_sample_density, light_samples, shadow_segment, unblocked, ShadowRay};
 use super::mis::{power_heuristic, Strategies};
 use super::Context;
 use crate::material::Bsdf;
@@ -19,14 +19,6 @@ use crate::rng::Sampler;
 use crate::scene::{Receiver, SurfacePoint};
 use crate::stats::RayCounts;
 use glam::Vec3;
-
-/// The fraction of a shadow ray's light the medium lets through over its length (the whole
-/// ray for a distant light: none where σ_t > 0).
-#[must_use]
-pub fn shadow_transmittance(medium: &Medium, ray: &ShadowRay) -> Vec3 {
-    let length = if ray.t_max.is_finite() { ray.direction.length() * ray.t_max } else { f32::INFINITY };
-    medium.transmittance(length)
-}
 
 /// Direct light at `sp` toward `wo` by light sampling, each unblocked shadow ray's
 /// contribution times the transmittance of the medium it travels in, `medium_toward` its
@@ -44,24 +36,10 @@ pub fn attenuated_direct_light<'m>(
     rays: &mut RayCounts,
 ) -> Vec3 {
     let mut sum = Vec3::ZERO;
-    direct_light_rays(ctx, sp, bsdf, wo, s, false, mis, |r| sum += through(ctx, medium_toward(r.direction), &r, rays));
+    direct_light_rays(ctx, sp, bsdf, wo, s, false, mis, |r| {
+        sum += unblocked(ctx, medium_toward(r.direction), &r, rays)
+    });
     sum
-}
-
-/// What shadow ray `r` carries through `medium` (none: clear): its contribution times the
-/// transmittance along it, if nothing blocks it (no ray is traced where the medium lets
-/// nothing through).
-fn through(ctx: &Context, medium: Option<&Medium>, r: &ShadowRay, rays: &mut RayCounts) -> Vec3 {
-    let t = medium.map_or(Vec3::ONE, |m| shadow_transmittance(m, r));
-    if t == Vec3::ZERO {
-        return Vec3::ZERO;
-    }
-    rays.shadow += 1;
-    if ctx.scene.occluded(r.origin, r.direction, r.t_max) {
-        Vec3::ZERO
-    } else {
-        r.contribution * t
-    }
 }
 
 /// The receiver light sampling works for at medium point `p` reached along unit `d`.
@@ -96,7 +74,7 @@ pub fn in_scattered_light(
         }
         let (direction, t_max) = shadow_segment(p, inc);
         let ray = ShadowRay { origin: p, direction, t_max, contribution: inc.value * (f * w * weight) };
-        sum += through(ctx, Some(medium), &ray, rays);
+        sum += unblocked(ctx, Some(medium), &ray, rays);
     });
     sum
 }

@@ -8,8 +8,8 @@
 //! - [`photon`]: photon emission, deposit, scattering and the exact-count emission tally;
 //! - [`direct`]: direct light by light sampling (shadow rays);
 //! - [`mis`]: multiple importance sampling of emitters, light samples against BSDF samples;
-//! - [`media`]: light in a scene-filling medium (shadow-ray transmittance, in-scattering), for
-//!   the path tracer;
+//! - [`media`]: light in a scene-filling medium (shadow-ray transmittance, in-scattering);
+//! - [`volume`]: the volume maps' estimate, and what camera-side rays find in the medium;
 //! - [`gather`]: final-gather and glossy ray generation, and where the secondary gather applies;
 //! - [`estimate`]: photon-map density estimates at a surface point;
 //! - [`lobe`]: where gather and glossy rays land on a narrow lobe, its own ray;
@@ -34,6 +34,7 @@ pub mod photon;
 pub mod specular;
 pub mod streams;
 pub mod tally;
+pub mod volume;
 
 pub use maps::PhotonMaps;
 

@@ -22,11 +22,19 @@
 //! count in the emitted total). Paths are emitted in fixed batches of [`BATCH`] until the map
 //! holds its target, so the photon set is the same at any thread count and in every engine.
 //! Stored power = Φ-weighted path power divided by the number of paths emitted.
+//!
+//! In a medium filling the scene (Jensen and Christensen 1998), every segment samples its first
+//! interaction by free flight ([`photon_flight`]); a photon that interacts there scatters by the
+//! phase function and is stored as a volume photon ([`deposit_in_medium`]), one that passes
+//! reaches the surface with the free flight's weight. The volume photons travel in the same
+//! list as the surface ones, flagged [`flags::VOLUME`], so the tally counts them toward the
+//! map's target like any other; [`super::PhotonMaps::build`] sorts them into the volume maps.
 
 pub use super::tally::{normalise_power, PathCounts, PathEnd, Tally, TracedPhotons, BATCH};
 use crate::geometry::offset::{barycentric_error, offset_ray_origin};
 use crate::job::Job;
 use crate::material::{Bsdf, SurfaceFrame, Transport};
+use crate::medium::{FreeFlight, Medium};
 use crate::photon_map::{flags, Photon};
 use crate::rng::{Domain, Sampler};
 use crate::sampling::Distribution1D;
@@ -182,6 +190,58 @@ pub fn deposit_photon(
     !caustic
 }
 
+/// Samples where photon `photon` of stream `s` first interacts with `medium` on its segment of
+/// `length` (∞ where it leaves the scene), the segment leading to the path's `bounce`-th vertex:
+/// dimensions 4 (the channel) and 5 (the distance) of bounce `bounce + 1`, which the vertex's
+/// scattering leaves free.
+#[must_use]
+#[inline]
+pub fn photon_flight(s: &Sampler, medium: &Medium, length: f32, bounce: u32) -> FreeFlight {
+    medium.free_flight(length, s.get(bounce + 1, 4), s.get(bounce + 1, 5))
+}
+
+/// At a scattering event at `p` in the medium filling the scene, `photon.power` already
+/// weighted by the free flight (the power that scatters there): stores a volume photon
+/// ([`flags::VOLUME`]) where its map wants it; returns whether the path goes on. The global
+/// pass stores every one, flagged [`flags::DIRECT`] at the path's first vertex and
+/// [`flags::CAUSTIC`] when every surface before was specular (a volumetric caustic, `LS+V`);
+/// the caustic pass stores only those and ends its path at the event.
+pub fn deposit_in_medium(domain: Domain, p: Vec3, photon: &PhotonRay, bounce: u32, out: &mut Vec<Photon>) -> bool {
+    if photon.power == Vec3::ZERO {
+        // A channel-mixture flight that scattered where σ_s is 0 in every channel it carries.
+        return false;
+    }
+    let caustic = photon.specular_only && bounce > 0;
+    let mut f = flags::VOLUME;
+    if bounce == 0 {
+        f |= flags::DIRECT;
+    }
+    if caustic {
+        f |= flags::CAUSTIC;
+    }
+    if domain != Domain::CausticPhoton || caustic {
+        out.push(Photon { position: p, power: photon.power, wi: -photon.dir, normal: flags::VOLUME_NORMAL, flags: f });
+    }
+    domain != Domain::CausticPhoton
+}
+
+/// Scatters a photon at medium point `p` by the phase function of `medium` (sampled exactly,
+/// so the power is unchanged) with the numbers of bounce `bounce + 1` (dims 0–1), then Russian
+/// roulette at the path's emitted power (dim 3), as at a surface.
+#[must_use]
+pub fn scatter_in_medium(s: &Sampler, medium: &Medium, p: Vec3, photon: &PhotonRay, bounce: u32) -> Scattered {
+    let dir = medium.phase().sample(photon.dir, [s.get(bounce + 1, 0), s.get(bounce + 1, 1)]);
+    if !photon.power.is_finite() {
+        return Scattered::NonFinite;
+    }
+    let next = |power| PhotonRay { origin: p, dir, power, emitted: photon.emitted, specular_only: false };
+    match roulette(photon.power, photon.emitted, s.get(bounce + 1, 3)) {
+        Roulette::Absorbed => Scattered::Absorbed,
+        Roulette::Survives(q) => Scattered::Continue(next(q)),
+        Roulette::Capped(q) => Scattered::Capped(next(q)),
+    }
+}
+
 /// What scattering did to a photon.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Scattered {
@@ -283,19 +343,39 @@ pub fn trace_path(scene: &Scene, job: &Job, domain: Domain, index: u64, out: &mu
     let s = Sampler::new(job.pass.seed, domain, index);
     for bounce in 0..job.settings.max_depth {
         counts.ray();
-        let Some(hit) = scene.intersect(photon.origin, photon.dir, f32::INFINITY) else {
-            if scene.encloses_lights {
-                counts.end = PathEnd::Escaped;
+        let hit = scene.intersect(photon.origin, photon.dir, f32::INFINITY);
+        let mut in_medium = None;
+        if let Some(medium) = scene.filling_medium(hit.as_ref(), photon.dir) {
+            let length = hit.map_or(f32::INFINITY, |h| h.t);
+            match photon_flight(&s, medium, length, bounce) {
+                FreeFlight::Scatter { distance, weight } => {
+                    photon.power *= weight;
+                    in_medium = Some((medium, photon.origin + photon.dir * distance));
+                }
+                FreeFlight::Pass { weight } => photon.power *= weight,
             }
-            return counts;
-        };
-        photon.power *= scene.interior_transmittance(&hit, photon.dir);
-        let sp = scene.surface(&hit);
-        let bsdf = scene.bsdf(&sp);
-        if !bsdf.is_delta() && !deposit_photon(domain, &sp, &bsdf, &photon, bounce, out) {
-            return counts;
         }
-        match scatter_photon(&s, &sp, &bsdf, &photon, bounce) {
+        let scattered = if let Some((medium, p)) = in_medium {
+            if !deposit_in_medium(domain, p, &photon, bounce, out) {
+                return counts;
+            }
+            scatter_in_medium(&s, medium, p, &photon, bounce)
+        } else {
+            let Some(hit) = hit else {
+                if scene.encloses_lights {
+                    counts.end = PathEnd::Escaped;
+                }
+                return counts;
+            };
+            photon.power *= scene.interior_transmittance(&hit, photon.dir);
+            let sp = scene.surface(&hit);
+            let bsdf = scene.bsdf(&sp);
+            if !bsdf.is_delta() && !deposit_photon(domain, &sp, &bsdf, &photon, bounce, out) {
+                return counts;
+            }
+            scatter_photon(&s, &sp, &bsdf, &photon, bounce)
+        };
+        match scattered {
             Scattered::Continue(next) => photon = next,
             Scattered::Capped(next) => {
                 counts.capped += 1;

@@ -1,10 +1,11 @@
 //! Ray continuation: a ray leaving a surface by sampling its BSDF, the chain of mirrors and
-//! glass a camera-side ray follows to its first non-specular hit, and emission seen along a
-//! ray.
+//! glass a camera-side ray follows to its first non-specular hit (or, in a medium filling the
+//! scene, to where its free flight stops), and emission seen along a ray.
 
 use super::Context;
 use crate::geometry::offset::offset_ray_origin;
 use crate::material::{Bsdf, Transport};
+use crate::medium::{FreeFlight, Medium};
 use crate::rng::Sampler;
 use crate::scene::{Scene, SurfacePoint};
 use crate::stats::RayCounts;
@@ -103,13 +104,52 @@ pub enum Chain {
         /// Mirrors and glass on the way.
         bounces: u32,
     },
+    /// Stopped in the medium filling the scene (its free flight scattered there).
+    Medium(MediumEnd),
     /// Absorbed, ended by roulette, or cut at `max_depth` (counted in the context).
     Lost,
 }
 
+/// Where a chain's free flight stopped in the medium filling the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct MediumEnd {
+    /// The point.
+    pub p: Vec3,
+    /// Direction of the segment arriving there.
+    pub dir: Vec3,
+    /// Throughput of the chain, the free flight's weight (σ_s·T/pdf) included.
+    pub beta: Vec3,
+    /// The medium.
+    pub medium: Medium,
+    /// Mirrors and glass on the way.
+    pub bounces: u32,
+}
+
+/// Free flight along a camera-side segment from `o` along unit `d` to `hit` (or to infinity)
+/// in the medium filling the scene, if the segment lies in it, with dimensions 4 (the
+/// channel) and 5 (the distance) of `s`'s bounce `bounce`: `Err` with the point where it
+/// scatters and the flight's weight, or `Ok` with the weight of passing (1 outside a medium).
+#[inline]
+pub fn segment_flight(
+    scene: &Scene,
+    o: Vec3,
+    d: Vec3,
+    hit: Option<&crate::geometry::Hit>,
+    s: &Sampler,
+    bounce: u32,
+) -> Result<Vec3, (Medium, Vec3, Vec3)> {
+    let Some(medium) = scene.filling_medium(hit, d) else { return Ok(Vec3::ONE) };
+    let length = hit.map_or(f32::INFINITY, |h| h.t);
+    match medium.free_flight(length, s.get(bounce, 4), s.get(bounce, 5)) {
+        FreeFlight::Scatter { distance, weight } => Err((*medium, o + d * distance, weight)),
+        FreeFlight::Pass { weight } => Ok(weight),
+    }
+}
+
 /// Follows a ray through mirrors and glass (at most `max_depth` bounces, sampling each with `s`
 /// at bounce `first_bounce + depth`, [`continue_chain`]'s roulette included) to its first
-/// non-specular hit, or out of the scene. It also passes what photons pass
+/// non-specular hit, out of the scene, or, in a medium filling the scene, to where its free
+/// flight stops ([`segment_flight`] with the same bounce). It also passes what photons pass
 /// ([`Bsdf::photon_specular`]: frosted glass, smooth rough metal), sampling their BSDF: every
 /// path ends where photons are stored, so the maps read there hold the light that came through.
 pub fn follow_chain(
@@ -124,7 +164,14 @@ pub fn follow_chain(
     let mut beta = Vec3::ONE;
     for depth in 0..=ctx.settings.max_depth {
         rays.gather += 1;
-        let Some(hit) = scene.intersect(o, d, f32::INFINITY) else {
+        let hit = scene.intersect(o, d, f32::INFINITY);
+        match segment_flight(scene, o, d, hit.as_ref(), s, first_bounce + depth) {
+            Ok(weight) => beta *= weight,
+            Err((medium, p, weight)) => {
+                return Chain::Medium(MediumEnd { p, dir: d, beta: beta * weight, medium, bounces: depth });
+            }
+        }
+        let Some(hit) = hit else {
             return Chain::Escaped { dir: d, beta, bounces: depth };
         };
         beta *= scene.interior_transmittance(&hit, d);

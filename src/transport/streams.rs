@@ -29,7 +29,12 @@
 //! free flight of the path tracer's segment `d` (the camera ray is segment 0) draws bounce `d`
 //! dims 4–5 (the channel, the distance); where it scatters, the phase-function sample that
 //! continues the path draws bounce `d + 1` dims 0–1, and its in-scattered light forks
-//! [`path_light`]`(d)`.
+//! [`path_light`]`(d)`. The photon mappers' camera rays draw the same free flight
+//! ([`segment`]) and take single scattering from [`light`]`(d)`; a gather, glossy or lobe ray's
+//! chain segment `c` draws dims 4–5 of the bounce its chain samples at `c` draws dims 0–3 of.
+//! A photon's segment leading to its `b`-th vertex draws bounce `b + 1` dims 4–5; where it
+//! scatters in the medium, the phase function draws bounce `b + 1` dims 0–1 and Russian
+//! roulette dim 3, as at a surface.
 
 /// Tags of the per-hit sub-streams of a camera path (added to the hit's depth).
 const GATHER: u64 = 1 << 32;
@@ -78,6 +83,15 @@ pub const fn gather_ray(g: u32) -> u64 {
 #[must_use]
 pub const fn glossy(depth: u32) -> u64 {
     GLOSSY + depth as u64
+}
+
+/// Bounce of a camera stream whose dimensions 4–5 draw the free flight of the path's segment
+/// `depth` (the camera ray is segment 0) in a medium: the bounce whose dimensions 0–3 the
+/// chain's sample leaving hit `depth − 1` used. The photon-mapping engines' camera rays and the
+/// path tracer draw alike.
+#[must_use]
+pub const fn segment(depth: u32) -> u32 {
+    depth
 }
 
 /// Fork tag of the path tracer's direct light at depth `depth`.
