@@ -78,14 +78,6 @@ pub fn check_planned(job: &Job, scene: &Scene, engine: Engine, progressive: bool
                  render it with `--engine reference` (photon mapping with a volume photon map) or `--engine path`",
             ));
         }
-        if scene.medium.is_some() && progressive {
-            return Err(Error::setting(
-                "--passes",
-                "the scene has a participating medium ([medium]): progressive photon mapping does not shrink the \
-                 volume maps' radii yet; render it in one pass (no --passes, --time or --target-error) or with \
-                 `--engine path`",
-            ));
-        }
     }
     // Refuse what would exhaust memory before any of it is allocated.
     if let Some((available, total)) = crate::memory::machine() {

@@ -94,6 +94,10 @@ pub struct FixedRadii {
     /// The estimates also estimate their bias ([`crate::photon_map::Estimate::bias`]); a
     /// progressive render asks for it in some passes only (`progressive::BIAS_EVERY`).
     pub bias: bool,
+    /// The volume maps' radii (global, caustic) in a medium filling the scene. They shrink by
+    /// the 3-D sequence, r³ᵢ₊₁ = r³ᵢ·(i + α)/(i + 1) (Knaus and Zwicker 2011), so each is its
+    /// first radius times `scale`^(2/3).
+    pub volume: (f32, f32),
 }
 
 /// The first progressive pass's radii per pixel (row-major), in scene units.
@@ -110,7 +114,7 @@ impl FixedRadii {
     /// The same radius everywhere.
     #[must_use]
     pub fn uniform(global: f32, caustic: f32) -> Self {
-        FixedRadii { global, caustic, pixels: None, scale: 1.0, bias: true }
+        FixedRadii { global, caustic, pixels: None, scale: 1.0, bias: true, volume: (global, caustic) }
     }
 
     /// The caustic radius at `pixel`'s camera paths (`None`: anywhere else).

@@ -5,8 +5,8 @@
 //! integral along the camera ray by quadrature; a glass cube of index 1 holding a white
 //! scattering interior keeps the furnace at Le/(1 − ρ) too. The reference photon mapper's volume
 //! photons carry the power an infinite medium scatters, its furnace stays at Le/(1 − ρ), and its
-//! fog-filled Cornell box agrees with the path tracer. Bad media are errors naming the field; the
-//! wavefront engine and progressive photon mapping refuse a scene-filling medium; Mitsuba's
+//! fog-filled Cornell box agrees with the path tracer, in one pass and progressively. Bad media are
+//! errors naming the field; the wavefront engine refuses a scene-filling medium; Mitsuba's
 //! scattering interior media are read whole.
 
 mod common;
@@ -301,10 +301,30 @@ fn bad_media_are_named_and_engines_refuse_what_they_cannot_render() {
     let scene = Arc::new(loaded.scene);
     let e = render(&scene, &rays, &settings, Engine::Wavefront, None, &NoProgress).err().unwrap().to_string();
     assert!(e.contains("--engine") && e.contains("medium") && e.contains("--engine reference"), "{e}");
-    let progressive = Settings { passes: 4, ..settings.clone() };
-    let e = render(&scene, &rays, &progressive, Engine::Reference, None, &NoProgress).err().unwrap().to_string();
-    assert!(e.contains("--passes") && e.contains("medium"), "{e}");
     assert!(render(&scene, &rays, &settings, Engine::Reference, None, &NoProgress).is_ok());
+    // The CLI without --engine renders a medium with the reference engine, and says so.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_photonwave"))
+        .args([
+            "render",
+            "--width",
+            "4",
+            "--height",
+            "4",
+            "--spp",
+            "1",
+            "--photons",
+            "2000",
+            "--caustic-photons",
+            "1000",
+        ])
+        .arg(d.join("fog.toml"))
+        .arg("-o")
+        .arg(d.join("fog.exr"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && stderr.contains("engine: reference"), "{stderr}");
+    assert!(d.join("fog.exr").exists());
     let job = common::job(&scene, &settings);
     assert!(job.plan.media.on && job.plan.media.reason.contains("scattering medium"), "{:?}", job.plan.media);
 }
@@ -427,5 +447,22 @@ fn the_reference_engine_agrees_with_the_path_tracer_in_a_fog_box() {
     let se = (se_photon * se_photon + se_path * se_path).sqrt();
     eprintln!("fog box: photon mapping {photon:.5} ± {se_photon:.5} {photon_means:?}, path tracing {path:.5} ± {se_path:.5} {path_means:?}");
     assert!((photon - path).abs() <= 4.0 * se + 0.01 * path, "{photon} ± {se_photon} against {path} ± {se_path}");
+    assert!(se < 0.015 * path, "the test has no power (SE {se} against {path})");
+    // Progressive passes: fresh maps each pass, the volume radii shrinking by the 3-D sequence
+    // (r³ by (i + α)/(i + 1)), fixed-radius estimates. 3 seeds of 16 passes (2·10⁴ photons and
+    // 4 spp each); same tolerance. Measured at 32² against 4 096 spp: beauty 0.993, 0.994 and
+    // 0.997 of the path tracer's after 4, 16 and 64 passes, relMSE 1.2·10⁻², 3.5·10⁻³, 1.2·10⁻³.
+    let progressive_means: Vec<f32> = (1..4)
+        .map(|seed| {
+            let settings =
+                Settings { width: 24, height: 24, spp: 4, photons: 20_000, passes: 16, seed, ..Settings::default() };
+            let film = render(&shared, &rays, &settings, Engine::Reference, None, &NoProgress).unwrap().0;
+            mean_and_se(&scattered(&film)).0 as f32
+        })
+        .collect();
+    let (progressive, se_progressive) = mean_and_se(&progressive_means);
+    let se = (se_progressive * se_progressive + se_path * se_path).sqrt();
+    eprintln!("fog box, 16 passes: {progressive:.5} ± {se_progressive:.5} {progressive_means:?}");
+    assert!((progressive - path).abs() <= 4.0 * se + 0.01 * path, "{progressive} ± {se_progressive} against {path}");
     assert!(se < 0.015 * path, "the test has no power (SE {se} against {path})");
 }

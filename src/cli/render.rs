@@ -166,9 +166,10 @@ pub struct RenderArgs {
     #[arg(long)]
     pub png: Option<PathBuf>,
     /// Engine: `wavefront` (bevy_ecs stages over SoA queues), `reference` (scalar photon mapper)
-    /// or `path` (unbiased path tracer, for validation).
-    #[arg(long, default_value = "wavefront")]
-    pub engine: Engine,
+    /// or `path` (unbiased path tracer, for validation) [wavefront; reference for a scene filled
+    /// with a participating medium, which the wavefront engine does not render yet].
+    #[arg(long)]
+    pub engine: Option<Engine>,
     /// Amounts of work (spp, photons, gather rays, passes) from a named preset, over the scene
     /// file's settings and under these flags: `preview`, `default`, or `reference` (a long
     /// progressive run to measure other renders against).
@@ -272,7 +273,19 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let rays = camera.prepare(settings.width, settings.height)?;
     let load_s = t0.elapsed().as_secs_f64();
 
-    describe(say, &scene, &job, args.engine);
+    let engine = args.engine.unwrap_or_else(|| {
+        if scene.medium.is_some() {
+            say.info(
+                "engine: reference — the scene is filled with a participating medium, which the wavefront engine \
+                 does not render yet\n"
+                    .to_string(),
+            );
+            Engine::Reference
+        } else {
+            Engine::Wavefront
+        }
+    });
+    describe(say, &scene, &job, engine);
     let bars = Bars::new(args.quiet);
     let budget = args.time.map(|limit| Budget { limit, start: t0 });
     let flags = PassFlags {
@@ -286,7 +299,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     };
     let progressive = photonwave::engine::is_progressive(settings, budget) || flags.any();
     let job = if progressive {
-        if args.engine == Engine::Path {
+        if engine == Engine::Path {
             return Err(Error::setting(
                 "--engine",
                 "progressive passes (--passes, --time, --pass-set) need a photon-mapping engine",
@@ -300,20 +313,20 @@ pub fn run(args: RenderArgs) -> Result<()> {
     };
     let settings = &job.settings;
     let (film, mut stats, signal) = if progressive {
-        photonwave::engine::check_planned(&job, &scene, args.engine, true)?;
+        photonwave::engine::check_planned(&job, &scene, engine, true)?;
         let lights: Vec<String> = args.light.iter().map(|l| format!("{l:?}")).collect();
         let identity = Identity::new(
             &loaded.inputs,
             settings,
             &format!("{camera:?}"),
             &lights,
-            &format!("{:?}", args.engine).to_lowercase(),
+            &format!("{engine:?}").to_lowercase(),
         )?;
-        let setup = Setup { scene: &scene, rays: &rays, job: &job, engine: args.engine, budget, t0, identity };
+        let setup = Setup { scene: &scene, rays: &rays, job: &job, engine, budget, t0, identity };
         let r = super::passes::render(&setup, &flags, &bars, say)?;
         (r.film, r.stats, r.signal)
     } else {
-        let (film, stats) = photonwave::engine::render_planned(&scene, &rays, &job, args.engine, budget, &bars)?;
+        let (film, stats) = photonwave::engine::render_planned(&scene, &rays, &job, engine, budget, &bars)?;
         film.write_exr(&args.output)?;
         (film, stats, None)
     };

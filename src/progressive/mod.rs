@@ -128,12 +128,15 @@ impl Progressive {
     /// The radii of pass `i`.
     pub fn radii(&mut self, i: u32) -> FixedRadii {
         let s = self.sums.scale2(i).sqrt() as f32;
+        // Volume radii shrink as the cube root of the product whose square root the surfaces' do.
+        let v = s.powf(2.0 / 3.0);
         FixedRadii {
             global: self.first.global * s,
             caustic: self.first.caustic * s,
             pixels: self.first.pixels.clone(),
             scale: s,
             bias: estimates_bias(i),
+            volume: (self.first.volume.0 * v, self.first.volume.1 * v),
         }
     }
 

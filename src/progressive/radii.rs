@@ -42,6 +42,25 @@ pub fn pass_seed(seed: u64, i: u32) -> u64 {
 /// empty map or when no sampled photon has k neighbours within `r_max`.
 #[must_use]
 pub fn median_knn_radius(map: &PhotonMap, k: u32, r_max: f32, code_path: CodePath) -> Option<f32> {
+    median_radius_with(map, k, r_max, code_path, |p| Filter::at(p.position, p.normal, 0))
+}
+
+/// [`median_knn_radius`] in a volume map: each photon's k nearest in 3-D
+/// ([`Filter::volume`]).
+#[must_use]
+pub fn median_volume_radius(map: &PhotonMap, k: u32, r_max: f32, code_path: CodePath) -> Option<f32> {
+    median_radius_with(map, k, r_max, code_path, |_| Filter::volume(0))
+}
+
+/// The median k-nearest radius over the sampled photons of `map`, each searched with the
+/// filter `filter` gives it.
+fn median_radius_with(
+    map: &PhotonMap,
+    k: u32,
+    r_max: f32,
+    code_path: CodePath,
+    filter: impl Fn(&crate::photon_map::Photon) -> Filter,
+) -> Option<f32> {
     if map.is_empty() {
         return None;
     }
@@ -51,13 +70,7 @@ pub fn median_knn_radius(map: &PhotonMap, k: u32, r_max: f32, code_path: CodePat
         .step_by(step)
         .filter_map(|i| {
             let p = map.photon(i);
-            let q = Lookup {
-                p: p.position,
-                k: k as usize,
-                r_max,
-                kernel: Kernel::Box,
-                filter: Filter::at(p.position, p.normal, 0),
-            };
+            let q = Lookup { p: p.position, k: k as usize, r_max, kernel: Kernel::Box, filter: filter(&p) };
             let found = map.nearest(code_path, &q, &mut scratch);
             (found.len() == k as usize).then(|| found.iter().map(|c| c.0).fold(0.0, f32::max).sqrt())
         })
@@ -106,7 +119,14 @@ pub fn initial_radii(scene: &Scene, rays: &CameraRays, job: &Job) -> FixedRadii 
     );
     // The pixels' first radii follow the first pass's camera samples: `job`'s own seed.
     let pixels = settings.per_pixel_radii.then(|| Arc::new(pixel_radii(scene, rays, job, &maps, &uniform)));
-    FixedRadii { pixels, ..uniform }
+    // The volume maps' first radii: the median over their photons (the camera's medium points
+    // are spread through the medium as the photons are), else the surface maps' maximum radii.
+    let volume = (
+        median_volume_radius(&maps.volume, settings.k, r_global, settings.code_path).unwrap_or(r_global),
+        median_volume_radius(&maps.volume_caustic, settings.caustic_k, r_caustic, settings.code_path)
+            .unwrap_or(r_caustic),
+    );
+    FixedRadii { pixels, volume, ..uniform }
 }
 
 /// The median k-nearest radius of each map where the camera reads it: the caustic map at each

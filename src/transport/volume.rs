@@ -7,7 +7,8 @@
 //! x those photons sum, in expectation, to σ_s·∫ L dω per unit volume, so the radiance x
 //! scatters toward −d is
 //! `σ_s·∫ p(ω', d)·L(ω') dω' ≈ Σ p(θ_p)·Φ_p / (4/3·π·r³)`: the surface estimate's sum (over the
-//! disk πr², box kernel, the k − 1 form) times πr² / (4/3·πr³) = 3 / (4r). The functions here
+//! disk πr², box kernel, the k − 1 form, or every photon within a progressive pass's fixed
+//! radius) times πr² / (4/3·πr³) = 3 / (4r). The functions here
 //! return it per unit σ_s, as light sampling's in-scattering does
 //! ([`super::media::in_scattered_light`]): the free flight's weight carries σ_s.
 //!
@@ -33,8 +34,9 @@ use crate::stats::RayCounts;
 use glam::Vec3;
 
 /// The radiance a point of `medium` at `p`, reached along unit `d`, scatters back along −d per
-/// unit σ_s, by the k-nearest volume estimate in `map` (within `r_max`) over the photons that
-/// carry none of `mask`'s flags.
+/// unit σ_s, by the volume estimate in `map` over the photons that carry none of `mask`'s flags:
+/// `search` = (k, r) the k nearest within r, or (0, r) every photon within the fixed radius r (a
+/// progressive pass's).
 /// With `walls` ([`Walls`] around `p`), the sphere's volume is what of it lies in the medium.
 #[allow(clippy::too_many_arguments)]
 #[must_use]
@@ -55,7 +57,8 @@ pub fn volume_estimate(
     let phase = medium.phase();
     let f = |wi: Vec3| Vec3::splat(phase.eval(d, wi));
     let lookup = Lookup { p, k: k as usize, r_max, kernel: Kernel::Box, filter: Filter::volume(mask) };
-    let e = map.estimate(ctx.settings.code_path, &lookup, Reflectance::PerPhoton(&f), scratch);
+    let (set, f) = (ctx.settings.code_path, Reflectance::PerPhoton(&f));
+    let e = if k == 0 { map.estimate_radius(set, &lookup, f) } else { map.estimate(set, &lookup, f, scratch) };
     if !(e.radius > 0.0) {
         return Vec3::ZERO;
     }
@@ -63,6 +66,15 @@ pub fn volume_estimate(
     // the medium, where its walls are known).
     let open = walls.map_or(1.0, |w| w.open_fraction(e.radius));
     per_unit_scattering(e.radiance * (3.0 / (4.0 * e.radius * open)), medium)
+}
+
+/// The searches of the global and the caustic volume map: (k, maximum radius) from the settings,
+/// or under a progressive pass (0, its fixed volume radius).
+fn searches(ctx: &Context) -> ((u32, f32), (u32, f32)) {
+    match ctx.fixed {
+        Some(f) => ((0, f.volume.0), (0, f.volume.1)),
+        None => ((ctx.settings.k, ctx.global_radius), (ctx.settings.caustic_k, ctx.caustic_radius)),
+    }
 }
 
 /// Lebedev's 14-point rule on the sphere, exact for polynomials to degree 5: the 6 axes,
@@ -92,8 +104,8 @@ const RULE: [([f32; 3], f32); 14] = {
 /// leaves 1/8; below this the rule's error on a point hard against walls would dominate.
 const OPEN_MIN: f32 = 0.1;
 
-/// How far the surfaces around a medium point lie, along [`RULE`]'s 14 directions (up to a
-/// bound): the medium's share of any sphere about the point no larger than the bound. A
+/// How far the surfaces around a medium point lie, along the 14 directions of Lebedev's rule (up
+/// to a bound): the medium's share of any sphere about the point no larger than the bound. A
 /// k-nearest volume estimate divides its photons by its sphere's volume, but within a radius of
 /// a wall part of the sphere lies behind the wall, where no photon can be: at a plane wall the
 /// estimate reads half. Rays from the point find the region in the medium, star-shaped about
@@ -120,7 +132,7 @@ impl Walls {
     }
 
     /// The share of the sphere of radius `r` about the point that lies in the medium (1 with no
-    /// surface within it; at least [`OPEN_MIN`]).
+    /// surface within it; at least `OPEN_MIN`).
     #[must_use]
     pub fn open_fraction(&self, r: f32) -> f32 {
         let f: f32 = self.distance.iter().zip(RULE).map(|(&t, (_, w))| w * (t.min(r) / r).powi(3)).sum();
@@ -161,13 +173,11 @@ pub fn camera_in_medium(
     rays: &mut RayCounts,
     scratch: &mut Nearest,
 ) -> InMedium {
-    let settings = ctx.settings;
     let direct = single_scattering(ctx, medium, p, d, s, u, rays);
-    let walls = Walls::find(ctx, p, ctx.global_radius.max(ctx.caustic_radius), rays);
+    let (global, caustic) = searches(ctx);
+    let walls = Walls::find(ctx, p, global.1.max(caustic.1), rays);
     let (maps, w) = (ctx.maps, Some(&walls));
-    let caustic_search = (settings.caustic_k, ctx.caustic_radius);
-    let caustic = volume_estimate(ctx, &maps.volume_caustic, medium, p, d, caustic_search, 0, w, scratch);
-    let global = (settings.k, ctx.global_radius);
+    let caustic = volume_estimate(ctx, &maps.volume_caustic, medium, p, d, caustic, 0, w, scratch);
     let indirect = volume_estimate(ctx, &maps.volume, medium, p, d, global, flags::OWN_TERMS, w, scratch);
     InMedium { direct, caustic, indirect }
 }
@@ -205,8 +215,8 @@ pub fn single_scattering(
 /// The radiance a gather or glossy ray finds where its chain stopped in the medium (`end`),
 /// its chain's throughput included: the whole global volume map's estimate.
 pub fn gather_in_medium(ctx: &Context, end: &MediumEnd, rays: &mut RayCounts, scratch: &mut Nearest) -> Vec3 {
-    let global = (ctx.settings.k, ctx.global_radius);
-    let walls = Walls::find(ctx, end.p, ctx.global_radius, rays);
+    let (global, _) = searches(ctx);
+    let walls = Walls::find(ctx, end.p, global.1, rays);
     end.beta * volume_estimate(ctx, &ctx.maps.volume, &end.medium, end.p, end.dir, global, 0, Some(&walls), scratch)
 }
 
