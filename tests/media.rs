@@ -373,8 +373,8 @@ fn volume_photons_carry_what_an_infinite_medium_scatters() {
 #[test]
 fn the_reference_engine_keeps_the_white_furnace() {
     // The white-medium furnace above (walls Le 1, ρ 0.5, albedo 1, g 0.6) in the reference
-    // photon mapper: camera rays stop in the medium by free flight and take single scattering
-    // by light sampling and the rest from the volume map; final-gather rays that stop there read
+    // photon mapper: camera rays march the medium and take single scattering by light sampling
+    // and the rest from the volume map; final-gather rays that stop there by free flight read
     // the whole volume map. The radiance is 2 everywhere, so the density estimates have no
     // gradient to blur, but near a wall a k-nearest sphere reaches out of the box and reads low.
     // Each seed's photon maps are shared by its pixels, so the seeds, not the pixels, are the
@@ -388,7 +388,7 @@ fn the_reference_engine_keeps_the_white_furnace() {
     let shared = Arc::new(loaded.scene);
     let means: Vec<f32> = (1..9)
         .map(|seed| {
-            let settings = Settings { width: 16, height: 16, spp: 64, photons: 200_000, seed, ..Settings::default() };
+            let settings = Settings { width: 16, height: 16, spp: 16, photons: 200_000, seed, ..Settings::default() };
             let film = render(&shared, &rays, &settings, Engine::Reference, None, &NoProgress).unwrap().0;
             let (mean, _) = mean_and_se(&common::grey(&film));
             mean as f32
@@ -415,8 +415,8 @@ fn the_reference_engine_agrees_with_the_path_tracer_in_a_fog_box() {
     // a small image's mean). The path tracer (4 seeds of 128 spp) is unbiased. The photon
     // mapper's volume estimates divide by the part of their sphere in the fog (`Walls`): at
     // 10⁵ photons r ≈ 4 cm, and a third of the box's volume lies within that of a wall. Measured
-    // at 32² over 4 seeds against 4 096 spp: direct layer 0.998 of the path tracer's, indirect
-    // 1.001 (0.970 with every sphere taken as whole). Each seed's maps are shared by its
+    // at 32² over 4 seeds against 4 096 spp (camera rays by free flight then): direct layer
+    // 0.998 of the path tracer's, indirect 1.001 (0.970 with every sphere taken as whole). Each seed's maps are shared by its
     // pixels, so each side's mean is taken over its seeds with their spread as its standard
     // error; tolerance 4 standard errors of the difference plus 1 % for the estimates' blur of
     // the lamp's gradients.
@@ -431,7 +431,7 @@ fn the_reference_engine_agrees_with_the_path_tracer_in_a_fog_box() {
     let shared = Arc::new(loaded.scene);
     let photon_means: Vec<f32> = (1..7)
         .map(|seed| {
-            let settings = Settings { width: 24, height: 24, spp: 64, photons: 100_000, seed, ..Settings::default() };
+            let settings = Settings { width: 24, height: 24, spp: 16, photons: 100_000, seed, ..Settings::default() };
             let film = render(&shared, &rays, &settings, Engine::Reference, None, &NoProgress).unwrap().0;
             mean_and_se(&scattered(&film)).0 as f32
         })
@@ -450,12 +450,13 @@ fn the_reference_engine_agrees_with_the_path_tracer_in_a_fog_box() {
     assert!(se < 0.015 * path, "the test has no power (SE {se} against {path})");
     // Progressive passes: fresh maps each pass, the volume radii shrinking by the 3-D sequence
     // (r³ by (i + α)/(i + 1)), fixed-radius estimates. 3 seeds of 16 passes (2·10⁴ photons and
-    // 4 spp each); same tolerance. Measured at 32² against 4 096 spp: beauty 0.993, 0.994 and
-    // 0.997 of the path tracer's after 4, 16 and 64 passes, relMSE 1.2·10⁻², 3.5·10⁻³, 1.2·10⁻³.
+    // 2 spp each); same tolerance. Measured at 32² against 4 096 spp (4 spp a pass, camera rays
+    // by free flight then): beauty 0.993, 0.994 and 0.997 of the path tracer's after 4, 16 and
+    // 64 passes, relMSE 1.2·10⁻², 3.5·10⁻³, 1.2·10⁻³.
     let progressive_means: Vec<f32> = (1..4)
         .map(|seed| {
             let settings =
-                Settings { width: 24, height: 24, spp: 4, photons: 20_000, passes: 16, seed, ..Settings::default() };
+                Settings { width: 24, height: 24, spp: 2, photons: 20_000, passes: 16, seed, ..Settings::default() };
             let film = render(&shared, &rays, &settings, Engine::Reference, None, &NoProgress).unwrap().0;
             mean_and_se(&scattered(&film)).0 as f32
         })

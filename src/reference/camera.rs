@@ -27,8 +27,8 @@ use crate::transport::estimate::{camera_indirect_estimate, caustic_estimate, ind
 use crate::transport::gather::{glossy_density, glossy_ray, lands_near, trace_gather_rays};
 use crate::transport::lobe::{gather_landing, lobe_escape, lobe_ray, Found};
 use crate::transport::mis::{emission_found, receiver, sky_found, Strategies};
-use crate::transport::specular::{continue_chain, emission_toward, follow_chain, segment_flight, Chain, ChainEnd};
-use crate::transport::volume::{camera_in_medium, gather_in_medium};
+use crate::transport::specular::{continue_chain, emission_toward, follow_chain, Chain, ChainEnd};
+use crate::transport::volume::{gather_in_medium, march_camera_segment};
 use crate::transport::{streams, Context, PhotonMaps};
 use glam::Vec3;
 
@@ -66,18 +66,18 @@ pub fn trace_camera_path(
     for depth in 0..=ctx.settings.max_depth {
         rays.camera += 1;
         let hit = scene.intersect(o, d, f32::INFINITY);
-        // In a medium filling the scene the segment's free flight may stop short of the hit:
-        // the light the medium scatters there, by term (`transport::volume`).
-        match segment_flight(scene, o, d, hit.as_ref(), s, streams::segment(depth)) {
-            Ok(weight) => beta *= weight,
-            Err((medium, p, weight)) => {
-                // The phase-function sample draws where the chain's next bounce would.
-                let u = [s.get(depth + 1, 0), s.get(depth + 1, 1)];
-                let l = camera_in_medium(ctx, &medium, p, d, &s.fork(streams::light(depth)), u, rays, scratch);
-                let w = beta * weight;
-                terms.add(Term::Direct.seen(through_specular), w * l.direct);
-                terms.add(Term::Caustic.seen(through_specular), w * l.caustic);
-                terms.add(Term::Indirect.seen(through_specular), w * l.indirect);
+        // In a medium filling the scene: the light the medium scatters toward the camera along
+        // the segment, by term, and the transmittance to what lies beyond (`transport::volume`).
+        if let Some(medium) = scene.filling_medium(hit.as_ref(), d) {
+            let length = hit.map_or(f32::INFINITY, |h| h.t);
+            let light = s.fork(streams::light(depth));
+            let stream = (s, streams::segment(depth));
+            let l = march_camera_segment(ctx, medium, o, d, length, stream, &light, rays, scratch);
+            terms.add(Term::Direct.seen(through_specular), beta * l.direct);
+            terms.add(Term::Caustic.seen(through_specular), beta * l.caustic);
+            terms.add(Term::Indirect.seen(through_specular), beta * l.indirect);
+            beta *= medium.transmittance(length);
+            if beta == Vec3::ZERO {
                 break;
             }
         }

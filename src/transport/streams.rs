@@ -29,8 +29,9 @@
 //! free flight of the path tracer's segment `d` (the camera ray is segment 0) draws bounce `d`
 //! dims 4–5 (the channel, the distance); where it scatters, the phase-function sample that
 //! continues the path draws bounce `d + 1` dims 0–1, and its in-scattered light forks
-//! [`path_light`]`(d)`. The photon mappers' camera rays draw the same free flight
-//! ([`segment`]) and take single scattering from [`light`]`(d)`; a gather, glossy or lobe ray's
+//! [`path_light`]`(d)`. The photon mappers' camera segment `d` draws its marching points'
+//! channel and stratum at [`segment`]`(d)` dims 4–5, and point `i` its single scattering from
+//! [`light`]`(d)` forked by `i` (the phase sample at bounce 0, dims 3–4); a gather, glossy or lobe ray's
 //! chain segment `c` draws dims 4–5 of the bounce its chain samples at `c` draws dims 0–3 of.
 //! A photon's segment leading to its `b`-th vertex draws bounce `b + 1` dims 4–5; where it
 //! scatters in the medium, the phase function draws bounce `b + 1` dims 0–1 and Russian
@@ -85,10 +86,10 @@ pub const fn glossy(depth: u32) -> u64 {
     GLOSSY + depth as u64
 }
 
-/// Bounce of a camera stream whose dimensions 4–5 draw the free flight of the path's segment
-/// `depth` (the camera ray is segment 0) in a medium: the bounce whose dimensions 0–3 the
-/// chain's sample leaving hit `depth − 1` used. The photon-mapping engines' camera rays and the
-/// path tracer draw alike.
+/// Bounce of a camera stream whose dimensions 4–5 draw the path's segment `depth` in a medium
+/// (the camera ray is segment 0): the bounce whose dimensions 0–3 the chain's sample leaving
+/// hit `depth − 1` used. The path tracer's free flight and the photon mappers' marching points
+/// draw there.
 #[must_use]
 pub const fn segment(depth: u32) -> u32 {
     depth
