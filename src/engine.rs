@@ -66,7 +66,7 @@ pub fn render(
 
 /// Refuses what `job` cannot render with `engine` (progressively or not): a map the plan needs
 /// left empty, more memory than the machine has (before any of it is allocated), diagnostics
-/// from the path tracer, a participating medium in a photon-mapping engine.
+/// from the path tracer, a medium filling the scene in the wavefront engine.
 pub fn check_planned(job: &Job, scene: &Scene, engine: Engine, progressive: bool) -> Result<()> {
     let settings = &job.settings;
     if engine != Engine::Path {

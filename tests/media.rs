@@ -338,8 +338,8 @@ fn volume_photons_carry_what_an_infinite_medium_scatters() {
     // probability a. So the direct photons carry Φ·a in all, and all of them Φ·a/(1 − a) (the
     // number of events is geometric with mean 1/(1 − a)). Tolerances: the direct total is
     // exact but for the RGBE rounding (dithered, < 0.1 % over 10⁵ photons); a path's total is
-    // Φ·a·K with K's relative spread √a, so over the ≥ 4·10⁴ paths that store 10⁵ photons the
-    // total's relative SE is at most √0.5/√(4·10⁴) = 0.35 %: 4 of those, 1.4 %.
+    // Φ·a·K with K's relative spread √a, and N photons come from N·(1 − a) paths, so the
+    // total's relative SE is √a/√(N·(1 − a)): 0.32 % at a = 0.5, 0.63 % at a = 0.8; 4 of those.
     let d = scratch_dir("media-photons");
     let obj = "mtllib b.mtl\nv -0.1 0 50\nv 0.1 0 50\nv 0 0.1 50\nusemtl black\nf 1 2 3\n";
     let files = [("b.obj", obj), ("b.mtl", "newmtl black\nKd 0 0 0\n")];
@@ -366,7 +366,8 @@ fn volume_photons_carry_what_an_infinite_medium_scatters() {
         let (want_direct, want_all) = (phi * a, phi * a / (1.0 - a));
         eprintln!("albedo {a}: direct {direct:.3} (Φa {want_direct:.3}), all {all:.3} (Φa/(1−a) {want_all:.3})");
         assert!((direct / want_direct - 1.0).abs() < 1e-3, "albedo {a}: direct {direct}, want {want_direct}");
-        assert!((all / want_all - 1.0).abs() < 0.014, "albedo {a}: all {all}, want {want_all}");
+        let se = (a / (100_000.0 * (1.0 - a))).sqrt();
+        assert!((all / want_all - 1.0).abs() < 4.0 * se, "albedo {a}: all {all}, want {want_all} (SE {se})");
     }
 }
 
@@ -376,7 +377,7 @@ fn the_reference_engine_keeps_the_white_furnace() {
     // photon mapper: camera rays march the medium and take single scattering by light sampling
     // and the rest from the volume map; final-gather rays that stop there by free flight read
     // the whole volume map. The radiance is 2 everywhere, so the density estimates have no
-    // gradient to blur, but near a wall a k-nearest sphere reaches out of the box and reads low.
+    // gradient to blur; near a wall they divide by the part of their sphere inside the box.
     // Each seed's photon maps are shared by its pixels, so the seeds, not the pixels, are the
     // independent samples: the mean of 8 seeds within 4 of their standard errors of 2, and that
     // standard error below 0.5 %.
@@ -388,7 +389,7 @@ fn the_reference_engine_keeps_the_white_furnace() {
     let shared = Arc::new(loaded.scene);
     let means: Vec<f32> = (1..9)
         .map(|seed| {
-            let settings = Settings { width: 16, height: 16, spp: 16, photons: 200_000, seed, ..Settings::default() };
+            let settings = Settings { width: 16, height: 16, spp: 16, photons: 400_000, seed, ..Settings::default() };
             let film = render(&shared, &rays, &settings, Engine::Reference, None, &NoProgress).unwrap().0;
             let (mean, _) = mean_and_se(&common::grey(&film));
             mean as f32
@@ -419,7 +420,9 @@ fn the_reference_engine_agrees_with_the_path_tracer_in_a_fog_box() {
     // 0.998 of the path tracer's, indirect 1.001 (0.970 with every sphere taken as whole). Each seed's maps are shared by its
     // pixels, so each side's mean is taken over its seeds with their spread as its standard
     // error; tolerance 4 standard errors of the difference plus 1 % for the estimates' blur of
-    // the lamp's gradients.
+    // the lamp's gradients. It catches gross errors (a volume estimate off by a factor, light
+    // counted twice or lost); percent-level ones (the walls' correction, 3 % of the indirect
+    // layer) are the unit tests' and BENCHMARKS.md's.
     let d = scratch_dir("media-fog-box");
     let obj = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-box.obj");
     let body = format!(
@@ -449,21 +452,21 @@ fn the_reference_engine_agrees_with_the_path_tracer_in_a_fog_box() {
     assert!((photon - path).abs() <= 4.0 * se + 0.01 * path, "{photon} ± {se_photon} against {path} ± {se_path}");
     assert!(se < 0.015 * path, "the test has no power (SE {se} against {path})");
     // Progressive passes: fresh maps each pass, the volume radii shrinking by the 3-D sequence
-    // (r³ by (i + α)/(i + 1)), fixed-radius estimates. 3 seeds of 16 passes (2·10⁴ photons and
+    // (r³ by (i + α)/(i + 1)), fixed-radius estimates. 6 seeds of 8 passes (2·10⁴ photons and
     // 2 spp each); same tolerance. Measured at 32² against 4 096 spp (4 spp a pass, camera rays
     // by free flight then): beauty 0.993, 0.994 and 0.997 of the path tracer's after 4, 16 and
     // 64 passes, relMSE 1.2·10⁻², 3.5·10⁻³, 1.2·10⁻³.
-    let progressive_means: Vec<f32> = (1..4)
+    let progressive_means: Vec<f32> = (1..7)
         .map(|seed| {
             let settings =
-                Settings { width: 24, height: 24, spp: 2, photons: 20_000, passes: 16, seed, ..Settings::default() };
+                Settings { width: 24, height: 24, spp: 2, photons: 20_000, passes: 8, seed, ..Settings::default() };
             let film = render(&shared, &rays, &settings, Engine::Reference, None, &NoProgress).unwrap().0;
             mean_and_se(&scattered(&film)).0 as f32
         })
         .collect();
     let (progressive, se_progressive) = mean_and_se(&progressive_means);
     let se = (se_progressive * se_progressive + se_path * se_path).sqrt();
-    eprintln!("fog box, 16 passes: {progressive:.5} ± {se_progressive:.5} {progressive_means:?}");
+    eprintln!("fog box, 8 passes: {progressive:.5} ± {se_progressive:.5} {progressive_means:?}");
     assert!((progressive - path).abs() <= 4.0 * se + 0.01 * path, "{progressive} ± {se_progressive} against {path}");
     assert!(se < 0.015 * path, "the test has no power (SE {se} against {path})");
 }

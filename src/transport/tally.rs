@@ -137,7 +137,10 @@ impl<'a> Tally<'a> {
                 break;
             }
             self.photons.push(photon);
-            if self.cells.is_none_or(|c| c.reads(photon.position, photon.normal)) {
+            // The pilot's cells are surfaces': a volume photon (in a medium filling the scene)
+            // counts as read wherever it lies.
+            let volume = photon.flags & crate::photon_map::flags::VOLUME != 0;
+            if volume || self.cells.is_none_or(|c| c.reads(photon.position, photon.normal)) {
                 self.read += 1;
             }
             if self.full_at.is_none() && self.stored() == self.target {
