@@ -30,8 +30,8 @@ use crate::scene::{Receiver, Scene};
 use crate::settings::Settings;
 use crate::stats::{MapStats, Numerics, PhaseTimes, RayCounts, RenderStats};
 use crate::transport::camera::render_pixels;
-use crate::transport::direct::weighted_direct_light;
-use crate::transport::media::{attenuated_direct_light, in_scattered_light, medium_receiver};
+use crate::transport::direct::{attenuated_direct_light, weighted_direct_light};
+use crate::transport::media::{in_scattered_light, medium_receiver};
 use crate::transport::mis::{emission_found, receiver, sky_found, Strategies};
 use crate::transport::specular::{continue_ray, emission_toward};
 use crate::transport::{streams, Context, PhotonMaps};
@@ -185,7 +185,7 @@ fn trace_path(ctx: &Context, media: bool, mut o: Vec3, mut d: Vec3, s: &Sampler,
             let l = if media {
                 // Each shadow ray in the medium on its side of the surface.
                 let toward = |dir: Vec3| scene.medium_on_side(hit.tri, dir);
-                attenuated_direct_light(ctx, toward, &sp, &bsdf, wo, &light_stream, &mis, rays)
+                attenuated_direct_light(ctx, toward, &sp, &bsdf, wo, &light_stream, false, &mis, rays)
             } else {
                 weighted_direct_light(ctx, &sp, &bsdf, wo, &light_stream, &mis, rays)
             };

@@ -2,9 +2,9 @@
 //! tracing; at the first non-specular hit, Jensen's terms — direct light by light sampling,
 //! caustics from the caustic map, indirect diffuse by final gather over the global map (with the
 //! secondary gather where a gather ray lands near; or the global map read directly), and the
-//! glossy lobe by one traced ray. In a medium filling the scene every segment samples free
-//! flight, and where it stops the volume maps and light sampling say what the medium scatters
-//! (`transport::volume`). Every vertex is the transport core's; only the loops are here.
+//! glossy lobe by one traced ray. In a medium filling the scene camera rays march each segment
+//! and gather rays sample free flight; the volume maps and light sampling say what the medium
+//! scatters (`transport::volume`). Every vertex is the transport core's; only the loops are here.
 //!
 //! Double counting is avoided by construction: emission that a final-gather or glossy ray hits
 //! straight away belongs to the direct term, weighted by MIS against the light samples

@@ -168,10 +168,30 @@ pub fn weighted_direct_light(
     mis: &Strategies,
     rays: &mut RayCounts,
 ) -> Vec3 {
-    let mut sum = Vec3::ZERO;
     let scene = ctx.scene;
-    direct_light_rays(ctx, sp, bsdf, wo, s, false, mis, |r| {
-        sum += unblocked(ctx, scene.filling_medium_toward(sp.tri, r.direction), &r, rays);
+    attenuated_direct_light(ctx, |v| scene.filling_medium_toward(sp.tri, v), sp, bsdf, wo, s, false, mis, rays)
+}
+
+/// The shadow rays of [`direct_light_rays`] summed, each unblocked one's contribution times the
+/// transmittance of the medium it travels in, `medium_toward` its direction (none: clear). The
+/// photon mappers' media rule gives it [`crate::scene::Scene::filling_medium_toward`] (through
+/// [`weighted_direct_light`] and [`delta_light`]), the path tracer's
+/// [`crate::scene::Scene::medium_on_side`].
+#[allow(clippy::too_many_arguments)]
+pub fn attenuated_direct_light<'m>(
+    ctx: &Context,
+    medium_toward: impl Fn(Vec3) -> Option<&'m Medium>,
+    sp: &SurfacePoint,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    s: &Sampler,
+    delta_only: bool,
+    mis: &Strategies,
+    rays: &mut RayCounts,
+) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    direct_light_rays(ctx, sp, bsdf, wo, s, delta_only, mis, |r| {
+        sum += unblocked(ctx, medium_toward(r.direction), &r, rays);
     });
     sum
 }
@@ -204,10 +224,7 @@ pub fn unblocked(ctx: &Context, medium: Option<&Medium>, r: &ShadowRay, rays: &m
 /// paths pass by sampling (frosted glass, smooth rough metal): sampling never reaches a delta
 /// light, and the other lights are found as emission along the sampled path.
 pub fn delta_light(ctx: &Context, sp: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, s: &Sampler, rays: &mut RayCounts) -> Vec3 {
-    let mut sum = Vec3::ZERO;
     let scene = ctx.scene;
-    direct_light_rays(ctx, sp, bsdf, wo, s, true, &Strategies::LightOnly, |r| {
-        sum += unblocked(ctx, scene.filling_medium_toward(sp.tri, r.direction), &r, rays);
-    });
-    sum
+    let toward = |v| scene.filling_medium_toward(sp.tri, v);
+    attenuated_direct_light(ctx, toward, sp, bsdf, wo, s, true, &Strategies::LightOnly, rays)
 }

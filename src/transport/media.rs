@@ -1,7 +1,7 @@
-//! Light in a scene-filling participating medium ([`crate::medium`]), for the path tracer:
-//! direct light at a surface attenuated by the medium ([`super::direct::unblocked`]), and
-//! the light a medium point scatters toward the camera path (in-scattering by light sampling
-//! through the phase function, weighted by MIS against the phase function's own sample).
+//! Light in a scene-filling participating medium ([`crate::medium`]): the light a medium point
+//! scatters toward the camera path (in-scattering by light sampling through the phase
+//! function, weighted by MIS against the phase function's own sample). Direct light at a
+//! surface in a medium is [`super::direct::attenuated_direct_light`].
 //!
 //! A medium point is a receiver with no surface: it takes light from every direction (a
 //! two-sided [`Receiver`] whose normal is the path's direction), so light choice and the MIS
@@ -10,37 +10,14 @@
 //! Reads the scene's lights and medium; writes radiance. The reference photon mapper uses the
 //! in-scattering for its single scattering ([`super::volume`]).
 
-use super::direct::{direct_light_rays, light_sample_density, light_samples, shadow_segment, unblocked, ShadowRay};
+use super::direct::{light_sample_density, light_samples, shadow_segment, unblocked, ShadowRay};
 use super::mis::{power_heuristic, Strategies};
 use super::Context;
-use crate::material::Bsdf;
 use crate::medium::Medium;
 use crate::rng::Sampler;
-use crate::scene::{Receiver, SurfacePoint};
+use crate::scene::Receiver;
 use crate::stats::RayCounts;
 use glam::Vec3;
-
-/// Direct light at `sp` toward `wo` by light sampling, each unblocked shadow ray's
-/// contribution times the transmittance of the medium it travels in, `medium_toward` its
-/// direction (none: clear) — the path tracer's [`super::direct::weighted_direct_light`] in
-/// media.
-#[allow(clippy::too_many_arguments)]
-pub fn attenuated_direct_light<'m>(
-    ctx: &Context,
-    medium_toward: impl Fn(Vec3) -> Option<&'m Medium>,
-    sp: &SurfacePoint,
-    bsdf: &Bsdf,
-    wo: Vec3,
-    s: &Sampler,
-    mis: &Strategies,
-    rays: &mut RayCounts,
-) -> Vec3 {
-    let mut sum = Vec3::ZERO;
-    direct_light_rays(ctx, sp, bsdf, wo, s, false, mis, |r| {
-        sum += unblocked(ctx, medium_toward(r.direction), &r, rays)
-    });
-    sum
-}
 
 /// The receiver light sampling works for at medium point `p` reached along unit `d`.
 #[must_use]

@@ -24,17 +24,19 @@
 //! Stored power = Φ-weighted path power divided by the number of paths emitted.
 //!
 //! In a medium filling the scene (Jensen and Christensen 1998), every segment samples its first
-//! interaction by free flight ([`photon_flight`]); a photon that interacts there scatters by the
-//! phase function and is stored as a volume photon ([`deposit_in_medium`]), one that passes
+//! interaction by free flight ([`super::specular::segment_flight`]); a photon that interacts
+//! there scatters by the phase function and is stored as a volume photon
+//! ([`deposit_in_medium`]), one that passes
 //! reaches the surface with the free flight's weight. The volume photons travel in the same
 //! list as the surface ones, flagged [`flags::VOLUME`], so the tally counts them toward the
 //! map's target like any other; [`super::PhotonMaps::build`] sorts them into the volume maps.
 
+use super::specular::{segment_flight, Flight};
 pub use super::tally::{normalise_power, PathCounts, PathEnd, Tally, TracedPhotons, BATCH};
 use crate::geometry::offset::{barycentric_error, offset_ray_origin};
 use crate::job::Job;
 use crate::material::{Bsdf, SurfaceFrame, Transport};
-use crate::medium::{FreeFlight, Medium};
+use crate::medium::Medium;
 use crate::photon_map::{flags, Photon};
 use crate::rng::{Domain, Sampler};
 use crate::sampling::Distribution1D;
@@ -190,16 +192,6 @@ pub fn deposit_photon(
     !caustic
 }
 
-/// Samples where photon `photon` of stream `s` first interacts with `medium` on its segment of
-/// `length` (∞ where it leaves the scene), the segment leading to the path's `bounce`-th vertex:
-/// dimensions 4 (the channel) and 5 (the distance) of bounce `bounce + 1`, which the vertex's
-/// scattering leaves free.
-#[must_use]
-#[inline]
-pub fn photon_flight(s: &Sampler, medium: &Medium, length: f32, bounce: u32) -> FreeFlight {
-    medium.free_flight(length, s.get(bounce + 1, 4), s.get(bounce + 1, 5))
-}
-
 /// At a scattering event at `p` in the medium filling the scene, `photon.power` already
 /// weighted by the free flight (the power that scatters there): stores a volume photon
 /// ([`flags::VOLUME`]) where its map wants it; returns whether the path goes on. The global
@@ -344,36 +336,32 @@ pub fn trace_path(scene: &Scene, job: &Job, domain: Domain, index: u64, out: &mu
     for bounce in 0..job.settings.max_depth {
         counts.ray();
         let hit = scene.intersect(photon.origin, photon.dir, f32::INFINITY);
-        let mut in_medium = None;
-        if let Some(medium) = scene.filling_medium(hit.as_ref(), photon.dir) {
-            let length = hit.map_or(f32::INFINITY, |h| h.t);
-            match photon_flight(&s, medium, length, bounce) {
-                FreeFlight::Scatter { distance, weight } => {
-                    photon.power *= weight;
-                    in_medium = Some((medium, photon.origin + photon.dir * distance));
+        // The segment to vertex `bounce` draws its free flight at bounce + 1 (dims 4–5), which
+        // that vertex's scattering leaves free.
+        let scattered = match segment_flight(scene, photon.origin, photon.dir, hit.as_ref(), &s, bounce + 1) {
+            Flight::Scatter { medium, p, weight } => {
+                photon.power *= weight;
+                if !deposit_in_medium(domain, p, &photon, bounce, out) {
+                    return counts;
                 }
-                FreeFlight::Pass { weight } => photon.power *= weight,
+                scatter_in_medium(&s, &medium, p, &photon, bounce)
             }
-        }
-        let scattered = if let Some((medium, p)) = in_medium {
-            if !deposit_in_medium(domain, p, &photon, bounce, out) {
-                return counts;
-            }
-            scatter_in_medium(&s, medium, p, &photon, bounce)
-        } else {
-            let Some(hit) = hit else {
-                if scene.encloses_lights {
-                    counts.end = PathEnd::Escaped;
+            Flight::Pass(weight) => {
+                photon.power *= weight;
+                let Some(hit) = hit else {
+                    if scene.encloses_lights {
+                        counts.end = PathEnd::Escaped;
+                    }
+                    return counts;
+                };
+                photon.power *= scene.interior_transmittance(&hit, photon.dir);
+                let sp = scene.surface(&hit);
+                let bsdf = scene.bsdf(&sp);
+                if !bsdf.is_delta() && !deposit_photon(domain, &sp, &bsdf, &photon, bounce, out) {
+                    return counts;
                 }
-                return counts;
-            };
-            photon.power *= scene.interior_transmittance(&hit, photon.dir);
-            let sp = scene.surface(&hit);
-            let bsdf = scene.bsdf(&sp);
-            if !bsdf.is_delta() && !deposit_photon(domain, &sp, &bsdf, &photon, bounce, out) {
-                return counts;
+                scatter_photon(&s, &sp, &bsdf, &photon, bounce)
             }
-            scatter_photon(&s, &sp, &bsdf, &photon, bounce)
         };
         match scattered {
             Scattered::Continue(next) => photon = next,

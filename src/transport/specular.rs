@@ -125,11 +125,28 @@ pub struct MediumEnd {
     pub bounces: u32,
 }
 
-/// Free flight along a camera-side segment from `o` along unit `d` to `hit` (or to infinity)
-/// in the medium filling the scene, if the segment lies in it, with dimensions 4 (the
-/// channel) and 5 (the distance) of `s`'s bounce `bounce`: `Err` with the point where it
-/// scatters and the flight's weight, or `Ok` with the weight of passing (1 outside a medium).
+/// What free flight did on a segment ([`segment_flight`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Flight {
+    /// It reaches the segment's end; the throughput takes this weight (1 outside a medium).
+    Pass(Vec3),
+    /// It scatters at `p` in `medium`; the throughput takes `weight` (σ_s·T/pdf).
+    Scatter {
+        /// The medium.
+        medium: Medium,
+        /// Where.
+        p: Vec3,
+        /// The throughput factor.
+        weight: Vec3,
+    },
+}
+
+/// Free flight along a segment from `o` along unit `d` to `hit` (or to infinity) in the medium
+/// filling the scene, if the segment lies in it ([`Scene::filling_medium`]), with dimensions 4
+/// (the channel) and 5 (the distance) of `s`'s bounce `bounce`. Camera-side chains and photons
+/// alike.
 #[inline]
+#[must_use]
 pub fn segment_flight(
     scene: &Scene,
     o: Vec3,
@@ -137,12 +154,12 @@ pub fn segment_flight(
     hit: Option<&crate::geometry::Hit>,
     s: &Sampler,
     bounce: u32,
-) -> Result<Vec3, (Medium, Vec3, Vec3)> {
-    let Some(medium) = scene.filling_medium(hit, d) else { return Ok(Vec3::ONE) };
+) -> Flight {
+    let Some(medium) = scene.filling_medium(hit, d) else { return Flight::Pass(Vec3::ONE) };
     let length = hit.map_or(f32::INFINITY, |h| h.t);
     match medium.free_flight(length, s.get(bounce, 4), s.get(bounce, 5)) {
-        FreeFlight::Scatter { distance, weight } => Err((*medium, o + d * distance, weight)),
-        FreeFlight::Pass { weight } => Ok(weight),
+        FreeFlight::Scatter { distance, weight } => Flight::Scatter { medium: *medium, p: o + d * distance, weight },
+        FreeFlight::Pass { weight } => Flight::Pass(weight),
     }
 }
 
@@ -166,8 +183,8 @@ pub fn follow_chain(
         rays.gather += 1;
         let hit = scene.intersect(o, d, f32::INFINITY);
         match segment_flight(scene, o, d, hit.as_ref(), s, first_bounce + depth) {
-            Ok(weight) => beta *= weight,
-            Err((medium, p, weight)) => {
+            Flight::Pass(weight) => beta *= weight,
+            Flight::Scatter { medium, p, weight } => {
                 return Chain::Medium(MediumEnd { p, dir: d, beta: beta * weight, medium, bounces: depth });
             }
         }

@@ -177,8 +177,11 @@ pub fn camera_in_medium(
 ) -> InMedium {
     let direct = single_scattering(ctx, medium, p, d, s, u, rays);
     let (global, caustic) = searches(ctx);
-    let walls = Walls::find(ctx, p, global.1.max(caustic.1), rays);
-    let (maps, w) = (ctx.maps, Some(&walls));
+    let maps = ctx.maps;
+    // The walls' rays only where a map can be read.
+    let walls = (!maps.volume.is_empty() || !maps.volume_caustic.is_empty())
+        .then(|| Walls::find(ctx, p, global.1.max(caustic.1), rays));
+    let w = walls.as_ref();
     let caustic = volume_estimate(ctx, &maps.volume_caustic, medium, p, d, caustic, 0, w, scratch);
     let indirect = volume_estimate(ctx, &maps.volume, medium, p, d, global, flags::OWN_TERMS, w, scratch);
     InMedium { direct, caustic, indirect }
@@ -296,6 +299,9 @@ pub fn single_scattering(
 /// The radiance a gather or glossy ray finds where its chain stopped in the medium (`end`),
 /// its chain's throughput included: the whole global volume map's estimate.
 pub fn gather_in_medium(ctx: &Context, end: &MediumEnd, rays: &mut RayCounts, scratch: &mut Nearest) -> Vec3 {
+    if ctx.maps.volume.is_empty() {
+        return Vec3::ZERO;
+    }
     let (global, _) = searches(ctx);
     let walls = Walls::find(ctx, end.p, global.1, rays);
     end.beta * volume_estimate(ctx, &ctx.maps.volume, &end.medium, end.p, end.dir, global, 0, Some(&walls), scratch)
